@@ -1,0 +1,1 @@
+"""The forward model: material laws, elements, assembly, linear and nonlinear solvers."""

@@ -1,0 +1,105 @@
+"""Mixed discretisations: everything about the mesh that assembly needs, computed once per mesh.
+
+A :class:`MixedDiscretization` stores, for all elements and integration points at once, the strain
+operator of the displacement field, the shape functions and gradients of the nonlocal strain field,
+the integration weights (including cross-section or thickness) and the global dof numbers. The
+material law and the solver never see the mesh; they work on these arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fracid.model.elasticity import UNIAXIAL, StrainState
+from fracid.model.elements import gauss_line, line_linear, line_quadratic
+
+
+@dataclass(frozen=True, eq=False)
+class MixedDiscretization:
+    """Precomputed element arrays of a mixed (u, ebar) discretisation.
+
+    Attributes
+    ----------
+    strain_state : StrainState
+        Kinematic assumption (uniaxial, plane stress).
+    weights : ndarray, shape (n_el, n_q)
+        Integration weight times Jacobian times cross-section (1D, mm^2) or thickness (2D, mm) [mm^3].
+    strain_operator : ndarray, shape (n_el, n_q, n_strain, n_u)
+        B: engineering strains at the integration points from the element displacement dofs [1/mm].
+    ebar_shape : ndarray, shape (n_q, n_e)
+        Shape functions of the nonlocal strain at the integration points.
+    ebar_gradient : ndarray, shape (n_el, n_q, dim, n_e)
+        Their gradients [1/mm].
+    u_dofs, ebar_dofs : ndarray of int, shape (n_el, n_u) and (n_el, n_e)
+        Global dof numbers; displacement dofs come first, ebar dofs are numbered from ``n_u_dofs``.
+    points : ndarray, shape (n_el, n_q, dim)
+        Coordinates of the integration points [mm].
+    n_u_dofs, n_ebar_dofs : int
+        Number of displacement and ebar dofs.
+    """
+
+    strain_state: StrainState
+    weights: np.ndarray
+    strain_operator: np.ndarray
+    ebar_shape: np.ndarray
+    ebar_gradient: np.ndarray
+    u_dofs: np.ndarray
+    ebar_dofs: np.ndarray
+    points: np.ndarray
+    n_u_dofs: int
+    n_ebar_dofs: int
+
+    @property
+    def n_elements(self) -> int:
+        return self.weights.shape[0]
+
+    @property
+    def n_dofs(self) -> int:
+        return self.n_u_dofs + self.n_ebar_dofs
+
+
+def bar_discretization(vertices, areas, n_gauss: int = 3) -> MixedDiscretization:
+    """Mixed 1D bar elements: quadratic displacement, linear nonlocal strain.
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n_el + 1,)
+        Increasing element end coordinates [mm].
+    areas : array_like, shape (n_el,) or float
+        Cross-section of each element [mm^2].
+    n_gauss : int
+        Gauss points per element (3 integrates the elastic quadratic-element stiffness exactly
+        and the element mass of the linear ebar field exactly).
+
+    Notes
+    -----
+    Displacement nodes are the vertices and the element mid-points, numbered along the bar
+    (vertex i is u node 2 i); ebar nodes are the vertices.
+    """
+    x = np.asarray(vertices, dtype=float)
+    if x.ndim != 1 or x.size < 2 or np.any(np.diff(x) <= 0):
+        raise ValueError("bar vertices must be a strictly increasing 1D array of at least two coordinates")
+    n_el = x.size - 1
+    areas = np.broadcast_to(np.asarray(areas, dtype=float), (n_el,))
+    if np.any(~np.isfinite(areas)) or np.any(areas <= 0):
+        raise ValueError("every element cross-section must be positive and finite")
+    xi, gw = gauss_line(n_gauss)
+    Nu, dNu = line_quadratic(xi)
+    Ne, dNe = line_linear(xi)
+    half = 0.5 * np.diff(x)  # Jacobian dx/dxi
+    mid = 0.5 * (x[:-1] + x[1:])
+    el = np.arange(n_el)
+    return MixedDiscretization(
+        strain_state=UNIAXIAL,
+        weights=(gw[None, :] * half[:, None]) * areas[:, None],
+        strain_operator=(dNu[None, :, :] / half[:, None, None])[:, :, None, :],
+        ebar_shape=Ne,
+        ebar_gradient=(dNe[None, :, :] / half[:, None, None])[:, :, None, :],
+        u_dofs=np.stack([2 * el, 2 * el + 1, 2 * el + 2], axis=1),
+        ebar_dofs=(2 * n_el + 1) + np.stack([el, el + 1], axis=1),
+        points=(mid[:, None] + half[:, None] * xi[None, :])[:, :, None],
+        n_u_dofs=2 * n_el + 1,
+        n_ebar_dofs=n_el + 1,
+    )

@@ -1,0 +1,110 @@
+"""Element residuals and consistent tangents of the damage models, for all elements at once.
+
+Pure functions over the arrays of a :class:`~fracid.model.discretization.MixedDiscretization`:
+the material law enters only through :func:`~fracid.model.damage.exponential_damage`,
+:func:`~fracid.model.damage.update_history` and the equivalent strain of the strain state.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from fracid.model.damage import exponential_damage, update_history
+
+
+class ElementArrays(NamedTuple):
+    """Element vectors and matrices of one evaluation.
+
+    ``residual`` is (n_el, n_dof_el) with the displacement dofs first; ``tangent`` is
+    (n_el, n_dof_el, n_dof_el); ``reference`` holds per field the element vectors whose assembled
+    norm scales that field's residual (internal forces for u, the equivalent-strain source for ebar).
+    """
+
+    residual: np.ndarray
+    tangent: np.ndarray
+    reference: dict
+    kappa: np.ndarray
+    omega: np.ndarray
+
+
+class ModelConstants(NamedTuple):
+    """What the kernels need besides the current state: built once per problem."""
+
+    E: np.ndarray  # Young's modulus at every integration point [MPa], (n_el, n_q)
+    D: np.ndarray  # unit elastic matrix (n_strain, n_strain)
+    DB: np.ndarray  # D times the strain operator, (n_el, n_q, n_strain, n_u)
+    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant
+
+
+def model_constants(disc, params, stiffness_factor) -> ModelConstants:
+    """Precompute the parts of the tangent that do not change during a computation."""
+    E = params.E * np.broadcast_to(stiffness_factor, disc.weights.shape)
+    D = disc.strain_state.unit_elastic_matrix(params.nu)
+    DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
+    N, G, w = disc.ebar_shape, disc.ebar_gradient, disc.weights
+    M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
+    return ModelConstants(E, D, DB, M)
+
+
+def _damage(params, kappa):
+    return exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
+
+
+def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
+    """Implicit gradient-enhanced damage: residuals of equilibrium and of the diffusion equation.
+
+    Parameters
+    ----------
+    ue, ee : ndarray, shape (n_el, n_u) and (n_el, n_e)
+        Element displacements [mm] and nonlocal strains [-].
+    kappa_old : ndarray, shape (n_el, n_q)
+        History variable at the end of the last converged step.
+    out_tangent : ndarray, shape (n_el, n_u + n_e, n_u + n_e)
+        Buffer for the element tangents; its ebar-ebar block must already hold ``const.ebar_matrix``.
+    """
+    B, N, w = disc.strain_operator, disc.ebar_shape, disc.weights
+    nu = B.shape[-1]
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    ebar = ee @ N.T
+    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    kappa, loading = update_history(kappa_old, ebar)
+    omega, d_omega = _damage(params, kappa)
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
+    w_sec = w * (1.0 - omega) * const.E
+    f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])
+    f_eq = (w * eq) @ N
+    f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
+    out_tangent[:, :nu, :nu] = np.einsum("eqsi,eqsj->eij", B * w_sec[..., None, None], const.DB)
+    w_ue = -(w * const.E * d_omega * loading)
+    out_tangent[:, :nu, nu:] = np.einsum("eqi,qj->eij", np.einsum("eqsi,eqs->eqi", B, sigma_eff) * w_ue[..., None], N)
+    out_tangent[:, nu:, :nu] = -np.einsum("qi,eqj->eij", N, np.einsum("eqs,eqsj->eqj", d_eq * w[..., None], B))
+    return ElementArrays(np.concatenate([f_u, f_e], axis=1), out_tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
+
+
+def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
+    """Local damage (no regularisation): kappa follows the local equivalent strain; mesh-dependent."""
+    B, w = disc.strain_operator, disc.weights
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    kappa, loading = update_history(kappa_old, eq)
+    omega, d_omega = _damage(params, kappa)
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
+    w_sec = w * (1.0 - omega) * const.E
+    f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])
+    secant = np.einsum("eqsi,eqsj->eij", B * w_sec[..., None, None], const.DB)
+    softening = np.einsum(
+        "eqi,eqj->eij",
+        np.einsum("eqsi,eqs->eqi", B, sigma_eff) * (w * const.E * d_omega * loading)[..., None],
+        np.einsum("eqs,eqsj->eqj", d_eq, B),
+    )
+    out_tangent[:] = secant - softening
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)
+
+
+def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
+    """Recoverable energy 1/2 int (1 - omega) E eps . D eps dV [N mm]."""
+    eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
+    return 0.5 * float(np.sum(disc.weights * (1.0 - omega) * const.E * np.sum(eps * sigma_eff, axis=-1)))

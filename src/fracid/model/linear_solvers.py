@@ -1,0 +1,62 @@
+"""Linear-solver backends behind one small interface.
+
+A backend is any object with ``solve(matrix, rhs) -> x`` for a square sparse CSC matrix and a
+right-hand side of shape (n,) or (n, k). It raises :class:`SingularMatrixError` when the matrix
+cannot be factorized, which the Newton solver treats as a failed iteration (the step is cut).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+
+class SingularMatrixError(RuntimeError):
+    """The tangent matrix could not be factorized."""
+
+
+class LinearSolver(Protocol):
+    name: str
+
+    def solve(self, matrix, rhs: np.ndarray) -> np.ndarray: ...
+
+
+class SuperLUSolver:
+    """Sparse LU factorization of SciPy (SuperLU), the default backend.
+
+    Parameters
+    ----------
+    permc_spec : str
+        Column ordering passed to :func:`scipy.sparse.linalg.splu`.
+    """
+
+    name = "superlu"
+
+    def __init__(self, permc_spec: str = "COLAMD"):
+        self.permc_spec = permc_spec
+
+    def solve(self, matrix, rhs):
+        try:
+            lu = spla.splu(matrix, permc_spec=self.permc_spec)
+        except RuntimeError as err:  # "Factor is exactly singular"
+            raise SingularMatrixError(str(err)) from err
+        return lu.solve(rhs)
+
+
+_BACKENDS = {"superlu": SuperLUSolver}
+
+
+def linear_solver(spec=None) -> LinearSolver:
+    """Return a backend from a name (``"superlu"``), an instance (returned as is), or None (default)."""
+    if spec is None:
+        return SuperLUSolver()
+    if isinstance(spec, str):
+        try:
+            return _BACKENDS[spec.lower()]()
+        except KeyError:
+            raise ValueError(f"unknown linear solver {spec!r}; available: {sorted(_BACKENDS)}") from None
+    if not callable(getattr(spec, "solve", None)):
+        raise TypeError(f"a linear solver needs a solve(matrix, rhs) method; got {type(spec).__name__}")
+    return spec

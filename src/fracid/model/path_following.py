@@ -1,0 +1,257 @@
+"""Incremental analysis: adaptive steps along a control quantity, step cutting, stop criteria."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+
+from fracid.model.linear_solvers import linear_solver as _make_linear_solver
+from fracid.model.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
+
+
+@dataclass
+class PathResult:
+    """Outcome of an incremental analysis, one entry per converged step (step 0 is the unloaded state).
+
+    Attributes
+    ----------
+    control_name : str
+        The prescribed functional.
+    control : ndarray
+        Its value at every step [mm].
+    force : ndarray
+        The load factor, i.e. the applied force for the unit load pattern [N].
+    observables : dict {name: ndarray}
+        Every named functional of the problem [mm], the load-point displacement, the external work,
+        elastic energy and dissipated energy [N mm], and the specimen's observers.
+    fields : dict {step: dict}
+        Fields (u, ebar, kappa, omega) at the requested steps.
+    stats : SolverStatistics
+    status : str
+        Why the analysis ended.
+    """
+
+    control_name: str
+    control: np.ndarray
+    force: np.ndarray
+    observables: dict
+    fields: dict = field(default_factory=dict)
+    stats: SolverStatistics = field(default_factory=SolverStatistics)
+    status: str = ""
+
+    @property
+    def n_steps(self) -> int:
+        return self.control.size - 1
+
+    @property
+    def peak_force(self) -> float:
+        """Largest absolute applied force [N]."""
+        return float(np.max(np.abs(self.force)))
+
+    def curve(self, name: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(displacement-like quantity, force): the control by default, or any observable."""
+        x = self.control if name is None or name == self.control_name else self.observables[name]
+        return x, self.force
+
+
+class ConvergenceError(RuntimeError):
+    """The analysis could not go on even with the smallest step; ``partial`` holds what converged."""
+
+    def __init__(self, message: str, partial: PathResult):
+        super().__init__(message)
+        self.partial = partial
+
+
+@dataclass(frozen=True)
+class StepOptions:
+    """Adaptive step-size rule.
+
+    Parameters
+    ----------
+    initial : float or None
+        First increment of the control quantity [mm]; None: 1/20 of the control value at damage onset.
+    maximum, minimum : float or None
+        Bounds on the increment [mm]; None: 4 x and 1e-4 x the initial increment.
+    grow, shrink : float
+        Factor applied after an easy increment (at most ``easy_iterations``) and after a cut.
+    easy_iterations : int
+    """
+
+    initial: float | None = None
+    maximum: float | None = None
+    minimum: float | None = None
+    grow: float = 1.5
+    shrink: float = 0.5
+    easy_iterations: int = 4
+
+
+def _check_request(problem, control, target, stop_force_fraction, max_steps):
+    if control not in problem.functionals:
+        raise ValueError(f"unknown control {control!r}; this specimen offers {sorted(problem.functionals)}")
+    if not (isinstance(target, (int, float)) and math.isfinite(target) and target > 0):
+        raise ValueError(f"target = {target!r}: the final control value must be a positive finite number [mm]")
+    if stop_force_fraction is not None and not 0.0 < stop_force_fraction < 1.0:
+        raise ValueError(f"stop_force_fraction = {stop_force_fraction!r}; it must be in (0, 1) or None")
+    if int(max_steps) != max_steps or max_steps < 1:
+        raise ValueError(f"max_steps = {max_steps!r}; it must be a positive integer")
+
+
+def _check_steps(steps: StepOptions, target):
+    for name in ("initial", "maximum", "minimum"):
+        value = getattr(steps, name)
+        if value is not None and not (math.isfinite(value) and 0 < value <= target):
+            raise ValueError(f"step {name} = {value!r} [mm]; it must be positive and not above the target {target}")
+    if not (steps.grow >= 1.0 and 0.0 < steps.shrink < 1.0):
+        raise ValueError(f"step grow = {steps.grow}, shrink = {steps.shrink}: need grow >= 1 and 0 < shrink < 1")
+
+
+def follow_path(
+    problem,
+    control: str,
+    target: float,
+    *,
+    steps: StepOptions = StepOptions(),
+    stop_force_fraction: float | None = None,
+    max_steps: int = 2000,
+    newton: NewtonOptions = NewtonOptions(),
+    linear_solver=None,
+    observers: Mapping[str, Callable] | None = None,
+    field_steps="last",
+    callback: Callable | None = None,
+) -> PathResult:
+    """Trace the equilibrium path by increasing the functional ``control`` up to ``target``.
+
+    Parameters
+    ----------
+    problem : DamageProblem
+    control : str
+        Name of the prescribed functional (one of ``problem.functionals``).
+    target : float
+        Final value of the control quantity [mm].
+    steps : StepOptions
+        Adaptive step-size rule. While the material is still undamaged, the response is linear and
+        the next step jumps straight to just below damage onset.
+    stop_force_fraction : float, optional
+        Stop once the force has fallen below this fraction of its peak after the peak.
+    max_steps : int
+        Stop after this many converged steps.
+    newton : NewtonOptions
+    linear_solver : str, LinearSolver or None
+        Backend (default SuperLU).
+    observers : mapping {name: f(problem, q, arrays) -> float}, optional
+        Scalar observables evaluated at every converged step (e.g. the damaged-zone width).
+    field_steps : "last", "all", None or iterable of int
+        Steps at which the fields are stored (the last converged step is always stored unless None).
+    callback : callable(step, tau, force), optional
+        Called after each converged step (progress reporting).
+
+    Returns
+    -------
+    PathResult
+
+    Raises
+    ------
+    ConvergenceError
+        When an increment fails even at the minimum step; its ``partial`` attribute holds the steps
+        that converged.
+    """
+    _check_request(problem, control, target, stop_force_fraction, max_steps)
+    _check_steps(steps, target)
+    t_start = time.perf_counter()
+    solver = _make_linear_solver(linear_solver)
+    system = ControlledSystem(problem, problem.functionals[control])
+    observers = dict(observers or {})
+    keep = _field_selector(field_steps)
+    stats = SolverStatistics()
+    load_point = problem.load_vector / np.dot(problem.load_vector, problem.load_vector)
+
+    z = np.zeros(problem.n_free + 1)
+    kappa = problem.initial_history()
+    final = None  # (step, q, arrays) of the last converged step
+    records = {"tau": [0.0], "force": [0.0], "work": [0.0], "elastic": [0.0], "load_point": [0.0]}
+    records.update({name: [0.0] for name in problem.functionals})
+    records.update({name: [0.0] for name in observers})
+    fields = {}
+    tau, peak, status = 0.0, 0.0, "target reached"
+    base = steps.initial  # reference increment; set from the onset of damage when not given
+    step = base if base is not None else 1e-3 * target  # elastic probe
+    elastic = True
+
+    def result(final_status):
+        stats.time_total = time.perf_counter() - t_start
+        if final is not None and field_steps is not None and final[0] not in fields:
+            fields[final[0]] = problem.fields(final[1], final[2].kappa, final[2].omega)
+        obs = {name: np.array(records[name]) for name in list(problem.functionals) + list(observers)}
+        obs["load_point_displacement"] = np.array(records["load_point"])
+        obs["external_work"] = np.array(records["work"])
+        obs["elastic_energy"] = np.array(records["elastic"])
+        obs["dissipated_energy"] = obs["external_work"] - obs["elastic_energy"]
+        return PathResult(control, np.array(records["tau"]), np.array(records["force"]), obs, fields, stats, final_status)
+
+    while tau < target * (1.0 - 1e-12):
+        if stats.steps >= max_steps:
+            status = f"stopped after max_steps = {max_steps} steps"
+            break
+        increment = min(step, target - tau)
+        try:
+            z_new, arrays, iterations = solve_increment(system, z, tau + increment, kappa, solver, newton, stats)
+        except IncrementFailed as err:
+            stats.failed_increments += 1
+            step = increment * steps.shrink
+            minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or increment)
+            if step < minimum:
+                message = (
+                    f"increment from {control} = {tau:.6g} mm failed at the minimum step {increment:.3g} mm "
+                    f"after {stats.steps} converged steps (peak force {peak:.6g} N): {err}"
+                )
+                raise ConvergenceError(message, result("failed: " + str(err))) from None
+            continue
+        tau += increment
+        z, kappa = z_new, arrays.kappa
+        q, force = z[:-1], z[-1]
+        stats.steps += 1
+        final = (stats.steps, q, arrays)
+        displacement = float(load_point @ q)
+        work = 0.5 * (force + records["force"][-1]) * (displacement - records["load_point"][-1])
+        records["work"].append(records["work"][-1] + work)
+        records["tau"].append(tau)
+        records["force"].append(force)
+        records["load_point"].append(displacement)
+        records["elastic"].append(problem.elastic_energy(q, arrays.omega))
+        for name, vec in problem.functionals.items():
+            records[name].append(float(vec @ q))
+        for name, fn in observers.items():
+            records[name].append(float(fn(problem, q, arrays)))
+        if keep(stats.steps):
+            fields[stats.steps] = problem.fields(q, kappa, arrays.omega)
+        if callback is not None:
+            callback(stats.steps, tau, force)
+        peak = max(peak, abs(force))
+        if stop_force_fraction is not None and abs(force) < stop_force_fraction * peak:
+            status = f"force below {stop_force_fraction:g} of the peak"
+            break
+        onset_ratio = float(kappa.max()) / problem.params.kappa_i
+        if elastic and 0.0 < onset_ratio < 1.0:
+            # linear response so far: jump to just below damage onset
+            tau_onset = tau / onset_ratio
+            base = base if base is not None else tau_onset / 20.0
+            step = max(tau_onset * (1.0 - 1e-3) - tau, base)
+            continue
+        elastic = False
+        base = base if base is not None else increment
+        maximum = steps.maximum if steps.maximum is not None else 4.0 * base
+        step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
+    return result(status)
+
+
+def _field_selector(field_steps):
+    if field_steps is None or field_steps == "last":
+        return lambda step: False
+    if field_steps == "all":
+        return lambda step: True
+    wanted = {int(s) for s in field_steps}
+    return lambda step: step in wanted

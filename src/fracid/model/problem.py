@@ -1,0 +1,139 @@
+"""A discretised damage model with its boundary conditions, load pattern and named functionals."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+
+from fracid.model.assembly import assemble_vector
+from fracid.model.discretization import MixedDiscretization
+from fracid.model.forms import elastic_energy, gradient_damage, local_damage, model_constants
+from fracid.model.parameters import DamageParameters
+
+REGULARIZATIONS = ("gradient", "local")
+
+
+class DamageProblem:
+    """Damage model on a mixed discretisation, ready for the nonlinear solver.
+
+    Dirichlet conditions are homogeneous (eliminated dofs); the structure is loaded by a force pattern
+    scaled by the load factor lambda (so lambda is the applied force in N for a unit pattern). Which
+    quantity is prescribed (an end displacement, an elongation, a CMOD) is a named linear functional of
+    the displacements chosen at solve time, so snap-back can be traced by indirect displacement control.
+
+    Parameters
+    ----------
+    disc : MixedDiscretization
+    params : DamageParameters
+    regularization : {"gradient", "local"}
+        Implicit gradient-enhanced damage, or the local damage model (no ebar dofs) for comparison.
+    stiffness_factor : float or ndarray, shape (n_el, n_q)
+        Young's modulus at each integration point relative to ``params.E`` (weak zones) [-].
+    fixed_dofs : sequence of int
+        Global displacement dofs held at zero.
+    load : mapping {dof: weight}
+        The force pattern f_hat; the applied force is lambda * f_hat [N].
+    functionals : mapping {name: {dof: coefficient}}
+        Linear functionals of the displacement (control quantities, observables) [mm].
+    """
+
+    def __init__(
+        self,
+        disc: MixedDiscretization,
+        params: DamageParameters,
+        *,
+        regularization: str = "gradient",
+        stiffness_factor=1.0,
+        fixed_dofs=(),
+        load: Mapping[int, float],
+        functionals: Mapping[str, Mapping[int, float]],
+    ):
+        if regularization not in REGULARIZATIONS:
+            raise ValueError(f"regularization = {regularization!r}; choose one of {REGULARIZATIONS}")
+        if not isinstance(params, DamageParameters):
+            raise TypeError(f"params must be DamageParameters, got {type(params).__name__}")
+        self.disc, self.params, self.regularization = disc, params, regularization
+        gradient = regularization == "gradient"
+        n_active = disc.n_dofs if gradient else disc.n_u_dofs
+        fixed = np.unique(np.asarray(fixed_dofs, dtype=int))
+        if fixed.size and (fixed.min() < 0 or fixed.max() >= disc.n_u_dofs):
+            raise ValueError(f"fixed dofs must be displacement dofs in [0, {disc.n_u_dofs}); got {fixed.tolist()}")
+        self.free_index = np.full(disc.n_dofs, -1)
+        free = np.setdiff1d(np.arange(n_active), fixed)
+        self.free_index[free] = np.arange(free.size)
+        self.n_free = free.size
+        dofs = np.concatenate([disc.u_dofs, disc.ebar_dofs], axis=1) if gradient else disc.u_dofs
+        self.element_dofs = self.free_index[dofs]
+        self.blocks = {"u": self.free_index[: disc.n_u_dofs][self.free_index[: disc.n_u_dofs] >= 0]}
+        if gradient:
+            self.blocks["ebar"] = self.free_index[disc.n_u_dofs :]
+        self.load_vector = self._dense(load, "load")
+        if not np.any(self.load_vector):
+            raise ValueError("the load pattern is empty or acts only on fixed dofs")
+        self.functionals = {name: self._dense(f, f"functional {name!r}") for name, f in functionals.items()}
+        self.const = model_constants(disc, params, stiffness_factor)
+        n_u = disc.u_dofs.shape[1]
+        self._tangent = np.zeros((disc.n_elements,) + (self.element_dofs.shape[1],) * 2)
+        if gradient:
+            self._tangent[:, n_u:, n_u:] = self.const.ebar_matrix
+
+    def _dense(self, entries: Mapping[int, float], what: str) -> np.ndarray:
+        vec = np.zeros(self.n_free)
+        for dof, value in entries.items():
+            if not 0 <= dof < self.disc.n_u_dofs:
+                raise ValueError(f"{what}: dof {dof} is not a displacement dof")
+            if self.free_index[dof] >= 0:
+                vec[self.free_index[dof]] += value
+            elif what == "load":
+                raise ValueError(f"load: dof {dof} is fixed; a load on a support does no work")
+        return vec
+
+    def initial_history(self) -> np.ndarray:
+        """History variable kappa of the virgin material, at every integration point."""
+        return np.zeros(self.disc.weights.shape)
+
+    def gather(self, q: np.ndarray) -> np.ndarray:
+        """Element dof values from the free-dof vector (eliminated dofs are zero)."""
+        return np.append(q, 0.0)[self.element_dofs]
+
+    def evaluate(self, q: np.ndarray, kappa_old: np.ndarray):
+        """Internal-force residual, element tangents and per-field reference norms at state q.
+
+        Returns
+        -------
+        residual : ndarray, shape (n_free,)
+            Internal forces minus the equivalent-strain source (no external load).
+        arrays : ElementArrays
+            Element tangents, trial history and damage.
+        references : dict {field: float}
+            Norms that make the residual of each field relative.
+        """
+        qe = self.gather(q)
+        n_u = self.disc.u_dofs.shape[1]
+        if self.regularization == "gradient":
+            arrays = gradient_damage(self.disc, self.params, self.const, qe[:, :n_u], qe[:, n_u:], kappa_old, self._tangent)
+        else:
+            arrays = local_damage(self.disc, self.params, self.const, qe, kappa_old, self._tangent)
+        residual = assemble_vector(self.element_dofs, arrays.residual, self.n_free)
+        references = {}
+        for field, element_ref in arrays.reference.items():
+            dofs = self.element_dofs[:, :n_u] if field == "u" else self.element_dofs[:, n_u:]
+            references[field] = float(np.linalg.norm(assemble_vector(dofs, element_ref, self.n_free)))
+        return residual, arrays, references
+
+    def full_vector(self, q: np.ndarray) -> np.ndarray:
+        """All dofs (displacements then ebar), eliminated ones zero."""
+        return np.where(self.free_index >= 0, np.append(q, 0.0)[self.free_index], 0.0)
+
+    def fields(self, q: np.ndarray, kappa: np.ndarray, omega: np.ndarray) -> dict:
+        """Nodal u [mm] and ebar [-], and kappa, omega [-] at the integration points."""
+        full = self.full_vector(q)
+        out = {"u": full[: self.disc.n_u_dofs], "kappa": kappa.copy(), "omega": omega.copy()}
+        if self.regularization == "gradient":
+            out["ebar"] = full[self.disc.n_u_dofs :]
+        return out
+
+    def elastic_energy(self, q: np.ndarray, omega: np.ndarray) -> float:
+        """Recoverable elastic energy of the state [N mm]."""
+        return elastic_energy(self.disc, self.const, self.gather(q)[:, : self.disc.u_dofs.shape[1]], omega)

@@ -1,0 +1,150 @@
+"""Monolithic Newton-Raphson on a damage problem under indirect displacement control.
+
+The unknowns are the free dofs q and the load factor lambda. The equations are equilibrium (and the
+diffusion equation) r(q) - lambda f_hat = 0 and the control constraint v . q = tau, with v a linear
+functional of the displacements (an end displacement, an elongation over a gauge length, a CMOD).
+With v the displacement of the loaded point this is plain displacement control; with another v it
+traces snap-back. The bordered matrix [[K, -f_hat], [v^T, 0]] is assembled into one sparse pattern
+built once, and stays regular at limit points of the load.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fracid.model.assembly import SparsePattern
+from fracid.model.linear_solvers import SingularMatrixError
+
+
+class IncrementFailed(RuntimeError):
+    """One increment did not converge (the caller cuts the step)."""
+
+
+@dataclass(frozen=True)
+class NewtonOptions:
+    """Convergence settings of the Newton-Raphson iterations.
+
+    Parameters
+    ----------
+    rtol_u : float
+        Relative tolerance on the equilibrium residual, scaled by the norm of the internal forces.
+    rtol_ebar : float
+        Relative tolerance on the residual of the diffusion equation, scaled by the norm of the
+        equivalent-strain source.
+    max_iterations : int
+        Iterations before an increment counts as failed.
+    """
+
+    rtol_u: float = 1e-8
+    rtol_ebar: float = 1e-8
+    max_iterations: int = 12
+
+    def __post_init__(self):
+        for name in ("rtol_u", "rtol_ebar"):
+            value = getattr(self, name)
+            if not (0.0 < value < 1.0):
+                raise ValueError(f"NewtonOptions.{name} = {value!r}; it must be in (0, 1)")
+        if int(self.max_iterations) != self.max_iterations or self.max_iterations < 1:
+            raise ValueError(f"NewtonOptions.max_iterations = {self.max_iterations!r}; it must be a positive integer")
+
+    def tolerance(self, field_name: str) -> float:
+        return {"u": self.rtol_u, "ebar": self.rtol_ebar}[field_name]
+
+
+@dataclass
+class SolverStatistics:
+    """Counters and timers of a forward analysis (wall times in s)."""
+
+    steps: int = 0
+    iterations: int = 0
+    failed_increments: int = 0
+    time_linear: float = 0.0
+    time_total: float = 0.0
+    linear_solves: int = 0
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class ControlledSystem:
+    """A :class:`~fracid.model.problem.DamageProblem` bordered by the load factor and one control functional."""
+
+    problem: object
+    control: np.ndarray
+    pattern: SparsePattern = field(init=False)
+    border_values: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        n = self.problem.n_free
+        f_idx = np.flatnonzero(self.problem.load_vector)
+        v_idx = np.flatnonzero(self.control)
+        if v_idx.size == 0:
+            raise ValueError("the control functional is zero on the free dofs: it cannot be prescribed")
+        rows = np.concatenate([f_idx, np.full(v_idx.size, n)])
+        cols = np.concatenate([np.full(f_idx.size, n), v_idx])
+        self.border_values = np.concatenate([-self.problem.load_vector[f_idx], self.control[v_idx]])
+        self.pattern = SparsePattern(n + 1, self.problem.element_dofs, rows, cols)
+
+    def evaluate(self, z: np.ndarray, tau: float, kappa_old: np.ndarray):
+        """Residual of the bordered system, element arrays, and relative residual per field."""
+        p = self.problem
+        q, lam = z[:-1], z[-1]
+        internal, arrays, references = p.evaluate(q, kappa_old)
+        residual = np.append(internal - lam * p.load_vector, self.control @ q - tau)
+        external = abs(lam) * np.linalg.norm(p.load_vector)
+        errors = {}
+        for name, idx in p.blocks.items():
+            scale = max(references[name], external if name == "u" else 0.0)
+            norm = float(np.linalg.norm(residual[idx]))
+            errors[name] = norm / scale if scale > 0.0 else norm
+        return residual, arrays, errors
+
+    def matrix(self, arrays):
+        return self.pattern.matrix(arrays.tangent, self.border_values)
+
+
+def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics):
+    """Newton-Raphson iterations for one increment to the control value ``tau``.
+
+    Returns
+    -------
+    z : ndarray
+        Converged free dofs followed by the load factor.
+    arrays : ElementArrays
+        Element arrays at the converged state (trial history and damage).
+    iterations : int
+
+    Raises
+    ------
+    IncrementFailed
+        On a non-finite residual, a singular tangent, or no convergence in ``options.max_iterations``.
+    """
+    z = z0.copy()
+    scale = max(abs(tau), 1e-300)
+    for iteration in range(options.max_iterations + 1):
+        residual, arrays, errors = system.evaluate(z, tau, kappa_old)
+        if not np.all(np.isfinite(residual)):
+            raise IncrementFailed(f"non-finite residual at iteration {iteration}")
+        if iteration > 0 and abs(residual[-1]) <= 1e-10 * scale and all(
+            err <= options.tolerance(name) for name, err in errors.items()
+        ):
+            return z, arrays, iteration
+        if iteration == options.max_iterations:
+            break
+        matrix = system.matrix(arrays)
+        t0 = time.perf_counter()
+        try:
+            dz = solver.solve(matrix, -residual)
+        except SingularMatrixError as err:
+            raise IncrementFailed(f"singular tangent at iteration {iteration}: {err}") from err
+        finally:
+            stats.time_linear += time.perf_counter() - t0
+            stats.linear_solves += 1
+        stats.iterations += 1
+        z += dz
+    detail = ", ".join(f"{k}: {v:.2e}" for k, v in errors.items())
+    raise IncrementFailed(f"no convergence in {options.max_iterations} iterations (relative residuals {detail})")
