@@ -20,7 +20,7 @@ def _from_invariants(I1, J2, nu, eta):
     safe = np.where(root > 0.0, root, 1.0)
     has_root = root > 0.0
     d_I1 = (a + np.where(has_root, a * a * I1 / safe, 0.0)) / (2.0 * eta)
-    d_J2 = np.where(has_root, 6.0 / ((1.0 + nu) ** 2 * safe), 0.0)
+    d_J2 = np.where(has_root, 3.0 / ((1.0 + nu) ** 2 * safe), 0.0)
     return eps_eq, d_I1, d_J2
 
 

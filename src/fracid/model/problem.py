@@ -126,6 +126,15 @@ class DamageProblem:
         """All dofs (displacements then ebar), eliminated ones zero."""
         return np.where(self.free_index >= 0, np.append(q, 0.0)[self.free_index], 0.0)
 
+    def restrict(self, full: np.ndarray) -> np.ndarray:
+        """Free-dof vector from all dofs (displacements, then ebar if any): inverse of :meth:`full_vector`."""
+        padded = np.zeros(self.disc.n_dofs)
+        padded[: len(full)] = full
+        active = self.free_index >= 0
+        q = np.zeros(self.n_free)
+        q[self.free_index[active]] = padded[active]
+        return q
+
     def fields(self, q: np.ndarray, kappa: np.ndarray, omega: np.ndarray) -> dict:
         """Nodal u [mm] and ebar [-], and kappa, omega [-] at the integration points."""
         full = self.full_vector(q)
