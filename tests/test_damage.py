@@ -40,4 +40,4 @@ def test_history_update_kuhn_tucker():
     driving = np.array([1e-4, 1e-4, 3e-4, 3e-4])
     kappa, loading = update_history(kappa_old, driving)
     np.testing.assert_array_equal(kappa, [1e-4, 2e-4, 3e-4, 3e-4])
-    np.testing.assert_array_equal(loading, [True, False, True, False])  # neutral loading counts as unloading
+    np.testing.assert_array_equal(loading, [True, False, True, True])  # neutral loading counts as loading

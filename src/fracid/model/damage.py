@@ -37,14 +37,17 @@ def update_history(kappa_old, driving):
     """Kuhn-Tucker update of the history variable.
 
     kappa = max(kappa_old, driving); the point is loading (d kappa / d driving = 1) where the driving
-    strain exceeds the history, unloading or neutral (derivative 0) elsewhere.
+    strain reaches the history, unloading (derivative 0) where it is below. Neutral loading counts
+    as loading: at the first iteration of a step (driving = kappa_old at the points that were loading)
+    the tangent then continues the last step's loading pattern instead of starting from the secant
+    stiffness, which is what keeps Newton from cycling near the peak.
 
     Returns
     -------
     kappa : ndarray
     loading : ndarray of bool
     """
-    loading = driving > kappa_old
+    loading = driving >= kappa_old
     return np.where(loading, driving, kappa_old), loading
 
 

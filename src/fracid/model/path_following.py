@@ -79,6 +79,10 @@ class StepOptions:
     grow, shrink : float
         Factor applied after an easy increment (at most ``easy_iterations``) and after a cut.
     easy_iterations : int
+    onset_fraction : float
+        The first increment after damage onset, as a fraction of ``initial``; the steps then grow
+        back. Small first steps resolve the peak and keep the damaged zone that a single large step
+        would create at once (an artefact, blatant in the local model) from appearing.
     """
 
     initial: float | None = None
@@ -87,6 +91,7 @@ class StepOptions:
     grow: float = 1.5
     shrink: float = 0.5
     easy_iterations: int = 4
+    onset_fraction: float = 0.02
 
 
 def _check_request(problem, control, target, stop_force_fraction, max_steps):
@@ -239,10 +244,13 @@ def follow_path(
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
             base = base if base is not None else tau_onset / 20.0
-            step = max(tau_onset * (1.0 - 1e-3) - tau, base)
+            step = max(tau_onset * (1.0 - 1e-3) - tau, base * steps.onset_fraction)
             continue
-        elastic = False
         base = base if base is not None else increment
+        if elastic:  # this step crossed damage onset: go on with small steps, growing again
+            elastic = False
+            step = base * steps.onset_fraction
+            continue
         maximum = steps.maximum if steps.maximum is not None else 4.0 * base
         step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
     return result(status)

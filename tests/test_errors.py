@@ -1,0 +1,98 @@
+"""Invalid parameters and impossible requests fail early with messages naming what is wrong."""
+
+import numpy as np
+import pytest
+
+import fracid
+
+
+@pytest.mark.parametrize(
+    "changes, words",
+    [
+        ({"E": -1.0}, ["'E'", "-1.0", "0 < E"]),
+        ({"nu": 0.5}, ["'nu'", "0.5", "nu < 0.5"]),
+        ({"kappa_i": 0.0}, ["'kappa_i'", "0 < kappa_i"]),
+        ({"alpha": 1.5}, ["'alpha'", "1.5", "0 <= alpha <= 1"]),
+        ({"beta": -3}, ["'beta'", "-3", "0 <= beta"]),
+        ({"c": 0.0}, ["'c'", "0 < c"]),
+        ({"eta": 0.5}, ["'eta'", "1 <= eta"]),
+        ({"c": float("nan")}, ["'c'", "nan"]),
+        ({"E": "stiff"}, ["'E'", "'stiff'", "not a number"]),
+    ],
+)
+def test_invalid_parameters_are_named(changes, words):
+    with pytest.raises(ValueError) as info:
+        fracid.DamageParameters(**changes)
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_replace_validates_and_rejects_unknown_names():
+    p = fracid.DamageParameters()
+    assert p.replace(c=2.0).c == 2.0 and p.c == 1.0
+    with pytest.raises(ValueError, match="'alpha'"):
+        p.replace(alpha=-0.1)
+    with pytest.raises(ValueError, match="unknown parameter"):
+        p.replace(gamma=1.0)
+    with pytest.raises(ValueError, match="7 parameters"):
+        fracid.DamageParameters.from_array([1.0, 2.0])
+    assert fracid.DamageParameters.from_array(p.as_array()) == p
+
+
+@pytest.mark.parametrize(
+    "changes, word",
+    [
+        ({"length": -1.0}, "length"),
+        ({"weak_zone_width": 200.0}, "weak_zone_width"),
+        ({"weak_zone_factor": 0.0}, "weak_zone_factor"),
+        ({"weakening": "density"}, "weakening"),
+        ({"profile": "gauss"}, "profile"),
+        ({"n_elements": 2}, "n_elements"),
+    ],
+)
+def test_invalid_bar_is_named(changes, word):
+    with pytest.raises(ValueError, match=word):
+        fracid.BarWithWeakZone(**changes)
+
+
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        ({"target": -0.01}, "target"),
+        ({"target": float("inf")}, "target"),
+        ({"control": "cmod"}, "unknown control 'cmod'"),
+        ({"stop_force_fraction": 1.5}, "stop_force_fraction"),
+        ({"regularization": "integral"}, "regularization"),
+        ({"steps": fracid.StepOptions(initial=1.0), "target": 0.01}, "step initial"),
+        ({"steps": fracid.StepOptions(grow=0.5)}, "grow"),
+        ({"max_steps": 0}, "max_steps"),
+        ({"damage_threshold": 1.0}, "never reached"),
+    ],
+)
+def test_impossible_requests_are_refused(kwargs, word):
+    with pytest.raises(ValueError, match=word):
+        fracid.simulate(fracid.BarWithWeakZone(n_elements=20), fracid.DamageParameters(), **kwargs)
+
+
+def test_newton_options_are_checked():
+    with pytest.raises(ValueError, match="rtol_u"):
+        fracid.NewtonOptions(rtol_u=0.0)
+    with pytest.raises(ValueError, match="max_iterations"):
+        fracid.NewtonOptions(max_iterations=0)
+
+
+def test_snap_back_under_end_displacement_fails_with_partial_result():
+    """Local model of a long bar snaps back: plain displacement control cannot follow it."""
+    params = fracid.DamageParameters(beta=100.0)
+    bar = fracid.BarWithWeakZone(n_elements=200, profile="hat", length=400.0)
+    with pytest.raises(fracid.ConvergenceError) as info:
+        fracid.simulate(bar, params, regularization="local", target=0.2, stop_force_fraction=0.05)
+    partial = info.value.partial
+    assert "end_displacement" in str(info.value) and "failed" in partial.status
+    assert partial.n_steps > 2 and partial.peak_force > 0
+    assert np.all(np.isfinite(partial.force))
+    # the weak-zone elongation is monotonic through the snap-back and gets further
+    result = fracid.simulate(bar, params, regularization="local", control="weak_zone_elongation", target=0.1, stop_force_fraction=0.05)
+    assert result.status.startswith("force below")
+    end = result.observables["end_displacement"]
+    assert np.any(np.diff(end) < 0)  # the end displacement goes back: snap-back traced
