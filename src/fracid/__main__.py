@@ -1,0 +1,5 @@
+import sys
+
+from fracid.cli import main
+
+sys.exit(main())
