@@ -169,33 +169,19 @@ def follow_path(
     t_start = time.perf_counter()
     solver = _make_linear_solver(linear_solver)
     system = ControlledSystem(problem, problem.functionals[control])
-    observers = dict(observers or {})
-    keep = _field_selector(field_steps)
     stats = SolverStatistics()
-    load_point = problem.load_vector / np.dot(problem.load_vector, problem.load_vector)
+    recorder = _Recorder(problem, control, dict(observers or {}), field_steps)
 
     z = np.zeros(problem.n_free + 1)
     kappa = problem.initial_history()
-    final = None  # (step, q, arrays) of the last converged step
-    records = {"tau": [0.0], "force": [0.0], "work": [0.0], "elastic": [0.0], "load_point": [0.0]}
-    records.update({name: [0.0] for name in problem.functionals})
-    records.update({name: [0.0] for name in observers})
-    fields = {}
-    tau, peak, status = 0.0, 0.0, "target reached"
+    tau, status = 0.0, "target reached"
     base = steps.initial  # reference increment; set from the onset of damage when not given
     step = base if base is not None else 1e-3 * target  # elastic probe
     elastic = True
 
     def result(final_status):
         stats.time_total = time.perf_counter() - t_start
-        if final is not None and field_steps is not None and final[0] not in fields:
-            fields[final[0]] = problem.fields(final[1], final[2].kappa, final[2].omega)
-        obs = {name: np.array(records[name]) for name in list(problem.functionals) + list(observers)}
-        obs["load_point_displacement"] = np.array(records["load_point"])
-        obs["external_work"] = np.array(records["work"])
-        obs["elastic_energy"] = np.array(records["elastic"])
-        obs["dissipated_energy"] = obs["external_work"] - obs["elastic_energy"]
-        return PathResult(control, np.array(records["tau"]), np.array(records["force"]), obs, fields, stats, final_status)
+        return recorder.result(stats, final_status)
 
     while tau < target * (1.0 - 1e-12):
         if stats.steps >= max_steps:
@@ -211,35 +197,20 @@ def follow_path(
             if step < minimum:
                 message = (
                     f"increment from {control} = {tau:.6g} mm failed at the minimum step {increment:.3g} mm "
-                    f"after {stats.steps} converged steps (peak force {peak:.6g} N): {err}"
+                    f"after {stats.steps} converged steps (peak force {recorder.peak:.6g} N): {err}"
                 )
                 raise ConvergenceError(message, result("failed: " + str(err))) from None
             continue
         tau += increment
         z, kappa = z_new, arrays.kappa
-        q, force = z[:-1], z[-1]
         stats.steps += 1
-        final = (stats.steps, q, arrays)
-        displacement = float(load_point @ q)
-        work = 0.5 * (force + records["force"][-1]) * (displacement - records["load_point"][-1])
-        records["work"].append(records["work"][-1] + work)
-        records["tau"].append(tau)
-        records["force"].append(force)
-        records["load_point"].append(displacement)
-        records["elastic"].append(problem.elastic_energy(q, arrays.omega))
-        for name, vec in problem.functionals.items():
-            records[name].append(float(vec @ q))
-        for name, fn in observers.items():
-            records[name].append(float(fn(problem, q, arrays)))
-        if keep(stats.steps):
-            fields[stats.steps] = problem.fields(q, kappa, arrays.omega)
+        force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
         if callback is not None:
             callback(stats.steps, tau, force)
-        peak = max(peak, abs(force))
-        if stop_force_fraction is not None and abs(force) < stop_force_fraction * peak:
+        if stop_force_fraction is not None and abs(force) < stop_force_fraction * recorder.peak:
             status = f"force below {stop_force_fraction:g} of the peak"
             break
-        onset_ratio = float(kappa.max()) / problem.params.kappa_i
+        onset_ratio = problem.onset_ratio(kappa)
         if elastic and 0.0 < onset_ratio < 1.0:
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
@@ -254,6 +225,49 @@ def follow_path(
         maximum = steps.maximum if steps.maximum is not None else 4.0 * base
         step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
     return result(status)
+
+
+class _Recorder:
+    """Collects the curves, observables and fields of the converged steps."""
+
+    def __init__(self, problem, control, observers, field_steps):
+        self.problem, self.control, self.observers, self.field_steps = problem, control, observers, field_steps
+        self.keep = _field_selector(field_steps)
+        self.load_point = problem.load_vector / np.dot(problem.load_vector, problem.load_vector)
+        names = ["tau", "force", "work", "elastic", "load_point", *problem.functionals, *observers]
+        self.records = {name: [0.0] for name in names}
+        self.fields, self.last, self.peak = {}, None, 0.0
+
+    def record(self, step, tau, q, force, arrays) -> float:
+        rec, problem = self.records, self.problem
+        displacement = float(self.load_point @ q)
+        work = 0.5 * (force + rec["force"][-1]) * (displacement - rec["load_point"][-1])
+        rec["work"].append(rec["work"][-1] + work)
+        rec["tau"].append(tau)
+        rec["force"].append(force)
+        rec["load_point"].append(displacement)
+        rec["elastic"].append(problem.elastic_energy(q, arrays.omega))
+        for name, vec in problem.functionals.items():
+            rec[name].append(float(vec @ q))
+        for name, fn in self.observers.items():
+            rec[name].append(float(fn(problem, q, arrays)))
+        if self.keep(step):
+            self.fields[step] = problem.fields(q, arrays.kappa, arrays.omega)
+        self.last = (step, q, arrays)
+        self.peak = max(self.peak, abs(force))
+        return force
+
+    def result(self, stats, status) -> PathResult:
+        if self.last is not None and self.field_steps is not None and self.last[0] not in self.fields:
+            step, q, arrays = self.last
+            self.fields[step] = self.problem.fields(q, arrays.kappa, arrays.omega)
+        rec = {name: np.array(values) for name, values in self.records.items()}
+        obs = {name: rec[name] for name in [*self.problem.functionals, *self.observers]}
+        obs["load_point_displacement"] = rec["load_point"]
+        obs["external_work"] = rec["work"]
+        obs["elastic_energy"] = rec["elastic"]
+        obs["dissipated_energy"] = rec["work"] - rec["elastic"]
+        return PathResult(self.control, rec["tau"], rec["force"], obs, self.fields, stats, status)
 
 
 def _field_selector(field_steps):

@@ -93,6 +93,10 @@ class DamageProblem:
         """History variable kappa of the virgin material, at every integration point."""
         return np.zeros(self.disc.weights.shape)
 
+    def onset_ratio(self, kappa: np.ndarray) -> float:
+        """Largest history variable relative to the damage threshold (< 1: still undamaged)."""
+        return float(kappa.max()) / self.params.kappa_i
+
     def gather(self, q: np.ndarray) -> np.ndarray:
         """Element dof values from the free-dof vector (eliminated dofs are zero)."""
         return np.append(q, 0.0)[self.element_dofs]
