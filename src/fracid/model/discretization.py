@@ -103,3 +103,68 @@ def bar_discretization(vertices, areas, n_gauss: int = 3) -> MixedDiscretization
         n_u_dofs=2 * n_el + 1,
         n_ebar_dofs=n_el + 1,
     )
+
+
+def plane_stress_discretization(nodes, cells, n_vertices: int, thickness: float, n_gauss: int = 3) -> MixedDiscretization:
+    """Mixed plane-stress quadrilaterals: 8-node serendipity displacement, 4-node bilinear ebar.
+
+    Parameters
+    ----------
+    nodes : ndarray, shape (n_nodes, 2)
+        Node coordinates [mm]; the element corners (vertices) come first, numbered 0..n_vertices-1,
+        then the mid-edge nodes.
+    cells : ndarray of int, shape (n_el, 8)
+        Corners counterclockwise, then the mid-edge nodes of edges 0-1, 1-2, 2-3, 3-0.
+    n_vertices : int
+        Number of corner nodes (ebar lives on them).
+    thickness : float
+        Out-of-plane thickness [mm].
+    n_gauss : int
+        Gauss points per direction (3: full integration of the quadratic element).
+
+    Notes
+    -----
+    Displacement dofs of node j are 2 j (x) and 2 j + 1 (y); the ebar dof of vertex v is
+    2 n_nodes + v. The geometry is isoparametric with the 8-node element (curved edges allowed).
+    """
+    from fracid.model.elasticity import PLANE_STRESS
+    from fracid.model.elements import gauss_quad, quad_linear, quad_serendipity
+
+    nodes = np.asarray(nodes, dtype=float)
+    cells = np.asarray(cells, dtype=int)
+    if cells.ndim != 2 or cells.shape[1] != 8 or np.any(cells[:, :4] >= n_vertices):
+        raise ValueError("cells must be (n_el, 8) with the four corners (vertices < n_vertices) first")
+    if not thickness > 0:
+        raise ValueError(f"thickness = {thickness!r} mm; it must be positive")
+    pts, gw = gauss_quad(n_gauss)
+    Nu, dNu = quad_serendipity(pts)
+    Ne, dNe = quad_linear(pts)
+    X = nodes[cells]  # (n_el, 8, 2)
+    J = np.einsum("qai,eaj->eqij", dNu, X)  # d x_j / d xi_i
+    detJ = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
+    if np.any(detJ <= 0):
+        bad = np.unique(np.nonzero(detJ <= 0)[0])
+        raise ValueError(f"elements {bad[:10].tolist()} are inverted or degenerate (Jacobian <= 0)")
+    Jinv = np.linalg.inv(J)
+    dNu_dx = np.einsum("eqij,qaj->eqai", Jinv, dNu)  # (n_el, n_q, 8, 2)
+    dNe_dx = np.einsum("eqij,qaj->eqai", Jinv, dNe)
+    n_el, n_q = detJ.shape
+    B = np.zeros((n_el, n_q, 3, 16))
+    B[:, :, 0, 0::2] = dNu_dx[..., 0]
+    B[:, :, 1, 1::2] = dNu_dx[..., 1]
+    B[:, :, 2, 0::2] = dNu_dx[..., 1]
+    B[:, :, 2, 1::2] = dNu_dx[..., 0]
+    u_dofs = np.empty((n_el, 16), dtype=int)
+    u_dofs[:, 0::2], u_dofs[:, 1::2] = 2 * cells, 2 * cells + 1
+    return MixedDiscretization(
+        strain_state=PLANE_STRESS,
+        weights=gw[None, :] * detJ * thickness,
+        strain_operator=B,
+        ebar_shape=Ne,
+        ebar_gradient=np.swapaxes(dNe_dx, -1, -2),
+        u_dofs=u_dofs,
+        ebar_dofs=2 * nodes.shape[0] + cells[:, :4],
+        points=np.einsum("qa,eai->eqi", Nu, X),
+        n_u_dofs=2 * nodes.shape[0],
+        n_ebar_dofs=int(n_vertices),
+    )

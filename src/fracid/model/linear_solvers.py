@@ -29,12 +29,14 @@ class SuperLUSolver:
     Parameters
     ----------
     permc_spec : str
-        Column ordering passed to :func:`scipy.sparse.linalg.splu`.
+        Column ordering passed to :func:`scipy.sparse.linalg.splu`. The default, minimum degree on
+        A^T + A, suits finite-element matrices (structurally symmetric): on the notched beam it halves
+        the fill and the time of COLAMD.
     """
 
     name = "superlu"
 
-    def __init__(self, permc_spec: str = "COLAMD"):
+    def __init__(self, permc_spec: str = "MMD_AT_PLUS_A"):
         self.permc_spec = permc_spec
 
     def solve(self, matrix, rhs):

@@ -26,7 +26,8 @@ class PathResult:
     force : ndarray
         The load factor, i.e. the applied force for the unit load pattern [N].
     observables : dict {name: ndarray}
-        Every named functional of the problem [mm], the load-point displacement, the external work,
+        Every named functional of the problem [mm], the load-point displacement (work-conjugate to
+        the force, so for a symmetric model it is scaled by the number of copies), the external work,
         elastic energy and dissipated energy [N mm], and the specimen's observers.
     fields : dict {step: dict}
         Fields (u, ebar, kappa, omega) at the requested steps.
@@ -233,7 +234,8 @@ class _Recorder:
     def __init__(self, problem, control, observers, field_steps):
         self.problem, self.control, self.observers, self.field_steps = problem, control, observers, field_steps
         self.keep = _field_selector(field_steps)
-        self.load_point = problem.load_vector / np.dot(problem.load_vector, problem.load_vector)
+        # displacement work-conjugate to the load factor, for the whole specimen
+        self.load_point = problem.symmetry_factor * problem.load_vector
         names = ["tau", "force", "work", "elastic", "load_point", *problem.functionals, *observers]
         self.records = {name: [0.0] for name in names}
         self.fields, self.last, self.peak = {}, None, 0.0

@@ -36,6 +36,11 @@ class DamageProblem:
         The force pattern f_hat; the applied force is lambda * f_hat [N].
     functionals : mapping {name: {dof: coefficient}}
         Linear functionals of the displacement (control quantities, observables) [mm].
+    tied : sequence of sequences of int, optional
+        Groups of displacement dofs that share one unknown (a rigid loading platen, a loading plate).
+    symmetry_factor : float
+        Copies of the model in the whole specimen (2 for a half model, 4 for a quarter model); the
+        energies are reported for the whole specimen.
     """
 
     def __init__(
@@ -48,6 +53,8 @@ class DamageProblem:
         fixed_dofs=(),
         load: Mapping[int, float],
         functionals: Mapping[str, Mapping[int, float]],
+        tied=(),
+        symmetry_factor: float = 1.0,
     ):
         if regularization not in REGULARIZATIONS:
             raise ValueError(f"regularization = {regularization!r}; choose one of {REGULARIZATIONS}")
@@ -59,13 +66,13 @@ class DamageProblem:
         fixed = np.unique(np.asarray(fixed_dofs, dtype=int))
         if fixed.size and (fixed.min() < 0 or fixed.max() >= disc.n_u_dofs):
             raise ValueError(f"fixed dofs must be displacement dofs in [0, {disc.n_u_dofs}); got {fixed.tolist()}")
-        self.free_index = np.full(disc.n_dofs, -1)
-        free = np.setdiff1d(np.arange(n_active), fixed)
-        self.free_index[free] = np.arange(free.size)
-        self.n_free = free.size
+        self.free_index = self._number_unknowns(n_active, fixed, tied)
+        self.n_free = int(self.free_index.max()) + 1
+        self.symmetry_factor = float(symmetry_factor)
         dofs = np.concatenate([disc.u_dofs, disc.ebar_dofs], axis=1) if gradient else disc.u_dofs
         self.element_dofs = self.free_index[dofs]
-        self.blocks = {"u": self.free_index[: disc.n_u_dofs][self.free_index[: disc.n_u_dofs] >= 0]}
+        u_index = self.free_index[: disc.n_u_dofs]
+        self.blocks = {"u": np.unique(u_index[u_index >= 0])}
         if gradient:
             self.blocks["ebar"] = self.free_index[disc.n_u_dofs :]
         self.load_vector = self._dense(load, "load")
@@ -77,6 +84,24 @@ class DamageProblem:
         self._tangent = np.zeros((disc.n_elements,) + (self.element_dofs.shape[1],) * 2)
         if gradient:
             self._tangent[:, n_u:, n_u:] = self.const.ebar_matrix
+
+    def _number_unknowns(self, n_active, fixed, tied) -> np.ndarray:
+        """Unknown index of every dof: -1 if fixed or absent, shared within a tied group."""
+        representative = np.arange(self.disc.n_dofs)
+        for group in tied:
+            group = np.asarray(group, dtype=int)
+            if group.size == 0 or group.min() < 0 or group.max() >= self.disc.n_u_dofs:
+                raise ValueError(f"a tied group must hold displacement dofs in [0, {self.disc.n_u_dofs})")
+            if np.intersect1d(group, fixed).size:
+                raise ValueError("a tied group contains a fixed dof; fix the whole group instead")
+            representative[group] = group[0]
+        active = np.zeros(self.disc.n_dofs, dtype=bool)
+        active[:n_active] = True
+        active[fixed] = False
+        leaders = np.unique(representative[active])
+        number = np.full(self.disc.n_dofs, -1)
+        number[leaders] = np.arange(leaders.size)
+        return np.where(active, number[representative], -1)
 
     def _dense(self, entries: Mapping[int, float], what: str) -> np.ndarray:
         vec = np.zeros(self.n_free)
@@ -149,4 +174,5 @@ class DamageProblem:
 
     def elastic_energy(self, q: np.ndarray, omega: np.ndarray) -> float:
         """Recoverable elastic energy of the state [N mm]."""
-        return elastic_energy(self.disc, self.const, self.gather(q)[:, : self.disc.u_dofs.shape[1]], omega)
+        ue = self.gather(q)[:, : self.disc.u_dofs.shape[1]]
+        return self.symmetry_factor * elastic_energy(self.disc, self.const, ue, omega)

@@ -1,0 +1,205 @@
+"""Intel MKL PARDISO backend (optional: ``pip install 'fracid[pardiso]'``, which pulls pypardiso and MKL).
+
+:class:`PardisoSolver` factorizes real unsymmetric matrices (PARDISO matrix type 11). The symbolic
+analysis (phase 11: fill-reducing ordering, scaling and matching) runs once per sparsity pattern;
+while the pattern stays the same, as it does for the tangents of a forward analysis, each call only
+refactorizes and solves (phase 23). pypardiso is used for locating MKL and for the ctypes prototype
+of ``pardiso``; the calls are made here, because pypardiso (0.4.7) leaves ``iparm[0] = 0`` and MKL
+2025+ then overwrites the transpose flag that its CSC path relies on (wrong solutions; see
+haasad/PyPardiso#87). Every parameter is therefore set explicitly.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import weakref
+
+import numpy as np
+import scipy.sparse as sp
+
+from fracid.model.linear_solvers import SingularMatrixError
+
+_MTYPE = 11  # real unsymmetric
+_ERRORS = {
+    -1: "input inconsistent",
+    -2: "not enough memory",
+    -3: "reordering problem",
+    -4: "zero pivot, numerical factorization or iterative refinement problem",
+    -5: "unclassified (internal) error",
+    -6: "reordering failed",
+    -7: "diagonal matrix is singular",
+    -8: "32-bit integer overflow problem",
+    -9: "not enough memory for OOC",
+    -10: "error opening OOC files",
+    -11: "read/write error with OOC files",
+}
+_I32 = ctypes.POINTER(ctypes.c_int32)
+_F64 = ctypes.POINTER(ctypes.c_double)
+
+
+@functools.cache
+def _mkl_pardiso():
+    """The ctypes ``pardiso`` function and the C type of the handle (located once: it takes ~0.3 s)."""
+    try:
+        from pypardiso.pardiso_wrapper import PyPardisoSolver
+    except ImportError as err:
+        raise ImportError("the PARDISO linear solver needs pypardiso: pip install 'fracid[pardiso]'") from err
+    loader = PyPardisoSolver(mtype=_MTYPE)
+    return loader._mkl_pardiso, loader._pt_type
+
+
+def _default_iparm() -> np.ndarray:
+    iparm = np.zeros(64, dtype=np.int32)
+    iparm[0] = 1  # all values below are supplied (iparm[0] = 0 would reset them to MKL's defaults)
+    iparm[1] = 2  # nested dissection ordering (METIS)
+    iparm[7] = 0  # iterative refinement only when pivots were perturbed (two steps at most)
+    iparm[9] = 13  # pivot perturbation 1e-13
+    iparm[10] = 1  # scaling and
+    iparm[12] = 1  # weighted matching, both computed from the values seen by the analysis
+    iparm[11] = 2  # solve with the transpose: CSC arrays read as CSR describe A^T
+    iparm[17] = -1  # report the nonzeros of the factors in iparm[17]
+    iparm[34] = 1  # zero-based indices
+    return iparm
+
+
+def _call(pardiso, pt_type, pt, iparm, phase, n, data, indptr, indices, b, x) -> int:
+    error = ctypes.c_int32(0)
+    one = ctypes.c_int32(1)
+    pardiso(
+        pt.ctypes.data_as(ctypes.POINTER(pt_type)),
+        ctypes.byref(one),  # maxfct
+        ctypes.byref(one),  # mnum
+        ctypes.byref(ctypes.c_int32(_MTYPE)),
+        ctypes.byref(ctypes.c_int32(phase)),
+        ctypes.byref(ctypes.c_int32(n)),
+        data.ctypes.data_as(_F64),
+        indptr.ctypes.data_as(_I32),
+        indices.ctypes.data_as(_I32),
+        None,  # perm (unused: iparm[4] = 0)
+        ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),
+        iparm.ctypes.data_as(_I32),
+        ctypes.byref(ctypes.c_int32(0)),  # msglvl
+        b.ctypes.data_as(_F64),
+        x.ctypes.data_as(_F64),
+        ctypes.byref(error),
+    )
+    return error.value
+
+
+def _release(pardiso, pt_type, pt, iparm):
+    """Free PARDISO's internal memory (phase -1) held by the handle ``pt``, if any."""
+    if pt.any():
+        dummy_i, dummy_f = np.zeros(1, dtype=np.int32), np.zeros(1)
+        _call(pardiso, pt_type, pt, iparm, -1, 0, dummy_f, dummy_i, dummy_i, dummy_f, dummy_f)
+        pt[:] = 0
+
+
+class PardisoSolver:
+    """Sparse LU of Intel MKL PARDISO, reusing the symbolic analysis while the pattern is unchanged.
+
+    Parameters
+    ----------
+    residual_rtol : float
+        When PARDISO had to perturb pivots (it never stops on a zero pivot: it perturbs it and
+        refines), the solution is accepted only if ``||A x - b|| <= residual_rtol ||b||``; otherwise
+        the analysis is redone with the current values (new scaling and matching) and, if that does
+        not help either, :class:`~fracid.model.linear_solvers.SingularMatrixError` is raised.
+
+    Attributes
+    ----------
+    n_analyses, n_factorizations : int
+        Symbolic analyses (phase 11) and numeric factorizations performed.
+    perturbed_pivots : int
+        Perturbed pivots in the last factorization.
+    """
+
+    name = "pardiso"
+
+    def __init__(self, *, residual_rtol: float = 1e-8):
+        self._pardiso, pt_type = _mkl_pardiso()
+        self._pt_type = pt_type[0]
+        self.pt = np.zeros(64, dtype=pt_type[1])
+        self.iparm = _default_iparm()
+        self.residual_rtol = residual_rtol
+        self.n_analyses = self.n_factorizations = self.perturbed_pivots = 0
+        self._shape = None
+        self._indptr = self._indices = None
+        self._finalizer = weakref.finalize(self, _release, self._pardiso, self._pt_type, self.pt, self.iparm)
+        self._finalizer.atexit = False
+
+    def _run(self, phase, data, b, x):
+        n = self._shape[0]
+        error = _call(self._pardiso, self._pt_type, self.pt, self.iparm, phase, n, data, self._indptr, self._indices, b, x)
+        if error == 0:
+            return
+        message = f"PARDISO phase {phase} failed with error {error} ({_ERRORS.get(error, 'unknown error')})"
+        if phase == 11:
+            self._shape = None  # no valid analysis any more
+        if error in (-4, -7):
+            raise SingularMatrixError(message)
+        if error in (-2, -9):
+            raise MemoryError(message)
+        raise RuntimeError(message)
+
+    def _same_pattern(self, matrix) -> bool:
+        return (
+            matrix.shape == self._shape
+            and np.array_equal(matrix.indptr, self._indptr)
+            and np.array_equal(matrix.indices, self._indices)
+        )
+
+    def _analyse(self, matrix, data):
+        self.free()
+        indptr = np.ascontiguousarray(matrix.indptr, dtype=np.int32)
+        indices = np.ascontiguousarray(matrix.indices, dtype=np.int32)
+        n = matrix.shape[0]
+        if np.any(indptr[1:] == indptr[:-1]) or np.bincount(indices, minlength=n).min(initial=1) == 0:
+            raise SingularMatrixError("the matrix is structurally singular (an empty row or column)")
+        self._shape, self._indptr, self._indices = matrix.shape, indptr.copy(), indices.copy()
+        dummy = np.zeros(1)
+        self._run(11, data, dummy, dummy)
+        self.n_analyses += 1
+
+    def _checked_solve(self, matrix, data, b):
+        x = np.zeros_like(b, order="F")
+        self._run(23, data, b, x)
+        self.n_factorizations += 1
+        self.perturbed_pivots = int(self.iparm[13])
+        if not np.all(np.isfinite(x)) or (
+            self.perturbed_pivots and np.linalg.norm(matrix @ x - b) > self.residual_rtol * np.linalg.norm(b)
+        ):
+            raise SingularMatrixError(
+                f"PARDISO solution rejected ({self.perturbed_pivots} perturbed pivots): the matrix is numerically singular"
+            )
+        return x
+
+    def solve(self, matrix, rhs):
+        """Solve ``matrix @ x = rhs`` for a square sparse matrix (CSC preferred) and rhs of shape (n,) or (n, k)."""
+        if not sp.issparse(matrix) or matrix.format != "csc":
+            matrix = sp.csc_matrix(matrix)
+        if matrix.shape[0] != matrix.shape[1]:
+            raise ValueError(f"the matrix must be square; got shape {matrix.shape}")
+        b = np.asfortranarray(rhs, dtype=np.float64)
+        if b.shape[0] != matrix.shape[0] or b.ndim not in (1, 2):
+            raise ValueError(f"rhs of shape {np.shape(rhs)} does not match the matrix of shape {matrix.shape}")
+        fresh = not self._same_pattern(matrix)
+        if fresh and not matrix.has_canonical_format:  # PARDISO needs sorted indices without duplicates
+            matrix = matrix.copy()
+            matrix.sum_duplicates()
+            fresh = not self._same_pattern(matrix)
+        data = np.ascontiguousarray(matrix.data, dtype=np.float64)
+        if fresh:
+            self._analyse(matrix, data)
+        try:
+            return self._checked_solve(matrix, data, b)
+        except SingularMatrixError:
+            if fresh:
+                raise
+        self._analyse(matrix, data)  # the scaling and matching of an earlier matrix may not suit this one
+        return self._checked_solve(matrix, data, b)
+
+    def free(self):
+        """Release PARDISO's memory; the next solve starts with a new analysis."""
+        _release(self._pardiso, self._pt_type, self.pt, self.iparm)
+        self._shape = None

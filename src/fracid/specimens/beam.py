@@ -1,0 +1,110 @@
+"""Notched three-point bending beam (SPEC section 2), modelled as a symmetric half."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fracid.model.discretization import plane_stress_discretization
+from fracid.model.problem import DamageProblem
+from fracid.specimens.fpz import fpz_width_observer
+from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
+
+
+@dataclass(frozen=True)
+class NotchedBeam:
+    """Notched beam in three-point bending; the default geometry is the Gregoire et al. (2013) beam.
+
+    The half x >= 0 is meshed (symmetry: u_x = 0 on the ligament above the notch). The load acts on
+    a rigid loading plate at mid-span, the support is a roller at x = S/2. Curves are for the full
+    specimen: force [N], CMOD and mid-span deflection [mm].
+
+    Parameters
+    ----------
+    depth, thickness, length, span : float
+        D, b, L, S [mm].
+    notch_depth, notch_width : float
+        a0 and the notch width [mm].
+    plate_width : float
+        Width of the loading plate [mm] (its nodes move together vertically).
+    h_fine : float
+        Element size in the process zone, a band of ``fine_width`` around the ligament [mm].
+    h_coarse : float
+        Largest element size away from it [mm].
+    fine_width : float
+        Half-width of the refined band around the crack path [mm].
+
+    Controls: ``cmod`` (default; passes snap-back) and ``deflection`` (plain displacement control
+    of the loading plate). Observer: ``fpz_width`` [mm].
+    """
+
+    depth: float = 50.0
+    thickness: float = 50.0
+    length: float = 175.0
+    span: float = 125.0
+    notch_depth: float = 25.0
+    notch_width: float = 2.0
+    plate_width: float = 5.0
+    h_fine: float = 1.0
+    h_coarse: float = 6.0
+    fine_width: float = 10.0
+
+    default_control = "cmod"
+
+    def __post_init__(self):
+        for name in ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
+                     "h_fine", "h_coarse", "fine_width"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"NotchedBeam.{name} = {value!r}; it must be a positive number [mm]")
+        if not self.span < self.length:
+            raise ValueError(f"span = {self.span} must be smaller than length = {self.length}")
+        if not self.notch_depth < self.depth:
+            raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
+        if not self.notch_width / 2 < self.fine_width < self.span / 2:
+            raise ValueError(f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
+
+    def refined(self, factor: float = 2.0) -> "NotchedBeam":
+        """The same beam with the process-zone elements divided by ``factor``."""
+        from dataclasses import replace
+
+        return replace(self, h_fine=self.h_fine / factor)
+
+    def mesh(self) -> QuadMesh:
+        h_f, h_c, w = self.h_fine, self.h_coarse, self.fine_width
+        x_size = lambda x: np.minimum(h_c, h_f + 0.3 * np.maximum(x - w, 0.0))  # noqa: E731
+        x_keys = sorted({0.0, self.notch_width / 2, self.plate_width / 2, w, self.span / 2, self.length / 2})
+        xs = graded_lines(x_keys, x_size)
+        y_size = lambda y: np.minimum(h_c, h_f + 0.3 * np.maximum(self.notch_depth - h_f * 4 - y, 0.0))  # noqa: E731
+        ys = graded_lines([0.0, self.notch_depth, self.depth], y_size)
+        in_notch = lambda s, t: (s < self.notch_width / 2) & (t < self.notch_depth)  # noqa: E731
+        return structured_quad8(xs, ys, keep=lambda s, t: ~in_notch(s, t))
+
+    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
+        mesh = mesh or self.mesh()
+        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
+        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        ligament = np.flatnonzero((np.abs(x) < 1e-9) & (y >= self.notch_depth - 1e-9))
+        support = mesh.closest_node((self.span / 2, 0.0))
+        plate = np.flatnonzero((np.abs(y - self.depth) < 1e-9) & (x <= self.plate_width / 2 + 1e-9))
+        mouth = mesh.closest_node((self.notch_width / 2, 0.0))
+        master = int(plate[np.argmin(x[plate])])
+        return DamageProblem(
+            disc,
+            params,
+            regularization=regularization,
+            fixed_dofs=np.concatenate([2 * ligament, [2 * support + 1]]),
+            tied=[2 * plate + 1],
+            load={2 * master + 1: -0.5},  # the half model carries half the force: lambda = total force [N]
+            functionals={"cmod": {2 * mouth: 2.0}, "deflection": {2 * master + 1: -1.0}},
+            symmetry_factor=2.0,
+        )
+
+    def observers(self, params, damage_threshold: float = 0.0) -> dict:
+        """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold [mm]."""
+        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True)}
+
+    def default_target(self, params) -> float:
+        return 0.3  # CMOD [mm]

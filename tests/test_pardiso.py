@@ -1,0 +1,163 @@
+"""PARDISO backend: agreement with SuperLU, reuse of the symbolic analysis, singular matrices."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+pytest.importorskip("pypardiso")
+
+import fracid  # noqa: E402
+from fracid.model import pardiso as pardiso_module  # noqa: E402
+from fracid.model.linear_solvers import SingularMatrixError, SuperLUSolver  # noqa: E402
+from fracid.model.pardiso import PardisoSolver  # noqa: E402
+
+
+def random_unsymmetric(n, density, seed, explicit_zeros=0):
+    """A well-conditioned unsymmetric CSC matrix (random entries plus a dominant diagonal)."""
+    rng = np.random.default_rng(seed)
+    off = sp.random(n, n, density=density, random_state=rng, data_rvs=rng.standard_normal, format="csc")
+    matrix = (off + sp.diags(rng.uniform(2.0, 3.0, n) * (1.0 + abs(off).sum(axis=1).A1))).tocsc()
+    matrix.sort_indices()
+    if explicit_zeros:
+        off_diagonal = np.flatnonzero(matrix.indices != np.repeat(np.arange(n), np.diff(matrix.indptr)))
+        matrix.data[rng.choice(off_diagonal, explicit_zeros, replace=False)] = 0.0  # stored, not removed
+    return matrix
+
+
+def relative_error(x, reference):
+    return np.linalg.norm(x - reference) / np.linalg.norm(reference)
+
+
+@pytest.mark.parametrize("n, density, explicit_zeros", [(50, 0.1, 0), (400, 0.01, 0), (400, 0.01, 60)])
+def test_matches_spsolve(n, density, explicit_zeros):
+    matrix = random_unsymmetric(n, density, seed=n + explicit_zeros, explicit_zeros=explicit_zeros)
+    assert np.count_nonzero(matrix.data == 0.0) == explicit_zeros
+    assert abs(matrix - matrix.T).max() > 0.1  # truly unsymmetric: a transposed solve would be wrong
+    b = np.random.default_rng(1).standard_normal(n)
+    x = PardisoSolver().solve(matrix, b)
+    assert x.shape == (n,)
+    assert relative_error(x, spla.spsolve(matrix, b)) < 1e-10
+    assert relative_error(x, spla.spsolve(matrix.T.tocsc(), b)) > 1e-3
+
+
+def test_several_right_hand_sides_and_other_formats():
+    matrix = random_unsymmetric(200, 0.03, seed=3)
+    rhs = np.random.default_rng(2).standard_normal((200, 3))
+    reference = spla.spsolve(matrix, rhs)
+    solver = PardisoSolver()
+    x = solver.solve(matrix, rhs)
+    assert x.shape == (200, 3)
+    assert relative_error(x, reference) < 1e-10
+    # CSR input and a non-canonical CSC (unsorted indices, a duplicate entry) give the same answer
+    assert relative_error(solver.solve(matrix.tocsr(), rhs), reference) < 1e-10
+    coo = matrix.tocoo()
+    order = np.random.default_rng(0).permutation(coo.nnz)
+    rows, cols, vals = coo.row[order], coo.col[order], coo.data[order]
+    k = np.flatnonzero(rows == cols)[0]  # split one diagonal entry into two duplicates
+    rows, cols = np.append(rows, rows[k]), np.append(cols, cols[k])
+    vals = np.append(vals, 0.25 * vals[k])
+    vals[k] *= 0.75
+    messy = sp.csc_matrix((vals, (rows, cols)), shape=matrix.shape)
+    messy.has_canonical_format = False
+    messy = sp.csc_matrix((messy.data, messy.indices, messy.indptr), shape=matrix.shape)
+    assert relative_error(solver.solve(messy, rhs), reference) < 1e-10
+
+
+def test_analysis_reused_while_pattern_is_unchanged(monkeypatch):
+    phases = []
+    call = pardiso_module._call
+
+    def recording_call(pardiso, pt_type, pt, iparm, phase, *args):
+        phases.append(phase)
+        return call(pardiso, pt_type, pt, iparm, phase, *args)
+
+    monkeypatch.setattr(pardiso_module, "_call", recording_call)
+    base = random_unsymmetric(300, 0.02, seed=7, explicit_zeros=20)
+    rng = np.random.default_rng(8)
+    solver = PardisoSolver()
+    for k in range(5):
+        # a new matrix object with new values (explicit zeros becoming nonzero and back) on the same pattern
+        data = base.data * rng.uniform(0.5, 1.5, base.nnz) + (k % 2) * (base.data == 0.0) * rng.standard_normal(base.nnz)
+        matrix = sp.csc_matrix((data, base.indices.copy(), base.indptr.copy()), shape=base.shape)
+        b = rng.standard_normal(300)
+        assert relative_error(solver.solve(matrix, b), spla.spsolve(matrix, b)) < 1e-10
+    assert solver.n_analyses == 1
+    assert solver.n_factorizations == 5
+    assert phases == [11] + [23] * 5
+    # a new pattern triggers a new analysis (after releasing the old one)
+    other = random_unsymmetric(300, 0.02, seed=9)
+    b = rng.standard_normal(300)
+    assert relative_error(solver.solve(other, b), spla.spsolve(other, b)) < 1e-10
+    assert solver.n_analyses == 2
+    assert phases[-3:] == [-1, 11, 23]
+    solver.free()
+    assert not solver.pt.any()
+    solver.solve(other, b)
+    assert solver.n_analyses == 3
+
+
+def test_singular_matrices_raise():
+    solver = PardisoSolver()
+    with pytest.raises(SingularMatrixError):  # numerically singular: perturbed pivots, large residual
+        solver.solve(sp.csc_matrix(np.array([[1.0, 2.0, 0.0], [2.0, 4.0, 0.0], [0.0, 1.0, 1.0]])), np.array([1.0, 0.0, 0.0]))
+    with pytest.raises(SingularMatrixError):  # all-zero values on a full pattern
+        solver.solve(sp.csc_matrix((np.zeros(4), [0, 1, 0, 1], [0, 2, 4]), shape=(2, 2)), np.ones(2))
+    with pytest.raises(SingularMatrixError):  # an empty column (PARDISO itself would crash on it)
+        solver.solve(sp.csc_matrix(np.array([[1.0, 0.0], [1.0, 0.0]])), np.ones(2))
+    with pytest.raises(SingularMatrixError):  # an empty row
+        solver.solve(sp.csc_matrix(np.array([[1.0, 1.0], [0.0, 0.0]])), np.ones(2))
+    # the solver is still usable afterwards
+    matrix = random_unsymmetric(30, 0.2, seed=1)
+    assert relative_error(solver.solve(matrix, np.ones(30)), spla.spsolve(matrix, np.ones(30))) < 1e-10
+
+
+def test_bar_force_curve_matches_superlu():
+    bar = fracid.BarWithWeakZone(n_elements=100)
+    params = fracid.DamageParameters()
+    reference = fracid.simulate(bar, params, linear_solver=SuperLUSolver())
+    solver = PardisoSolver()
+    result = fracid.simulate(bar, params, linear_solver=solver)
+    assert result.status == reference.status
+    assert result.n_steps == reference.n_steps > 10
+    np.testing.assert_allclose(result.control, reference.control, rtol=1e-8, atol=0.0)
+    np.testing.assert_allclose(result.force, reference.force, rtol=1e-8, atol=1e-8 * reference.peak_force)
+    assert solver.n_analyses == 1
+    assert solver.n_factorizations == result.stats.linear_solves
+
+
+def test_snap_back_run_matches_superlu():
+    bar = fracid.BarWithWeakZone(n_elements=60, weak_zone_width=5.0)
+    params = fracid.DamageParameters()
+    kwargs = dict(control="weak_zone_elongation", target=0.02)
+    reference = fracid.simulate(bar, params, linear_solver=SuperLUSolver(), **kwargs)
+    result = fracid.simulate(bar, params, linear_solver=PardisoSolver(), **kwargs)
+    assert result.n_steps == reference.n_steps
+    np.testing.assert_allclose(result.force, reference.force, rtol=1e-8, atol=1e-8 * reference.peak_force)
+
+
+def test_registered_by_name_when_available():
+    from fracid.model import linear_solvers
+
+    if "pardiso" not in linear_solvers._BACKENDS:
+        pytest.skip("'pardiso' is not registered in linear_solvers._BACKENDS yet")
+    assert isinstance(linear_solvers.linear_solver("pardiso"), PardisoSolver)
+
+
+def test_missing_pypardiso_gives_a_clear_error(monkeypatch):
+    monkeypatch.setitem(sys.modules, "pypardiso", None)
+    monkeypatch.setitem(sys.modules, "pypardiso.pardiso_wrapper", None)
+    pardiso_module._mkl_pardiso.cache_clear()
+    try:
+        with pytest.raises(ImportError, match=r"pip install 'fracid\[pardiso\]'"):
+            PardisoSolver()
+    finally:
+        pardiso_module._mkl_pardiso.cache_clear()
+
+
+def test_importing_fracid_does_not_import_pypardiso():
+    code = "import sys, fracid, fracid.model.pardiso; assert 'pypardiso' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
