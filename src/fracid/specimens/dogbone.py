@@ -1,0 +1,131 @@
+"""Dog-bone tension specimen (van Vliet & van Mier size-effect series), modelled as a symmetric quarter."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from fracid.model.discretization import plane_stress_discretization
+from fracid.model.problem import DamageProblem
+from fracid.specimens.fpz import fpz_width_observer
+from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
+
+
+@dataclass(frozen=True)
+class DogBone:
+    """Dog-bone specimen of size D: width D, height 1.5 D, circular side notches of radius 0.725 D
+    reducing the width to 0.6 D at mid-height, thickness 100 mm; ends glued to loading platens.
+
+    The quarter x >= 0, y >= 0 is meshed (symmetry about both axes; glued platens with rotations fixed
+    keep the response symmetric). The top edge moves as a rigid platen: u_x = 0, one common u_y.
+    Curves are for the full specimen: force [N], elongation over the gauge length [mm].
+
+    Parameters
+    ----------
+    size : float
+        D [mm].
+    thickness : float
+        [mm].
+    gauge_length : float or None
+        Length over which the elongation is measured, centred at mid-height [mm]; 0.5 D if None.
+    h_fine : float
+        Element size at the notched section, in a band of half-height ``fine_height`` [mm].
+    fine_height : float or None
+        Half-height of the refined band [mm]; 0.05 D + 5 h_fine if None.
+    h_coarse : float or None
+        Largest element height away from the band [mm]; 0.1 D if None.
+    notch_radius, notch_width : float
+        Notch radius and the width at mid-height, relative to D (0.725 and 0.6).
+
+    Controls: ``elongation`` (default; passes snap-back) and ``platen_displacement`` (plain
+    displacement control). Observer: ``fpz_width`` [mm], across the mid-height section.
+    """
+
+    size: float = 100.0
+    thickness: float = 100.0
+    gauge_length: float | None = None
+    h_fine: float = 2.0
+    fine_height: float | None = None
+    h_coarse: float | None = None
+    notch_radius: float = 0.725
+    notch_width: float = 0.6
+
+    default_control = "elongation"
+
+    def __post_init__(self):
+        for name in ("size", "thickness", "gauge_length", "h_fine", "fine_height", "h_coarse", "notch_radius", "notch_width"):
+            value = getattr(self, name)
+            if value is None and name in ("gauge_length", "fine_height", "h_coarse"):
+                continue
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"DogBone.{name} = {value!r}; it must be a positive number")
+        if not self.notch_width < 1.0 or (1.0 - self.notch_width) / 2 > self.notch_radius:
+            raise ValueError(f"notch_width = {self.notch_width} and notch_radius = {self.notch_radius}: "
+                             "the notch must narrow the width (notch_width < 1) and fit its radius")
+        if self._gauge / 2 >= 0.75 * self.size:
+            raise ValueError(f"gauge_length = {self._gauge} mm must be shorter than the height 1.5 D")
+
+    @property
+    def _gauge(self) -> float:
+        return self.gauge_length if self.gauge_length is not None else 0.5 * self.size
+
+    def refined(self, factor: float = 2.0) -> "DogBone":
+        """The same specimen with the process-zone elements divided by ``factor``."""
+        return replace(self, h_fine=self.h_fine / factor, fine_height=self._fine_height)
+
+    @property
+    def _fine_height(self) -> float:
+        return self.fine_height if self.fine_height is not None else 0.05 * self.size + 5 * self.h_fine
+
+    def half_width(self, y) -> np.ndarray:
+        """Half-width of the specimen at height y above mid-height [mm]."""
+        D, R = self.size, self.notch_radius * self.size
+        centre = 0.5 * self.notch_width * D + R
+        y = np.abs(np.asarray(y, dtype=float))
+        arc = centre - np.sqrt(np.maximum(R * R - y * y, 0.0))
+        return np.where(arc < 0.5 * D, np.minimum(arc, 0.5 * D), 0.5 * D)
+
+    def mesh(self) -> QuadMesh:
+        D, h = self.size, self.h_fine
+        fine, coarse = self._fine_height, self.h_coarse or 0.1 * D
+        R = self.notch_radius * D
+        end_of_arc = math.sqrt(max(R * R - (0.5 * D - (0.5 * self.notch_width * D + R)) ** 2, 0.0))
+        keys = sorted({0.0, self._gauge / 2, min(end_of_arc, 0.75 * D), 0.75 * D})
+        ts = graded_lines(keys, lambda t: np.minimum(coarse, h + 0.25 * np.maximum(t - fine, 0.0)))
+        n_s = max(2, math.ceil(0.5 * self.notch_width * D / h))
+        return structured_quad8(np.linspace(0.0, 1.0, n_s + 1), ts, mapping=lambda s, t: (s * self.half_width(t), t))
+
+    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
+        mesh = mesh or self.mesh()
+        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
+        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        top = np.flatnonzero(np.abs(y - 0.75 * self.size) < 1e-9)
+        axis = np.flatnonzero(np.abs(x) < 1e-9)
+        section = np.flatnonzero(np.abs(y) < 1e-9)
+        gauge = mesh.closest_node((float(self.half_width(self._gauge / 2)), self._gauge / 2))
+        master = int(top[0])
+        return DamageProblem(
+            disc,
+            params,
+            regularization=regularization,
+            fixed_dofs=np.concatenate([2 * axis, 2 * section + 1, 2 * top]),
+            tied=[2 * top + 1],
+            load={2 * master + 1: 0.5},  # the quarter carries half the force: lambda = total force [N]
+            functionals={"elongation": {2 * gauge + 1: 2.0}, "platen_displacement": {2 * master + 1: 2.0}},
+            symmetry_factor=4.0,
+        )
+
+    def observers(self, params, damage_threshold: float = 0.0) -> dict:
+        """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
+        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True)}
+
+    def default_target(self, params) -> float:
+        """Elongation well past the peak: 20 times the elastic elongation of the gauge at damage onset [mm]."""
+        return 20.0 * params.kappa_i * self._gauge
+
+    @property
+    def ligament_area(self) -> float:
+        """Area of the notched section [mm^2], for the nominal strength F / (0.6 D t)."""
+        return self.notch_width * self.size * self.thickness
