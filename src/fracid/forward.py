@@ -15,7 +15,7 @@ def simulate(
     target: float | None = None,
     stop_force_fraction: float | None = 0.1,
     damage_threshold: float = 0.0,
-    steps: StepOptions = StepOptions(),
+    steps: StepOptions | None = None,
     newton: NewtonOptions = NewtonOptions(),
     linear_solver=None,
     field_steps="last",
@@ -38,14 +38,19 @@ def simulate(
         Stop when the force falls below this fraction of its peak (None: run to ``target``).
     damage_threshold : float
         Damage above which a point counts in the damaged-zone width [-].
+    steps : StepOptions, optional
+        Step-size rule; the specimen's default (``specimen.default_steps(target)``) if None.
 
     Other parameters are passed to :func:`~fracid.model.path_following.follow_path`.
     """
     problem = specimen.build_problem(params, regularization)
+    target = target if target is not None else specimen.default_target(params)
+    if steps is None:
+        steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
     return follow_path(
         problem,
         control or specimen.default_control,
-        target if target is not None else specimen.default_target(params),
+        target,
         steps=steps,
         stop_force_fraction=stop_force_fraction,
         max_steps=max_steps,

@@ -53,7 +53,7 @@ def _default_iparm() -> np.ndarray:
     iparm = np.zeros(64, dtype=np.int32)
     iparm[0] = 1  # all values below are supplied (iparm[0] = 0 would reset them to MKL's defaults)
     iparm[1] = 2  # nested dissection ordering (METIS)
-    iparm[7] = 0  # iterative refinement only when pivots were perturbed (two steps at most)
+    iparm[7] = 2  # up to two steps of iterative refinement (pivoting is only within supernodes)
     iparm[9] = 13  # pivot perturbation 1e-13
     iparm[10] = 1  # scaling and
     iparm[12] = 1  # weighted matching, both computed from the values seen by the analysis

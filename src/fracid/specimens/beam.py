@@ -28,7 +28,9 @@ class NotchedBeam:
     notch_depth, notch_width : float
         a0 and the notch width [mm].
     plate_width : float
-        Width of the loading plate [mm] (its nodes move together vertically).
+        Width of the loading plate and of each support [mm]: the plate's nodes move together
+        vertically, the support's nodes are held vertically (a point load or support would make
+        the deflection mesh-dependent).
     h_fine : float
         Element size in the process zone, a band of ``fine_width`` around the ligament [mm].
     h_coarse : float
@@ -48,7 +50,7 @@ class NotchedBeam:
     notch_width: float = 2.0
     plate_width: float = 5.0
     h_fine: float = 1.0
-    h_coarse: float = 6.0
+    h_coarse: float = 4.0
     fine_width: float = 10.0
 
     default_control = "cmod"
@@ -63,21 +65,25 @@ class NotchedBeam:
             raise ValueError(f"span = {self.span} must be smaller than length = {self.length}")
         if not self.notch_depth < self.depth:
             raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
-        if not self.notch_width / 2 < self.fine_width < self.span / 2:
+        if not self.notch_width / 2 < self.fine_width < self.span / 2 - self.plate_width / 2:
             raise ValueError(f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
 
-    def refined(self, factor: float = 2.0) -> "NotchedBeam":
-        """The same beam with the process-zone elements divided by ``factor``."""
+    def refined(self, factor: float = 2.0, everywhere: bool = False) -> "NotchedBeam":
+        """The same beam with the process-zone elements (or all elements) divided by ``factor``."""
         from dataclasses import replace
 
-        return replace(self, h_fine=self.h_fine / factor)
+        return replace(self, h_fine=self.h_fine / factor, h_coarse=self.h_coarse / factor if everywhere else self.h_coarse)
 
     def mesh(self) -> QuadMesh:
         h_f, h_c, w = self.h_fine, self.h_coarse, self.fine_width
-        x_size = lambda x: np.minimum(h_c, h_f + 0.3 * np.maximum(x - w, 0.0))  # noqa: E731
-        x_keys = sorted({0.0, self.notch_width / 2, self.plate_width / 2, w, self.span / 2, self.length / 2})
+        h_plate = self.plate_width / 4  # the rigid support's edges concentrate the reaction
+        x_size = lambda x: np.minimum.reduce(  # noqa: E731
+            [np.full_like(x, h_c), h_f + 0.3 * np.maximum(x - w, 0.0), h_plate + 0.3 * np.abs(x - self.span / 2)]
+        )
+        p = self.plate_width / 2
+        x_keys = sorted({0.0, self.notch_width / 2, p, w, self.span / 2 - p, self.span / 2 + p, self.length / 2})
         xs = graded_lines(x_keys, x_size)
-        y_size = lambda y: np.minimum(h_c, h_f + 0.3 * np.maximum(self.notch_depth - h_f * 4 - y, 0.0))  # noqa: E731
+        y_size = lambda y: np.minimum(h_c, h_f + 0.15 * np.maximum(self.notch_depth - h_f * 4 - y, 0.0))  # noqa: E731
         ys = graded_lines([0.0, self.notch_depth, self.depth], y_size)
         in_notch = lambda s, t: (s < self.notch_width / 2) & (t < self.notch_depth)  # noqa: E731
         return structured_quad8(xs, ys, keep=lambda s, t: ~in_notch(s, t))
@@ -87,7 +93,7 @@ class NotchedBeam:
         x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
         ligament = np.flatnonzero((np.abs(x) < 1e-9) & (y >= self.notch_depth - 1e-9))
-        support = mesh.closest_node((self.span / 2, 0.0))
+        support = np.flatnonzero((np.abs(y) < 1e-9) & (np.abs(x - self.span / 2) <= self.plate_width / 2 + 1e-9))
         plate = np.flatnonzero((np.abs(y - self.depth) < 1e-9) & (x <= self.plate_width / 2 + 1e-9))
         mouth = mesh.closest_node((self.notch_width / 2, 0.0))
         master = int(plate[np.argmin(x[plate])])
@@ -95,7 +101,7 @@ class NotchedBeam:
             disc,
             params,
             regularization=regularization,
-            fixed_dofs=np.concatenate([2 * ligament, [2 * support + 1]]),
+            fixed_dofs=np.concatenate([2 * ligament, 2 * support + 1]),
             tied=[2 * plate + 1],
             load={2 * master + 1: -0.5},  # the half model carries half the force: lambda = total force [N]
             functionals={"cmod": {2 * mouth: 2.0}, "deflection": {2 * master + 1: -1.0}},
@@ -105,6 +111,12 @@ class NotchedBeam:
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold [mm]."""
         return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True)}
+
+    def default_steps(self, target: float):
+        """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
+        from fracid.model.path_following import StepOptions
+
+        return StepOptions(maximum=target / 60)
 
     def default_target(self, params) -> float:
         return 0.3  # CMOD [mm]

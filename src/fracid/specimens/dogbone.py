@@ -71,9 +71,11 @@ class DogBone:
     def _gauge(self) -> float:
         return self.gauge_length if self.gauge_length is not None else 0.5 * self.size
 
-    def refined(self, factor: float = 2.0) -> "DogBone":
-        """The same specimen with the process-zone elements divided by ``factor``."""
-        return replace(self, h_fine=self.h_fine / factor, fine_height=self._fine_height)
+    def refined(self, factor: float = 2.0, everywhere: bool = False) -> "DogBone":
+        """The same specimen with the process-zone elements (or all elements) divided by ``factor``."""
+        coarse = self.h_coarse or 0.1 * self.size
+        return replace(self, h_fine=self.h_fine / factor, fine_height=self._fine_height,
+                       h_coarse=coarse / factor if everywhere else coarse)
 
     @property
     def _fine_height(self) -> float:
@@ -120,6 +122,12 @@ class DogBone:
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
         return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True)}
+
+    def default_steps(self, target: float):
+        """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
+        from fracid.model.path_following import StepOptions
+
+        return StepOptions(maximum=target / 60)
 
     def default_target(self, params) -> float:
         """Elongation well past the peak: 20 times the elastic elongation of the gauge at damage onset [mm]."""
