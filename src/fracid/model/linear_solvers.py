@@ -57,7 +57,13 @@ class SuperLUSolver:
         return lu.solve(rhs)
 
 
-_BACKENDS = {"superlu": SuperLUSolver}
+def _pardiso():
+    from fracid.model.pardiso import PardisoSolver  # lazy: pypardiso is an optional extra
+
+    return PardisoSolver()
+
+
+_BACKENDS = {"superlu": SuperLUSolver, "pardiso": _pardiso}
 
 
 def linear_solver(spec=None) -> LinearSolver:

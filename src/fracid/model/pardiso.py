@@ -4,9 +4,10 @@
 analysis (phase 11: fill-reducing ordering, scaling and matching) runs once per sparsity pattern;
 while the pattern stays the same, as it does for the tangents of a forward analysis, each call only
 refactorizes and solves (phase 23). pypardiso is used for locating MKL and for the ctypes prototype
-of ``pardiso``; the calls are made here, because pypardiso (0.4.7) leaves ``iparm[0] = 0`` and MKL
-2025+ then overwrites the transpose flag that its CSC path relies on (wrong solutions; see
-haasad/PyPardiso#87). Every parameter is therefore set explicitly.
+of ``pardiso``; the calls are made here, because pypardiso (0.4.7) leaves ``iparm[0] = 0``, with
+which MKL 2025+ resets every parameter to its defaults, including the transpose flag that pypardiso's
+CSC path relies on: its solutions of unsymmetric CSC systems are then wrong (checked with MKL 2026.2;
+see haasad/PyPardiso#87). Every parameter is therefore set explicitly here.
 """
 
 from __future__ import annotations
@@ -43,9 +44,10 @@ def _mkl_pardiso():
     """The ctypes ``pardiso`` function and the C type of the handle (located once: it takes ~0.3 s)."""
     try:
         from pypardiso.pardiso_wrapper import PyPardisoSolver
-    except ImportError as err:
-        raise ImportError("the PARDISO linear solver needs pypardiso: pip install 'fracid[pardiso]'") from err
-    loader = PyPardisoSolver(mtype=_MTYPE)
+
+        loader = PyPardisoSolver(mtype=_MTYPE)
+    except (ImportError, OSError) as err:
+        raise ImportError(f"the PARDISO linear solver needs pypardiso and MKL: pip install 'fracid[pardiso]' ({err})") from err
     return loader._mkl_pardiso, loader._pt_type
 
 

@@ -9,6 +9,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from fracid.model.assembly import dot
 from fracid.model.linear_solvers import linear_solver as _make_linear_solver
 from fracid.model.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
@@ -216,7 +217,9 @@ def follow_path(
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
             base = base if base is not None else tau_onset / 20.0
-            step = max(tau_onset * (1.0 - 1e-3) - tau, base * steps.onset_fraction)
+            # land half a small step below onset, so the next step clearly crosses it
+            # (landing on it exactly would leave the crossing to rounding)
+            step = max(tau_onset - 0.5 * base * steps.onset_fraction - tau, base * steps.onset_fraction)
             continue
         base = base if base is not None else increment
         if elastic:  # this step crossed damage onset: go on with small steps, growing again
@@ -242,7 +245,7 @@ class _Recorder:
 
     def record(self, step, tau, q, force, arrays) -> float:
         rec, problem = self.records, self.problem
-        displacement = float(self.load_point @ q)
+        displacement = dot(self.load_point, q)
         work = 0.5 * (force + rec["force"][-1]) * (displacement - rec["load_point"][-1])
         rec["work"].append(rec["work"][-1] + work)
         rec["tau"].append(tau)
@@ -250,7 +253,7 @@ class _Recorder:
         rec["load_point"].append(displacement)
         rec["elastic"].append(problem.elastic_energy(q, arrays.omega))
         for name, vec in problem.functionals.items():
-            rec[name].append(float(vec @ q))
+            rec[name].append(dot(vec, q))
         for name, fn in self.observers.items():
             rec[name].append(float(fn(problem, q, arrays)))
         if self.keep(step):

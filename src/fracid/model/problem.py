@@ -6,7 +6,7 @@ from typing import Mapping
 
 import numpy as np
 
-from fracid.model.assembly import assemble_vector
+from fracid.model.assembly import assemble_vector, norm2
 from fracid.model.discretization import MixedDiscretization
 from fracid.model.forms import elastic_energy, gradient_damage, local_damage, model_constants
 from fracid.model.parameters import DamageParameters
@@ -148,7 +148,7 @@ class DamageProblem:
         references = {}
         for field, element_ref in arrays.reference.items():
             dofs = self.element_dofs[:, :n_u] if field == "u" else self.element_dofs[:, n_u:]
-            references[field] = float(np.linalg.norm(assemble_vector(dofs, element_ref, self.n_free)))
+            references[field] = float(norm2(assemble_vector(dofs, element_ref, self.n_free)))
         return residual, arrays, references
 
     def full_vector(self, q: np.ndarray) -> np.ndarray:

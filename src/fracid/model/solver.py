@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fracid.model.assembly import SparsePattern
+from fracid.model.assembly import SparsePattern, dot, norm2
 from fracid.model.linear_solvers import SingularMatrixError
 
 
@@ -94,12 +94,12 @@ class ControlledSystem:
         p = self.problem
         q, lam = z[:-1], z[-1]
         internal, arrays, references = p.evaluate(q, kappa_old)
-        residual = np.append(internal - lam * p.load_vector, self.control @ q - tau)
-        external = abs(lam) * np.linalg.norm(p.load_vector)
+        residual = np.append(internal - lam * p.load_vector, dot(self.control, q) - tau)
+        external = abs(lam) * norm2(p.load_vector)
         errors = {}
         for name, idx in p.blocks.items():
             scale = max(references[name], external if name == "u" else 0.0)
-            norm = float(np.linalg.norm(residual[idx]))
+            norm = float(norm2(residual[idx]))
             errors[name] = norm / scale if scale > 0.0 else norm
         return residual, arrays, errors
 

@@ -112,6 +112,12 @@ class BarWithWeakZone:
             functionals=functionals,
         )
 
+    def output_mesh(self):
+        """Nodes, cells and VTK cell type of the mesh, for :func:`fracid.report.write_result_vtk`."""
+        from fracid.report.vtk import bar_mesh
+
+        return bar_mesh(self.vertices())
+
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``damaged_zone_width``: length [mm] where omega > damage_threshold (kappa-level, interpolated)."""
         kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)

@@ -108,6 +108,11 @@ class NotchedBeam:
             symmetry_factor=2.0,
         )
 
+    def output_mesh(self):
+        """Nodes, cells and VTK cell type of the (half) mesh, for :func:`fracid.report.write_result_vtk`."""
+        mesh = self.mesh()
+        return mesh.nodes, mesh.cells, "quad8"
+
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold [mm]."""
         return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True)}

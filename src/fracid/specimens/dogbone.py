@@ -119,6 +119,11 @@ class DogBone:
             symmetry_factor=4.0,
         )
 
+    def output_mesh(self):
+        """Nodes, cells and VTK cell type of the (quarter) mesh, for :func:`fracid.report.write_result_vtk`."""
+        mesh = self.mesh()
+        return mesh.nodes, mesh.cells, "quad8"
+
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
         return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True)}
