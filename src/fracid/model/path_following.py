@@ -179,6 +179,7 @@ def follow_path(
     tau, status = 0.0, "target reached"
     base = steps.initial  # reference increment; set from the onset of damage when not given
     step = base if base is not None else 1e-3 * target  # elastic probe
+    first_step = step
     elastic = True
 
     def result(final_status):
@@ -195,7 +196,7 @@ def follow_path(
         except IncrementFailed as err:
             stats.failed_increments += 1
             step = increment * steps.shrink
-            minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or increment)
+            minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or first_step)
             if step < minimum:
                 message = (
                     f"increment from {control} = {tau:.6g} mm failed at the minimum step {increment:.3g} mm "

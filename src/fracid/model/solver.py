@@ -77,6 +77,8 @@ class ControlledSystem:
     control: np.ndarray
     pattern: SparsePattern = field(init=False)
     border_values: np.ndarray = field(init=False)
+    _scale: np.ndarray | None = field(init=False, default=None)
+    _entry_scale: np.ndarray | None = field(init=False, default=None)
 
     def __post_init__(self):
         n = self.problem.n_free
@@ -105,6 +107,22 @@ class ControlledSystem:
 
     def matrix(self, arrays):
         return self.pattern.matrix(arrays.tangent, self.border_values)
+
+    def scaled_matrix(self, arrays):
+        """The bordered matrix equilibrated as S M S, and the diagonal of S.
+
+        S = diag(1 / sqrt|M_ii|) of the first matrix assembled (the virgin elastic state; 1 on the
+        border). The rows of equilibrium (order E t) and of the diffusion equation (order mm^2)
+        differ by six orders of magnitude; equilibrated, SuperLU reaches 1e-15 relative residuals
+        instead of 1e-7 and PARDISO no longer perturbs pivots of the virgin state.
+        """
+        matrix = self.matrix(arrays)
+        if self._scale is None:
+            diagonal = np.abs(matrix.diagonal())
+            self._scale = np.where(diagonal > 0.0, 1.0 / np.sqrt(np.where(diagonal > 0.0, diagonal, 1.0)), 1.0)
+            self._entry_scale = self._scale[matrix.indices] * np.repeat(self._scale, np.diff(matrix.indptr))
+        matrix.data *= self._entry_scale
+        return matrix, self._scale
 
 
 def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics):
@@ -135,10 +153,10 @@ def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, option
             return z, arrays, iteration
         if iteration == options.max_iterations:
             break
-        matrix = system.matrix(arrays)
+        matrix, equilibration = system.scaled_matrix(arrays)
         t0 = time.perf_counter()
         try:
-            dz = solver.solve(matrix, -residual)
+            dz = equilibration * solver.solve(matrix, -residual * equilibration)
         except SingularMatrixError as err:
             raise IncrementFailed(f"singular tangent at iteration {iteration}: {err}") from err
         finally:
