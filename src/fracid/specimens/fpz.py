@@ -33,12 +33,9 @@ def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool) -> float:
     across = np.abs(points[:, axis])
     along = points[:, 1 - axis]
     # the bands are the distinct positions of points along the path (structured meshes)
-    keys = np.round(along[damaged], 9)
-    extent = np.zeros(keys.size)
-    spacing = _half_spacing(across)
-    order = np.argsort(keys)
-    far = across[damaged] + spacing(across[damaged])
-    np.maximum.at(extent, np.searchsorted(np.unique(keys), keys), far)
+    bands, band = np.unique(np.round(along[damaged], 9), return_inverse=True)
+    extent = np.zeros(bands.size)
+    np.maximum.at(extent, band, across[damaged] + _half_spacing(across)(across[damaged]))
     width = float(extent.max())
     return 2.0 * width if mirror else width
 
