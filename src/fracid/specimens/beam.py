@@ -114,8 +114,10 @@ class NotchedBeam:
         return mesh.nodes, mesh.cells, "quad8"
 
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
-        """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold [mm]."""
-        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True)}
+        """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold,
+        over the ligament [mm]."""
+        ligament = (self.notch_depth, self.depth)
+        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True, along_range=ligament)}
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""

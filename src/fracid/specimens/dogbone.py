@@ -126,7 +126,8 @@ class DogBone:
 
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
-        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True)}
+        section = (0.0, float(self.half_width(0.0)))
+        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True, along_range=section)}
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""

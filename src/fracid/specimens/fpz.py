@@ -7,7 +7,7 @@ import numpy as np
 from fracid.model.damage import kappa_at_damage
 
 
-def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool) -> float:
+def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool, along_range=(-np.inf, np.inf)) -> float:
     """Largest extent, across the crack path, of the zone where kappa exceeds ``kappa_threshold``.
 
     The crack path is the line ``x_axis = 0`` (a symmetry line of the model). Integration points
@@ -26,12 +26,14 @@ def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool) -> float:
         0 if the path is the line x = 0 (width measured along x), 1 if it is y = 0.
     mirror : bool
         Whether only one side of the path is modelled.
+    along_range : (float, float)
+        Part of the path considered [mm] (the ligament: damage at supports or platens is not FPZ).
     """
-    damaged = kappa > kappa_threshold
+    along = points[:, 1 - axis]
+    damaged = (kappa > kappa_threshold) & (along >= along_range[0]) & (along <= along_range[1])
     if not np.any(damaged):
         return 0.0
     across = np.abs(points[:, axis])
-    along = points[:, 1 - axis]
     # the bands are the distinct positions of points along the path (structured meshes)
     bands, band = np.unique(np.round(along[damaged], 9), return_inverse=True)
     extent = np.zeros(bands.size)
@@ -48,11 +50,11 @@ def _half_spacing(coords):
     return lambda c: half[np.clip(np.searchsorted(levels, np.round(c, 9)), 0, levels.size - 1)]
 
 
-def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool):
+def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool, along_range=(-np.inf, np.inf)):
     """Observer f(problem, q, arrays) -> FPZ width [mm] for :func:`~fracid.model.path_following.follow_path`."""
     kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
 
     def observe(problem, q, arrays):
-        return fpz_width(problem.disc.points.reshape(-1, 2), arrays.kappa.ravel(), kappa_t, axis, mirror)
+        return fpz_width(problem.disc.points.reshape(-1, 2), arrays.kappa.ravel(), kappa_t, axis, mirror, along_range)
 
     return observe
