@@ -21,7 +21,7 @@ from fracid.specimens.dogbone import DogBone
 CASES = {
     # Gregoire beam: E = 37 GPa, ft ~ 3 MPa (kappa_i = ft / E), internal length 4.2 mm
     "beam": (NotchedBeam(), fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=8.4e-5, alpha=0.99, beta=600.0, c=9.0), 0.5),
-    "dogbone": (DogBone(size=100.0), fracid.DamageParameters(E=30000.0, nu=0.2, kappa_i=1e-4, alpha=0.99, beta=300.0, c=25.0), None),
+    "dogbone": (DogBone(size=100.0), fracid.DamageParameters(E=30000.0, nu=0.2, kappa_i=1e-4, alpha=0.99, beta=300.0, c=25.0), 0.3),
 }
 
 
