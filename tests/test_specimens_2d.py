@@ -67,3 +67,16 @@ def test_size_effect_nominal_strength_decreases():
         strengths.append(result.peak_force / specimen.ligament_area)
     assert np.all(np.diff(strengths) < 0), strengths
     assert strengths[-1] < 0.85 * strengths[0]
+
+
+def test_hinged_platens_rotate_under_eccentric_load_glued_ones_do_not():
+    glued = fracid.simulate(DogBone(size=100.0), DOGBONE_PARAMS, target=0.3, stop_force_fraction=0.5)
+    centred = fracid.simulate(DogBone(size=100.0, platens="hinged"), DOGBONE_PARAMS, target=0.3, stop_force_fraction=0.5)
+    eccentric = fracid.simulate(DogBone(size=100.0, platens="hinged", hinge_offset=10.0), DOGBONE_PARAMS, target=0.3,
+                                stop_force_fraction=0.5)
+    # centred hinge, symmetric specimen: no rotation, and nearly the glued response (stiff, not rigid, platen)
+    assert np.max(np.abs(centred.observables["platen_tilt"])) < 1e-9
+    assert centred.peak_force == pytest.approx(glued.peak_force, rel=0.03)
+    # an eccentric hinge tilts the platen and bends the specimen: lower peak
+    assert np.max(np.abs(eccentric.observables["platen_tilt"])) > 1e-3
+    assert eccentric.peak_force < 0.95 * centred.peak_force

@@ -36,16 +36,18 @@ class ModelConstants(NamedTuple):
     D: np.ndarray  # unit elastic matrix (n_strain, n_strain)
     DB: np.ndarray  # D times the strain operator, (n_el, n_q, n_strain, n_u)
     ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant
+    damageable: np.ndarray  # 1 where the material can damage, 0 in elastic parts (platens), (n_el, n_q)
 
 
-def model_constants(disc, params, stiffness_factor) -> ModelConstants:
+def model_constants(disc, params, stiffness_factor, damageable=1.0) -> ModelConstants:
     """Precompute the parts of the tangent that do not change during a computation."""
     E = params.E * np.broadcast_to(stiffness_factor, disc.weights.shape)
+    mask = np.broadcast_to(np.asarray(damageable, dtype=float), disc.weights.shape)
     D = disc.strain_state.unit_elastic_matrix(params.nu)
     DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
     N, G, w = disc.ebar_shape, disc.ebar_gradient, disc.weights
     M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
-    return ModelConstants(E, D, DB, M)
+    return ModelConstants(E, D, DB, M, mask)
 
 
 def _btdb(weighted_B, DB):
@@ -54,8 +56,9 @@ def _btdb(weighted_B, DB):
     return np.matmul(weighted_B.reshape(n_el, -1, n_u).transpose(0, 2, 1), DB.reshape(n_el, -1, n_u))
 
 
-def _damage(params, kappa):
-    return exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
+def _damage(params, const, kappa):
+    omega, d_omega = exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
+    return omega * const.damageable, d_omega * const.damageable
 
 
 def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
@@ -76,7 +79,7 @@ def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_
     ebar = ee @ N.T
     eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
     kappa, loading = update_history(kappa_old, ebar)
-    omega, d_omega = _damage(params, kappa)
+    omega, d_omega = _damage(params, const, kappa)
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
     w_sec = w * (1.0 - omega) * const.E
     f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])
@@ -95,7 +98,7 @@ def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent
     eps = np.einsum("eqsi,ei->eqs", B, ue)
     eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
     kappa, loading = update_history(kappa_old, eq)
-    omega, d_omega = _damage(params, kappa)
+    omega, d_omega = _damage(params, const, kappa)
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
     w_sec = w * (1.0 - omega) * const.E
     f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])

@@ -41,6 +41,8 @@ class DamageProblem:
     symmetry_factor : float
         Copies of the model in the whole specimen (2 for a half model, 4 for a quarter model); the
         energies are reported for the whole specimen.
+    damageable : float or ndarray, shape (n_el, n_q)
+        1 where the material damages, 0 where it stays elastic (loading platens) [-].
     """
 
     def __init__(
@@ -55,6 +57,7 @@ class DamageProblem:
         functionals: Mapping[str, Mapping[int, float]],
         tied=(),
         symmetry_factor: float = 1.0,
+        damageable=1.0,
     ):
         if regularization not in REGULARIZATIONS:
             raise ValueError(f"regularization = {regularization!r}; choose one of {REGULARIZATIONS}")
@@ -79,7 +82,7 @@ class DamageProblem:
         if not np.any(self.load_vector):
             raise ValueError("the load pattern is empty or acts only on fixed dofs")
         self.functionals = {name: self._dense(f, f"functional {name!r}") for name, f in functionals.items()}
-        self.const = model_constants(disc, params, stiffness_factor)
+        self.const = model_constants(disc, params, stiffness_factor, damageable)
         n_u = disc.u_dofs.shape[1]
         self._tangent = np.zeros((disc.n_elements,) + (self.element_dofs.shape[1],) * 2)
         if gradient:

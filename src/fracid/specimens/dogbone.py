@@ -18,8 +18,12 @@ class DogBone:
     """Dog-bone specimen of size D: width D, height 1.5 D, circular side notches of radius 0.725 D
     reducing the width to 0.6 D at mid-height, thickness 100 mm; ends glued to loading platens.
 
-    The quarter x >= 0, y >= 0 is meshed (symmetry about both axes; glued platens with rotations fixed
-    keep the response symmetric). The top edge moves as a rigid platen: u_x = 0, one common u_y.
+    Glued platens (default, rotations fixed): the quarter x >= 0, y >= 0 is meshed (symmetry about
+    both axes) and the top edge moves as a rigid platen: u_x = 0, one common u_y.
+    Hinged platens: the upper half y >= 0 is meshed over the full width with a stiff elastic platen
+    block glued on top, loaded at a hinge at its top centre (u_x = 0 there), so the platen can
+    rotate if the specimen fails asymmetrically (``platen_tilt`` records its rotation as the
+    difference of the vertical displacements of the specimen's top corners).
     Curves are for the full specimen: force [N], elongation over the gauge length [mm].
 
     Parameters
@@ -38,6 +42,14 @@ class DogBone:
         Largest element height away from the band [mm]; 0.1 D if None.
     notch_radius, notch_width : float
         Notch radius and the width at mid-height, relative to D (0.725 and 0.6).
+    platens : {"glued", "hinged"}
+        Boundary condition of the loading platens.
+    platen_height, platen_stiffness : float
+        Height of the hinged platen block relative to D (0.1) and its Young's modulus relative to
+        the specimen's (100; it does not damage).
+    hinge_offset : float
+        Eccentricity of the hinge from the specimen's axis [mm] (hinged platens only; the nearest
+        node of the platen's top edge is used).
 
     Controls: ``elongation`` (default; passes snap-back) and ``platen_displacement`` (plain
     displacement control). Observer: ``fpz_width`` [mm], across the mid-height section.
@@ -51,6 +63,10 @@ class DogBone:
     h_coarse: float | None = None
     notch_radius: float = 0.725
     notch_width: float = 0.6
+    platens: str = "glued"
+    platen_height: float = 0.1
+    platen_stiffness: float = 100.0
+    hinge_offset: float = 0.0
 
     default_control = "elongation"
 
@@ -64,6 +80,13 @@ class DogBone:
         if not self.notch_width < 1.0 or (1.0 - self.notch_width) / 2 > self.notch_radius:
             raise ValueError(f"notch_width = {self.notch_width} and notch_radius = {self.notch_radius}: "
                              "the notch must narrow the width (notch_width < 1) and fit its radius")
+        if self.platens not in ("glued", "hinged"):
+            raise ValueError(f"DogBone.platens = {self.platens!r}; choose 'glued' or 'hinged'")
+        for name in ("platen_height", "platen_stiffness"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"DogBone.{name} = {getattr(self, name)!r}; it must be positive")
+        if not abs(self.hinge_offset) < 0.5 * self.size or (self.hinge_offset and self.platens != "hinged"):
+            raise ValueError(f"DogBone.hinge_offset = {self.hinge_offset!r} mm: it needs hinged platens and |offset| < D/2")
         if self._gauge / 2 >= 0.75 * self.size:
             raise ValueError(f"gauge_length = {self._gauge} mm must be shorter than the height 1.5 D")
 
@@ -97,12 +120,19 @@ class DogBone:
         keys = sorted({0.0, self._gauge / 2, min(end_of_arc, 0.75 * D), 0.75 * D})
         ts = graded_lines(keys, lambda t: np.minimum(coarse, h + 0.25 * np.maximum(t - fine, 0.0)))
         n_s = max(2, math.ceil(0.5 * self.notch_width * D / h))
-        return structured_quad8(np.linspace(0.0, 1.0, n_s + 1), ts, mapping=lambda s, t: (s * self.half_width(t), t))
+        s_lines = np.linspace(0.0, 1.0, n_s + 1)
+        if self.platens == "hinged":
+            s_lines = np.concatenate([-s_lines[:0:-1], s_lines])
+            top = 0.75 * D + self.platen_height * D
+            ts = np.concatenate([ts, np.linspace(0.75 * D, top, max(2, math.ceil(self.platen_height * D / coarse)) + 1)[1:]])
+        return structured_quad8(s_lines, ts, mapping=lambda s, t: (s * self.half_width(t), t))
 
     def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
         mesh = mesh or self.mesh()
-        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        if self.platens == "hinged":
+            return self._hinged_problem(params, regularization, mesh, disc)
+        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         top = np.flatnonzero(np.abs(y - 0.75 * self.size) < 1e-9)
         axis = np.flatnonzero(np.abs(x) < 1e-9)
         section = np.flatnonzero(np.abs(y) < 1e-9)
@@ -119,6 +149,31 @@ class DogBone:
             symmetry_factor=4.0,
         )
 
+    def _hinged_problem(self, params, regularization, mesh, disc) -> DamageProblem:
+        D, y = self.size, mesh.nodes[:, 1]
+        hinge = mesh.closest_node((self.hinge_offset, 0.75 * D + self.platen_height * D))
+        section = np.flatnonzero(np.abs(y) < 1e-9)
+        g = self._gauge / 2
+        right, left = (mesh.closest_node((sign * float(self.half_width(g)), g)) for sign in (1.0, -1.0))
+        corners = [mesh.closest_node((sign * 0.5 * D, 0.75 * D)) for sign in (1.0, -1.0)]
+        in_platen = disc.points[..., 1] > 0.75 * D
+        return DamageProblem(
+            disc,
+            params,
+            regularization=regularization,
+            stiffness_factor=np.where(in_platen, self.platen_stiffness, 1.0),
+            damageable=np.where(in_platen, 0.0, 1.0),
+            fixed_dofs=np.concatenate([2 * section + 1, [2 * hinge]]),
+            load={2 * hinge + 1: 1.0},  # the upper half carries the whole force
+            functionals={
+                # mean of the elongations on both sides: (2 u_R + 2 u_L) / 2
+                "elongation": {2 * right + 1: 1.0, 2 * left + 1: 1.0},
+                "platen_displacement": {2 * hinge + 1: 2.0},
+                "platen_tilt": {2 * corners[0] + 1: 1.0, 2 * corners[1] + 1: -1.0},
+            },
+            symmetry_factor=2.0,
+        )
+
     def output_mesh(self):
         """Nodes, cells and VTK cell type of the (quarter) mesh, for :func:`fracid.report.write_result_vtk`."""
         mesh = self.mesh()
@@ -126,7 +181,8 @@ class DogBone:
 
     def observers(self, params, damage_threshold: float = 0.0) -> dict:
         """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
-        section = (0.0, float(self.half_width(0.0)))
+        half = float(self.half_width(0.0))
+        section = (-half if self.platens == "hinged" else 0.0, half)
         return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True, along_range=section)}
 
     def default_steps(self, target: float):
