@@ -4,7 +4,7 @@ For the notched beam (Gregoire geometry) and the D = 100 mm dog-bone, loaded pas
 20 % of it, prints: unknowns, steps, Newton iterations, wall time, peak memory (resident set size of
 this process) and the ratio wall time / time in sparse factorizations and solves.
 
-    python benchmarks/forward_2d.py [--specimen beam|dogbone|all] [--solvers superlu,pardiso]
+    python benchmarks/forward_2d.py [--specimen beam,dogbone,dogbone1600|all] [--solvers superlu,pardiso]
 """
 
 from __future__ import annotations
@@ -22,6 +22,9 @@ CASES = {
     # Gregoire beam: E = 37 GPa, ft ~ 3 MPa (kappa_i = ft / E), internal length 4.2 mm
     "beam": (NotchedBeam(), fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=8.4e-5, alpha=0.99, beta=600.0, c=9.0), 0.5),
     "dogbone": (DogBone(size=100.0), fracid.DamageParameters(E=30000.0, nu=0.2, kappa_i=1e-4, alpha=0.99, beta=300.0, c=25.0), 0.3),
+    # the snap-back case of the tests on a mesh refined by two (h = 5 mm in the process zone)
+    "dogbone1600": (DogBone(size=1600.0, h_fine=5.0, gauge_length=200.0),
+                    fracid.DamageParameters(E=30000.0, nu=0.2, kappa_i=1e-4, alpha=0.99, beta=1000.0, c=100.0), None),
 }
 
 
@@ -48,10 +51,10 @@ def run(name, solver_name):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--specimen", default="all", choices=["all", *CASES])
+    parser.add_argument("--specimen", default="beam,dogbone", help=f"comma-separated, from {list(CASES)}, or all")
     parser.add_argument("--solvers", default="superlu,pardiso")
     args = parser.parse_args(argv)
-    names = list(CASES) if args.specimen == "all" else [args.specimen]
+    names = list(CASES) if args.specimen == "all" else args.specimen.split(",")
     for name in names:
         for solver_name in args.solvers.split(","):
             run(name, solver_name)
