@@ -56,6 +56,11 @@ def _btdb(weighted_B, DB):
     return np.matmul(weighted_B.reshape(n_el, -1, n_u).transpose(0, 2, 1), DB.reshape(n_el, -1, n_u))
 
 
+def _bt(vector, B):
+    """B^T v at every integration point: (n_el, n_q, n_strain) x (n_el, n_q, n_strain, n_u) -> (n_el, n_q, n_u)."""
+    return np.matmul(vector[..., None, :], B)[..., 0, :]
+
+
 def _damage(params, const, kappa):
     omega, d_omega = exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
     return omega * const.damageable, d_omega * const.damageable
@@ -82,13 +87,14 @@ def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_
     omega, d_omega = _damage(params, const, kappa)
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
     w_sec = w * (1.0 - omega) * const.E
-    f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])
+    bt_sigma = _bt(sigma_eff, B)  # B^T D eps, (n_el, n_q, n_u)
+    f_u = np.einsum("eqi,eq->ei", bt_sigma, w_sec)
     f_eq = (w * eq) @ N
     f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
     out_tangent[:, :nu, :nu] = _btdb(B * w_sec[..., None, None], const.DB)
     w_ue = -(w * const.E * d_omega * loading)
-    out_tangent[:, :nu, nu:] = np.einsum("eqi,qj->eij", np.einsum("eqsi,eqs->eqi", B, sigma_eff) * w_ue[..., None], N)
-    out_tangent[:, nu:, :nu] = -np.einsum("qi,eqj->eij", N, np.einsum("eqs,eqsj->eqj", d_eq * w[..., None], B))
+    out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
+    out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
     return ElementArrays(np.concatenate([f_u, f_e], axis=1), out_tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
 
 
@@ -101,13 +107,10 @@ def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent
     omega, d_omega = _damage(params, const, kappa)
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
     w_sec = w * (1.0 - omega) * const.E
-    f_u = np.einsum("eqsi,eqs->ei", B, sigma_eff * w_sec[..., None])
+    bt_sigma = _bt(sigma_eff, B)
+    f_u = np.einsum("eqi,eq->ei", bt_sigma, w_sec)
     secant = _btdb(B * w_sec[..., None, None], const.DB)
-    softening = np.einsum(
-        "eqi,eqj->eij",
-        np.einsum("eqsi,eqs->eqi", B, sigma_eff) * (w * const.E * d_omega * loading)[..., None],
-        np.einsum("eqs,eqsj->eqj", d_eq, B),
-    )
+    softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1), _bt(d_eq, B))
     out_tangent[:] = secant - softening
     return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)
 

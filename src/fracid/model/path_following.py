@@ -176,6 +176,7 @@ def follow_path(
 
     z = np.zeros(problem.n_free + 1)
     kappa = problem.initial_history()
+    state = None  # evaluation at the current converged z, reused by the next increment
     tau, status = 0.0, "target reached"
     base = steps.initial  # reference increment; set from the onset of damage when not given
     step = base if base is not None else 1e-3 * target  # elastic probe
@@ -192,8 +193,11 @@ def follow_path(
             break
         increment = min(step, target - tau)
         try:
-            z_new, arrays, iterations = solve_increment(system, z, tau + increment, kappa, solver, newton, stats)
+            z_new, arrays, iterations, state = solve_increment(
+                system, z, tau + increment, kappa, solver, newton, stats, state
+            )
         except IncrementFailed as err:
+            state = None  # the failed iterations overwrote the problem's tangent buffer
             stats.failed_increments += 1
             step = increment * steps.shrink
             minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or first_step)

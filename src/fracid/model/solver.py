@@ -91,11 +91,12 @@ class ControlledSystem:
         self.border_values = np.concatenate([-self.problem.load_vector[f_idx], self.control[v_idx]])
         self.pattern = SparsePattern(n + 1, self.problem.element_dofs, rows, cols)
 
-    def evaluate(self, z: np.ndarray, tau: float, kappa_old: np.ndarray):
-        """Residual of the bordered system, element arrays, and relative residual per field."""
+    def evaluate(self, z: np.ndarray, tau: float, kappa_old: np.ndarray, state=None):
+        """Residual of the bordered system, element arrays, relative residual per field, and the
+        problem's evaluation ``state`` (pass it back to skip re-evaluating at the same z and history)."""
         p = self.problem
         q, lam = z[:-1], z[-1]
-        internal, arrays, references = p.evaluate(q, kappa_old)
+        internal, arrays, references = state if state is not None else p.evaluate(q, kappa_old)
         residual = np.append(internal - lam * p.load_vector, dot(self.control, q) - tau)
         external = abs(lam) * norm2(p.load_vector)
         errors = {}
@@ -103,7 +104,7 @@ class ControlledSystem:
             scale = max(references[name], external if name == "u" else 0.0)
             norm = float(norm2(residual[idx]))
             errors[name] = norm / scale if scale > 0.0 else norm
-        return residual, arrays, errors
+        return residual, arrays, errors, (internal, arrays, references)
 
     def matrix(self, arrays):
         return self.pattern.matrix(arrays.tangent, self.border_values)
@@ -125,8 +126,14 @@ class ControlledSystem:
         return matrix, self._scale
 
 
-def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics):
+def solve_increment(
+    system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics, state=None
+):
     """Newton-Raphson iterations for one increment to the control value ``tau``.
+
+    ``state`` is the evaluation at ``z0`` returned by the previous increment: at a converged state the
+    internal forces and tangent under the updated history equal those of the last iteration (the
+    loading pattern does not change), so the first iteration of a step costs no evaluation.
 
     Returns
     -------
@@ -135,6 +142,8 @@ def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, option
     arrays : ElementArrays
         Element arrays at the converged state (trial history and damage).
     iterations : int
+    state : tuple
+        The evaluation at the converged z (for the next increment).
 
     Raises
     ------
@@ -144,13 +153,13 @@ def solve_increment(system: ControlledSystem, z0, tau, kappa_old, solver, option
     z = z0.copy()
     scale = max(abs(tau), 1e-300)
     for iteration in range(options.max_iterations + 1):
-        residual, arrays, errors = system.evaluate(z, tau, kappa_old)
+        residual, arrays, errors, state = system.evaluate(z, tau, kappa_old, state if iteration == 0 else None)
         if not np.all(np.isfinite(residual)):
             raise IncrementFailed(f"non-finite residual at iteration {iteration}")
         if iteration > 0 and abs(residual[-1]) <= 1e-10 * scale and all(
             err <= options.tolerance(name) for name, err in errors.items()
         ):
-            return z, arrays, iteration
+            return z, arrays, iteration, state
         if iteration == options.max_iterations:
             break
         matrix, equilibration = system.scaled_matrix(arrays)
