@@ -21,6 +21,7 @@ def simulate(
     field_steps="last",
     max_steps: int = 2000,
     callback=None,
+    checkpoints=None,
 ) -> PathResult:
     """Run the forward model of ``specimen`` with ``params``.
 
@@ -59,4 +60,5 @@ def simulate(
         observers=specimen.observers(params, damage_threshold),
         field_steps=field_steps,
         callback=callback,
+        checkpoints=checkpoints,
     )

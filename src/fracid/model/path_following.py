@@ -77,7 +77,9 @@ class StepOptions:
     initial : float or None
         First increment of the control quantity [mm]; None: 1/20 of the control value at damage onset.
     maximum, minimum : float or None
-        Bounds on the increment [mm]; None: 4 x and 1e-4 x the initial increment.
+        Bounds on the increment [mm]; None: ``max_factor`` x and 1e-4 x the initial increment.
+    max_factor : float
+        Largest increment relative to the initial one when ``maximum`` is None.
     grow, shrink : float
         Factor applied after an easy increment (at most ``easy_iterations``) and after a cut.
     easy_iterations : int
@@ -90,6 +92,7 @@ class StepOptions:
     initial: float | None = None
     maximum: float | None = None
     minimum: float | None = None
+    max_factor: float = 4.0
     grow: float = 1.5
     shrink: float = 0.5
     easy_iterations: int = 4
@@ -129,6 +132,7 @@ def follow_path(
     observers: Mapping[str, Callable] | None = None,
     field_steps="last",
     callback: Callable | None = None,
+    checkpoints=None,
 ) -> PathResult:
     """Trace the equilibrium path by increasing the functional ``control`` up to ``target``.
 
@@ -155,6 +159,10 @@ def follow_path(
         Steps at which the fields are stored (the last converged step is always stored unless None).
     callback : callable(step, tau, force), optional
         Called after each converged step (progress reporting).
+    checkpoints : array_like, optional
+        Control values [mm] that must be steps of the analysis (the sampling points of measured
+        data), so that the computed values there are not interpolated between steps and do not
+        jitter with the adaptive step sequence.
 
     Returns
     -------
@@ -181,6 +189,7 @@ def follow_path(
     base = steps.initial  # reference increment; set from the onset of damage when not given
     step = base if base is not None else 1e-3 * target  # elastic probe
     first_step = step
+    marks = np.sort(np.asarray([] if checkpoints is None else checkpoints, dtype=float))
     elastic = True
 
     def result(final_status):
@@ -192,6 +201,9 @@ def follow_path(
             status = f"stopped after max_steps = {max_steps} steps"
             break
         increment = min(step, target - tau)
+        ahead = marks[marks > tau * (1.0 + 1e-12) + 1e-15]
+        if ahead.size and ahead[0] < tau + increment:
+            increment = ahead[0] - tau
         try:
             z_new, arrays, iterations, state = solve_increment(
                 system, z, tau + increment, kappa, solver, newton, stats, state
@@ -231,7 +243,7 @@ def follow_path(
             elastic = False
             step = base * steps.onset_fraction
             continue
-        maximum = steps.maximum if steps.maximum is not None else 4.0 * base
+        maximum = steps.maximum if steps.maximum is not None else steps.max_factor * base
         step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
     return result(status)
 

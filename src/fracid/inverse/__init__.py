@@ -1,0 +1,1 @@
+"""Inverse methods: forward operator, KNN population search, Kalman filter, strategy."""

@@ -1,0 +1,186 @@
+"""The forward operator h(x): a vector of identified parameters -> computed observations.
+
+An :class:`Observation` says what is measured on which specimen: a curve quantity (the force, or a
+local quantity such as the FPZ width) sampled at given values of the specimen's control quantity.
+:class:`ForwardOperator` maps a vector x of the identified parameters (a named subset of the model
+parameters; the others fixed) to the concatenated computed values ``y_comp``, in the order of the
+observations. A forward run that does not converge is retried once with smaller steps; if it still
+fails, the result records the failure (reason, how far it got) instead of raising, so a study goes on.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from fracid.forward import simulate
+from fracid.model.parameters import DamageParameters
+from fracid.model.path_following import ConvergenceError, StepOptions
+
+
+@dataclass(frozen=True, eq=False)
+class Observation:
+    """Computed counterpart of one measured data block.
+
+    Parameters
+    ----------
+    specimen
+        Specimen object (bar, beam, dog-bone).
+    control_points : array_like
+        Increasing values of the control quantity at which the data are sampled [mm].
+    quantity : str
+        ``"force"`` [N] or the name of an observable of the forward run (e.g. ``"fpz_width"`` [mm]).
+    control : str or None
+        The specimen's control quantity (its default if None).
+    name : str
+        Label of the block.
+    """
+
+    specimen: object
+    control_points: np.ndarray
+    quantity: str = "force"
+    control: str | None = None
+    name: str = "global"
+
+    def __post_init__(self):
+        points = np.asarray(self.control_points, dtype=float)
+        if points.ndim != 1 or points.size == 0 or np.any(np.diff(points) <= 0) or points[0] <= 0:
+            raise ValueError(f"observation {self.name!r}: control points must be positive and increasing")
+        object.__setattr__(self, "control_points", points)
+
+
+@dataclass
+class RunRecord:
+    """Outcome of one evaluation of the forward operator.
+
+    ``y`` holds the computed values (NaN where not computed); ``status`` is ``"ok"`` or ``"failed"``;
+    ``error`` the reason of a failure and ``reached`` the control value reached per observation.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    status: str = "ok"
+    error: str = ""
+    reached: list = field(default_factory=list)
+    seconds: float = 0.0
+    retried: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def as_dict(self) -> dict:
+        return {"x": self.x, "y": self.y, "status": self.status, "error": self.error, "reached": list(self.reached),
+                "seconds": self.seconds, "retried": self.retried}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "RunRecord":
+        return cls(np.asarray(d["x"], float), np.asarray(d["y"], float), d["status"], d["error"], list(d["reached"]),
+                   float(d["seconds"]), bool(d["retried"]))
+
+
+@dataclass(frozen=True, eq=False)
+class ForwardOperator:
+    """h(x) for a set of observations, x being the parameters ``names`` (the rest from ``base``).
+
+    Parameters
+    ----------
+    observations : sequence of Observation
+    base : DamageParameters
+        Values of the parameters that are not identified.
+    names : sequence of str
+        Identified parameters, in the order of x.
+    regularization : str
+        ``"gradient"`` or ``"local"``.
+    steps : StepOptions or None
+        Step rule (the specimen's default if None); the retry divides its increments by 4.
+    """
+
+    observations: tuple
+    base: DamageParameters
+    names: tuple
+    regularization: str = "gradient"
+    steps: StepOptions | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "observations", tuple(self.observations))
+        object.__setattr__(self, "names", tuple(self.names))
+        unknown = set(self.names) - set(DamageParameters.names())
+        if unknown or not self.names:
+            raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {DamageParameters.names()}")
+        sizes = [o.control_points.size for o in self.observations]
+        object.__setattr__(self, "_offsets", np.concatenate([[0], np.cumsum(sizes)]))
+
+    @property
+    def n_outputs(self) -> int:
+        return int(self._offsets[-1])
+
+    def parameters(self, x) -> DamageParameters:
+        """The full parameter set for the vector x (raises ValueError for invalid values)."""
+        x = np.asarray(x, dtype=float)
+        if x.shape != (len(self.names),):
+            raise ValueError(f"x must have {len(self.names)} entries {self.names}, got shape {x.shape}")
+        return self.base.replace(**dict(zip(self.names, x.tolist())))
+
+    def slices(self) -> list[slice]:
+        """Position of each observation block in y."""
+        return [slice(int(a), int(b)) for a, b in zip(self._offsets[:-1], self._offsets[1:])]
+
+    def __call__(self, x, needed: int | None = None) -> RunRecord:
+        """Evaluate h(x); only the first ``needed`` outputs are guaranteed (runs stop early)."""
+        start = time.perf_counter()
+        x = np.asarray(x, dtype=float)
+        y = np.full(self.n_outputs, np.nan)
+        record = RunRecord(x=x, y=y)
+        try:
+            params = self.parameters(x)
+        except ValueError as err:
+            record.status, record.error = "failed", f"invalid parameters: {err}"
+            return record
+        limit = self.n_outputs if needed is None else int(needed)
+        for obs, part in zip(self.observations, self.slices()):
+            if part.start >= limit:
+                break
+            last = min(part.stop, limit) - part.start  # points of this block that are needed
+            target = float(obs.control_points[last - 1])
+            run, error, retried = self._run(obs, params, target, obs.control_points[:last])
+            record.retried |= retried
+            if run is None:
+                record.status, record.error = "failed", error
+                record.reached.append(0.0)
+                break
+            record.reached.append(float(run.control[-1]))
+            x_run = run.control
+            values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
+            y[part.start : part.start + last] = np.interp(obs.control_points[:last], x_run, values)
+            if error:
+                record.status, record.error = "failed", error
+                break
+        record.seconds = time.perf_counter() - start
+        return record
+
+    def _run(self, obs, params, target, checkpoints):
+        """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
+        error = ""
+        for attempt, steps in enumerate(self._step_rules(obs, target)):
+            try:
+                result = simulate(obs.specimen, params, regularization=self.regularization, control=obs.control,
+                                  target=target, stop_force_fraction=None, steps=steps, field_steps=None,
+                                  checkpoints=checkpoints)
+                return result, "", attempt > 0
+            except ConvergenceError as err:
+                error = str(err)
+                partial = err.partial
+        reached = partial.control[-1] if partial.n_steps else 0.0
+        return None, f"forward run failed at control {reached:.6g} of {target:.6g} mm: {error}", True
+
+    def _step_rules(self, obs, target):
+        first = self.steps
+        if first is None:
+            first = obs.specimen.default_steps(target) if hasattr(obs.specimen, "default_steps") else StepOptions()
+        quarter = (lambda v: None if v is None else v / 4)  # noqa: E731
+        smaller = replace(first, initial=quarter(first.initial), maximum=quarter(first.maximum),
+                          max_factor=first.max_factor / 4, onset_fraction=first.onset_fraction / 4)
+        return (first, smaller)
