@@ -98,6 +98,17 @@ class DamageParameters:
         """Unit of each parameter."""
         return {name: r[4] for name, r in _RANGES.items()}
 
+    @classmethod
+    def valid_bounds(cls, names) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper limits of the valid ranges of ``names``, open ends moved inside by 1e-9
+        (relative) so that clipped values stay valid; +-inf where unbounded."""
+        lower, upper = [], []
+        for name in names:
+            lo, lo_incl, hi, hi_incl, _ = _RANGES[name]
+            lower.append(-np.inf if lo is None else lo if lo_incl else lo + 1e-9 * max(abs(lo), 1e-9))
+            upper.append(np.inf if hi is None else hi if hi_incl else hi - 1e-9 * max(abs(hi), 1.0))
+        return np.array(lower), np.array(upper)
+
     def replace(self, **changes) -> "DamageParameters":
         """A copy with some parameters changed (validated)."""
         unknown = set(changes) - set(_RANGES)

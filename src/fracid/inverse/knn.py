@@ -1,0 +1,212 @@
+"""K-nearest-neighbour search over a population of forward runs (the discrete grid method, SPEC 4)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import solve_triangular
+from scipy.stats import qmc
+
+
+@dataclass(frozen=True)
+class ParameterSpace:
+    """Names, bounds and scale of the identified parameters.
+
+    Parameters
+    ----------
+    names : sequence of str
+    lower, upper : array_like
+        Bounds, in the parameters' units.
+    log : sequence of bool, optional
+        Per parameter: sample uniformly in log(x) instead of x (for ranges over decades).
+    """
+
+    names: tuple
+    lower: np.ndarray
+    upper: np.ndarray
+    log: tuple = ()
+
+    def __post_init__(self):
+        names = tuple(self.names)
+        lower, upper = np.asarray(self.lower, float), np.asarray(self.upper, float)
+        log = tuple(self.log) if self.log else (False,) * len(names)
+        if not (lower.shape == upper.shape == (len(names),) and len(log) == len(names)):
+            raise ValueError("names, lower, upper and log must have one entry per parameter")
+        for name, lo, hi, lg in zip(names, lower, upper, log):
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                raise ValueError(f"bounds of {name!r}: lower = {lo} must be below upper = {hi}")
+            if lg and lo <= 0:
+                raise ValueError(f"bounds of {name!r}: log scale needs a positive lower bound, got {lo}")
+        object.__setattr__(self, "names", names)
+        object.__setattr__(self, "lower", lower)
+        object.__setattr__(self, "upper", upper)
+        object.__setattr__(self, "log", log)
+
+    def from_unit(self, u: np.ndarray) -> np.ndarray:
+        """Map points of the unit cube to parameter values."""
+        u = np.atleast_2d(u)
+        lin = self.lower + u * (self.upper - self.lower)
+        logv = np.exp(np.log(np.where(self.lower > 0, self.lower, 1.0))
+                      + u * (np.log(np.where(self.upper > 0, self.upper, 1.0)) - np.log(np.where(self.lower > 0, self.lower, 1.0))))
+        return np.where(np.array(self.log), logv, lin)
+
+    def to_unit(self, x: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`from_unit`."""
+        x = np.atleast_2d(x)
+        lin = (x - self.lower) / (self.upper - self.lower)
+        safe = lambda v: np.log(np.where(v > 0, v, 1.0))  # noqa: E731
+        logu = (safe(x) - safe(self.lower)) / (safe(self.upper) - safe(self.lower))
+        return np.where(np.array(self.log), logu, lin)
+
+
+def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) -> np.ndarray:
+    """A population of parameter sets within the bounds.
+
+    Parameters
+    ----------
+    n : int
+        Number of points (``"grid"``: points per parameter, so n ** p in all).
+    method : {"sobol", "lhs", "grid"}
+        Scrambled Sobol sequence, Latin hypercube (scipy.stats.qmc) or full grid (cell centres
+        excluded: the grid includes the bounds).
+    """
+    p = len(space.names)
+    if int(n) != n or n < 1:
+        raise ValueError(f"population size n = {n!r} must be a positive integer")
+    if method == "grid":
+        if n < 2:
+            raise ValueError("a full grid needs at least 2 points per parameter")
+        axes = np.meshgrid(*[np.linspace(0.0, 1.0, int(n))] * p, indexing="ij")
+        unit = np.column_stack([a.ravel() for a in axes])
+    elif method == "lhs":
+        unit = qmc.LatinHypercube(d=p, seed=seed).random(int(n))
+    elif method == "sobol":
+        sampler = qmc.Sobol(d=p, scramble=True, seed=seed)
+        m = int(np.ceil(np.log2(n)))
+        unit = sampler.random_base2(m)[: int(n)]  # balanced for powers of 2
+    else:
+        raise ValueError(f"design method {method!r}; choose 'sobol', 'lhs' or 'grid'")
+    return space.from_unit(unit)
+
+
+def objective(y_exp, C_exp, Y) -> np.ndarray:
+    """f_i = (y_exp - y_i)^T C_exp^-1 (y_exp - y_i) for every row of Y; inf for failed (NaN) rows."""
+    L = np.linalg.cholesky(np.asarray(C_exp, float))
+    Y = np.atleast_2d(np.asarray(Y, float))
+    r = solve_triangular(L, (np.asarray(y_exp, float) - Y).T, lower=True)
+    f = np.sum(r * r, axis=0)
+    return np.where(np.all(np.isfinite(Y), axis=1), f, np.inf)
+
+
+@dataclass
+class KnnResult:
+    """Outcome of a KNN search.
+
+    Attributes
+    ----------
+    space : ParameterSpace
+    points : ndarray, shape (N, p)
+        The population.
+    f : ndarray, shape (N,)
+        Objective of every point (inf for failed runs).
+    status, errors : list of str
+        Per point: "ok" or "failed", and the failure reason.
+    order : ndarray of int
+        Points ranked by f (failed ones last).
+    k : int
+    x0, C0 : ndarray
+        Mean and covariance of the k nearest neighbours (the Kalman filter's prior).
+    """
+
+    space: ParameterSpace
+    points: np.ndarray
+    f: np.ndarray
+    status: list
+    errors: list
+    order: np.ndarray
+    k: int
+    x0: np.ndarray
+    C0: np.ndarray
+
+    @property
+    def neighbours(self) -> np.ndarray:
+        return self.points[self.order[: self.k]]
+
+    @property
+    def n_failed(self) -> int:
+        return sum(s != "ok" for s in self.status)
+
+    def table(self, rows: int | None = None) -> str:
+        """Ranked table: rank, objective, parameters, status."""
+        header = f"{'rank':>4} {'f':>12} " + " ".join(f"{n:>12}" for n in self.space.names) + "  status"
+        lines = [header]
+        for rank, i in enumerate(self.order[: rows or len(self.order)], start=1):
+            values = " ".join(f"{v:12.5g}" for v in self.points[i])
+            note = self.status[i] if self.status[i] == "ok" else f"failed: {self.errors[i][:60]}"
+            lines.append(f"{rank:4d} {self.f[i]:12.5g} {values}  {note}")
+        return "\n".join(lines)
+
+
+def knn_from_population(space, points, Y, status, errors, y_exp, C_exp, k) -> KnnResult:
+    """Rank an evaluated population against measured data (no forward runs: populations are reusable).
+
+    x0 is the mean of the k best points. C0 is their sample covariance plus, per parameter, the
+    squared half-spacing of the population (range / N^(1/p) / 2): a floor that keeps C0 positive
+    definite when the neighbours are fewer than p + 1 or aligned, and says that the population
+    cannot resolve finer than its spacing.
+    """
+    points = np.atleast_2d(np.asarray(points, float))
+    n, p = points.shape
+    ok = np.array([s == "ok" for s in status])
+    if not 1 <= k <= n:
+        raise ValueError(f"k = {k} must be between 1 and the population size {n}")
+    if k > ok.sum():
+        raise ValueError(f"k = {k} but only {ok.sum()} of {n} forward runs succeeded")
+    f = objective(y_exp, C_exp, Y)
+    order = np.argsort(f, kind="stable")
+    best = points[order[:k]]
+    x0 = best.mean(axis=0)
+    spread = np.cov(best.T, ddof=1).reshape(p, p) if k > 1 else np.zeros((p, p))
+    spacing = (space.upper - space.lower) / n ** (1.0 / p) / 2.0
+    C0 = spread + np.diag(spacing**2)
+    return KnnResult(space, points, f, list(status), list(errors), order, k, x0, C0)
+
+
+def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sobol", seed=0, k=5,
+               executor=None, store=None, progress=None) -> KnnResult:
+    """Run the forward operator on a population and rank it against the data.
+
+    Parameters
+    ----------
+    operator : ForwardOperator
+        Its ``names`` must be the space's names.
+    n, method, seed
+        Population design, see :func:`design`.
+    k : int
+        Neighbours averaged into x0 and C0.
+    executor : Executor, optional
+        Runs the population in parallel (see :mod:`fracid.parallel`).
+    store : RunStore, optional
+        Stored runs are reused, new ones stored as they finish (an interrupted population resumes).
+    """
+    if tuple(operator.names) != tuple(space.names):
+        raise ValueError(f"operator parameters {operator.names} differ from the space's {space.names}")
+    points = design(space, n, method, seed)
+    if not 1 <= k <= len(points):
+        raise ValueError(f"k = {k} must be between 1 and the population size {len(points)}")
+    records = evaluate_population(operator, points, executor=executor, store=store, progress=progress)
+    Y = np.array([r.y for r in records])
+    return knn_from_population(space, points, Y, [r.status for r in records], [r.error for r in records],
+                               y_exp, C_exp, k)
+
+
+def evaluate_population(operator, points, *, executor=None, store=None, progress=None):
+    """Forward runs of every point (through the run store and executor when given)."""
+    from fracid.inverse.sensitivity import evaluate_points
+
+    if store is None:
+        return evaluate_points(operator, points, None, executor)
+    from fracid.inverse.runs import run_population
+
+    return run_population(operator, points, executor=executor, store=store, progress=progress)
