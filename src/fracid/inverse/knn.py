@@ -94,9 +94,10 @@ def objective(y_exp, C_exp, Y) -> np.ndarray:
     """f_i = (y_exp - y_i)^T C_exp^-1 (y_exp - y_i) for every row of Y; inf for failed (NaN) rows."""
     L = np.linalg.cholesky(np.asarray(C_exp, float))
     Y = np.atleast_2d(np.asarray(Y, float))
-    r = solve_triangular(L, (np.asarray(y_exp, float) - Y).T, lower=True)
-    f = np.sum(r * r, axis=0)
-    return np.where(np.all(np.isfinite(Y), axis=1), f, np.inf)
+    computed = np.all(np.isfinite(Y), axis=1)
+    residual = np.where(computed[:, None], np.asarray(y_exp, float) - Y, 0.0)
+    r = solve_triangular(L, residual.T, lower=True)
+    return np.where(computed, np.sum(r * r, axis=0), np.inf)
 
 
 @dataclass

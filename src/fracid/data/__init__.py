@@ -1,0 +1,38 @@
+"""Experimental data: measured curves read from files, and the vector y_exp with its covariance C_exp.
+
+Units: control quantities in mm, forces in N.
+
+>>> from fracid.data import gregoire2013_beam4
+>>> data = gregoire2013_beam4(n_points=40)
+>>> data.y.shape, data.covariance.shape
+((40,), (40, 40))
+"""
+
+from fracid.data.curves import Curve, DataError, curve_from_arrays, read_curve_csv
+from fracid.data.experimental import (
+    ExperimentalData,
+    from_envelope,
+    from_repeats,
+    gregoire2013_beam4,
+    gregoire2013_beam4_path,
+    local_block,
+    sample_points,
+    stack,
+    with_std,
+)
+
+__all__ = [
+    "Curve",
+    "DataError",
+    "ExperimentalData",
+    "curve_from_arrays",
+    "from_envelope",
+    "from_repeats",
+    "gregoire2013_beam4",
+    "gregoire2013_beam4_path",
+    "local_block",
+    "read_curve_csv",
+    "sample_points",
+    "stack",
+    "with_std",
+]

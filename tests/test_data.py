@@ -1,0 +1,290 @@
+"""Experimental data: reading curves (every bad-file case names file, row, column) and building y_exp, C_exp."""
+
+import numpy as np
+import pytest
+
+from fracid.data import (
+    Curve,
+    DataError,
+    ExperimentalData,
+    curve_from_arrays,
+    from_envelope,
+    from_repeats,
+    gregoire2013_beam4,
+    gregoire2013_beam4_path,
+    local_block,
+    read_curve_csv,
+    sample_points,
+    stack,
+    with_std,
+)
+
+
+def write_csv(tmp_path, rows, header="cmod,F", name="curve.csv"):
+    """A CSV file with the given header and data rows (lists of cells, or raw strings)."""
+    lines = [header] + [row if isinstance(row, str) else ",".join(str(v) for v in row) for row in rows]
+    path = tmp_path / name
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def good_rows(n=12):
+    return [[0.01 * k, 100.0 * k] for k in range(n)]
+
+
+def read(path, **options):
+    options.setdefault("control_column", "cmod")
+    options.setdefault("force_columns", "F")
+    return read_curve_csv(path, **options)
+
+
+# ------------------------------------------------------------------------------------ bad files
+
+
+def test_empty_file_is_named(tmp_path):
+    path = tmp_path / "empty.csv"
+    path.write_text("\n \n")
+    with pytest.raises(DataError, match="empty") as info:
+        read(path)
+    assert "empty.csv" in str(info.value)
+
+
+def test_missing_column_lists_the_available_ones(tmp_path):
+    path = write_csv(tmp_path, good_rows())
+    with pytest.raises(DataError) as info:
+        read(path, force_columns=["F", "load_kN"])
+    message = str(info.value)
+    assert "curve.csv" in message and "'load_kN'" in message
+    assert "available columns: 'cmod', 'F'" in message
+
+
+def test_header_row_is_required(tmp_path):
+    path = tmp_path / "noheader.csv"
+    path.write_text("\n".join(f"{0.01 * k},{k}" for k in range(12)) + "\n")
+    with pytest.raises(DataError, match="header row"):
+        read(path)
+
+
+def test_text_in_a_number_cell_names_row_and_column(tmp_path):
+    rows = good_rows()
+    rows[4][1] = "abc"  # data row 5 = file row 6
+    path = write_csv(tmp_path, rows)
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and "row 6" in message and "'F'" in message and "'abc' is not a number" in message
+
+
+@pytest.mark.parametrize("cell, word", [("", "empty cell"), ("nan", "missing value"), ("NaN", "missing value")])
+def test_empty_or_nan_cell_names_row_and_column(tmp_path, cell, word):
+    rows = good_rows()
+    rows[2][0] = cell  # file row 4, control column
+    path = write_csv(tmp_path, rows)
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and "row 4" in message and "'cmod'" in message and word in message
+
+
+def test_control_going_backwards_beyond_noise_names_the_row(tmp_path):
+    rows = good_rows()
+    rows[7][0] = 0.03  # file row 9: 0.03 after 0.06, range 0.11 -> tolerance 0.0011 mm
+    path = write_csv(tmp_path, rows)
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and "backwards at row 9" in message and "row 8" in message
+
+
+def test_fewer_points_than_requested(tmp_path):
+    path = write_csv(tmp_path, good_rows(5))
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and "5 data rows" in message and "minimum of 10" in message
+    assert len(read(path, min_points=5)[0].control) == 5
+
+
+def test_row_with_missing_cells(tmp_path):
+    rows = good_rows()
+    rows[3] = "0.03"
+    path = write_csv(tmp_path, rows)
+    with pytest.raises(DataError, match="row 5 has 1 cells but the header has 2"):
+        read(path)
+
+
+# ------------------------------------------------------------------------------- reading rules
+
+
+def test_noise_backtrack_is_dropped_and_noted(tmp_path):
+    rows = good_rows()
+    rows[1][0] = 0.0201  # file row 3 above file row 4 (0.02) by 1e-4 mm < 1 % of the range
+    path = write_csv(tmp_path, rows)
+    (curve,) = read(path)
+    assert curve.n_points == 11
+    assert 0.02 not in curve.control and 0.0201 in curve.control
+    assert np.all(np.diff(curve.control) > 0)
+    assert len(curve.notes) == 1 and "1 backtracking point dropped" in curve.notes[0] and "row 4" in curve.notes[0]
+    assert "curve.csv" in curve.notes[0]
+
+
+def test_backtrack_tolerance_is_explicit(tmp_path):
+    rows = good_rows()
+    rows[1][0] = 0.0201
+    path = write_csv(tmp_path, rows)
+    with pytest.raises(DataError, match="backwards at row 4"):
+        read(path, backtrack_tolerance=1e-5)
+
+
+def test_unit_scaling_and_several_force_columns(tmp_path):
+    rows = [[10.0 * k, 0.1 * k, 0.2 * k] for k in range(10)]  # control in um, forces in kN
+    path = write_csv(tmp_path, rows, header="cmod_um,F1_kN,F2_kN")
+    curves = read_curve_csv(
+        path, control_column="cmod_um", force_columns=["F1_kN", "F2_kN"], control_unit_scale=1e-3, force_unit_scale=1e3
+    )
+    assert len(curves) == 2
+    np.testing.assert_allclose(curves[0].control, 0.01 * np.arange(10))
+    np.testing.assert_allclose(curves[0].force, 100.0 * np.arange(10))
+    np.testing.assert_allclose(curves[1].force, 200.0 * np.arange(10))
+    assert "'F2_kN'" in curves[1].source and "curve.csv" in curves[1].source
+    assert any("multiplied by 1000 to N" in note for note in curves[1].notes)
+
+
+def test_one_file_per_repeat(tmp_path):
+    paths = [write_csv(tmp_path, good_rows(), name=f"repeat{k}.csv") for k in range(3)]
+    curves = [curve for path in paths for curve in read(path)]
+    assert all(f"repeat{k}.csv" in curve.source for k, curve in enumerate(curves))
+
+
+def test_curve_requires_increasing_control():
+    with pytest.raises(DataError, match="increase strictly"):
+        Curve(control=[0.0, 2.0, 1.0], force=[0.0, 1.0, 2.0])
+    curve = curve_from_arrays([0.0, 1.0, 0.999, 2.0, 3.0], [0.0, 1.0, 1.1, 2.0, 3.0])
+    np.testing.assert_array_equal(curve.control, [0.0, 1.0, 2.0, 3.0])
+    assert "index 2" in curve.notes[0]
+
+
+# --------------------------------------------------------------------------------- y_exp, C_exp
+
+
+def linear_curve(slope, intercept, control, source="linear"):
+    control = np.asarray(control, dtype=float)
+    return Curve(control=control, force=slope * control + intercept, source=source)
+
+
+def test_sample_points_are_equally_spaced():
+    np.testing.assert_allclose(sample_points(0.0, 1.0, 5), [0.0, 0.25, 0.5, 0.75, 1.0])
+    with pytest.raises(DataError):
+        sample_points(1.0, 0.0, 5)
+
+
+def test_interpolation_is_exact_on_a_linear_curve():
+    control = [0.0, 0.013, 0.05, 0.051, 0.12, 0.2]  # irregular
+    data = with_std(linear_curve(3000.0, 20.0, control), 5.0, 9)
+    np.testing.assert_allclose(data.control, np.linspace(0.0, 0.2, 9))
+    np.testing.assert_allclose(data.y, 3000.0 * data.control + 20.0, rtol=1e-13)
+    np.testing.assert_allclose(data.std, 5.0)
+    relative = with_std(linear_curve(3000.0, 20.0, control), 0.1, 9, relative=True)
+    # 10 % of y, floored at 1 % of the peak (6.2 N) where y is small (first point: 2 N -> 6.2 N, noted)
+    np.testing.assert_allclose(relative.std, np.maximum(0.1 * relative.y, 6.2))
+    assert any("floor" in note and "1 of 9 points" in note for note in relative.notes)
+
+
+def test_repeats_give_mean_and_sample_variance():
+    control = np.linspace(0.0, 1.0, 11)
+    curves = [linear_curve(a, b, control, f"test {k}") for k, (a, b) in enumerate([(10, 1), (20, 2), (40, 4)])]
+    data = from_repeats(curves, 3, control_range=(0.0, 1.0), std_floor=0.0)
+    # at x: forces (10x+1, 20x+2, 40x+4) = (1, 2, 4) (10x+1): mean 7/3 (10x+1), variance 7/3 (10x+1)^2
+    x = np.array([0.0, 0.5, 1.0])
+    np.testing.assert_allclose(data.y, 7.0 / 3.0 * (10 * x + 1))
+    np.testing.assert_allclose(np.diag(data.covariance), 7.0 / 3.0 * (10 * x + 1) ** 2)
+    np.testing.assert_array_equal(data.covariance, np.diag(np.diag(data.covariance)))
+    assert any("ddof = 1" in note for note in data.notes)
+    with pytest.raises(DataError, match="repeats.*envelope.*explicit std"):
+        from_repeats(curves[:1], 3)
+
+
+def test_repeats_default_to_the_common_range_and_floor_is_noted():
+    a = linear_curve(100.0, 0.0, [0.0, 1.0, 2.0], "a")
+    b = linear_curve(100.0, 0.0, [0.5, 1.0, 3.0], "b")
+    data = from_repeats([a, b], 4)
+    np.testing.assert_allclose(data.control, [0.5, 1.0, 1.5, 2.0])
+    np.testing.assert_allclose(data.std, 0.01 * 200.0)  # identical curves: s = 0 raised to 1 % of the peak
+    assert any("floor" in note and "4 of 4 points" in note for note in data.notes)
+
+
+def test_no_extrapolation():
+    a = linear_curve(100.0, 0.0, [0.0, 1.0, 2.0], "curve a")
+    with pytest.raises(DataError, match="exceeds the data of curve a.*never extrapolated"):
+        with_std(a, 1.0, 5, control_range=(0.0, 2.5))
+    with pytest.raises(DataError, match="never extrapolated"):
+        from_repeats([a, linear_curve(50.0, 0.0, [0.1, 3.0], "b")], 5, control_range=(0.0, 2.0))
+
+
+def test_envelope_rule():
+    control = np.linspace(0.0, 1.0, 5)
+    mean = linear_curve(100.0, 10.0, control, "mean")
+    lower = linear_curve(80.0, 10.0, control, "min")
+    upper = linear_curve(140.0, 10.0, control, "max")
+    data = from_envelope(mean, lower, upper, 3)
+    np.testing.assert_allclose(data.y, [10.0, 60.0, 110.0])
+    # s = (max - min)/4 = 60 x / 4 = 15 x; the zero width at x = 0 is floored to 1 % of the peak mean
+    np.testing.assert_allclose(data.std, [1.1, 7.5, 15.0])
+    assert any("s = (max - min)/4 from the min/max envelope" in note for note in data.notes)
+    assert any("floor" in note and "1 of 3 points" in note for note in data.notes)
+    with pytest.raises(DataError, match="lower envelope"):
+        from_envelope(mean, upper, lower, 3)
+
+
+def test_local_block_and_stacking():
+    control = np.linspace(0.0, 1.0, 5)
+    first = with_std(linear_curve(100.0, 1.0, control, "beam D50"), 2.0, 4)
+    second = with_std(linear_curve(50.0, 1.0, control, "beam D100"), 3.0, 3)
+    local = local_block((control, 2.0 + 10.0 * control), 0.5, points=first.control)
+    data = stack(first, second, local)
+    assert data.n_y == 4 + 3 + 4
+    assert data.blocks == (("global", 0, 4), ("global_2", 4, 7), ("local", 7, 11))
+    np.testing.assert_allclose(data.y[data.block("local")], 2.0 + 10.0 * first.control)
+    expected = np.diag(np.r_[np.full(4, 4.0), np.full(3, 9.0), np.full(4, 0.25)])
+    np.testing.assert_array_equal(data.covariance, expected)
+    assert any("renamed 'global_2'" in note for note in data.notes)
+    assert any(note.startswith("[global_2]") and "beam D100" in note for note in data.notes)
+    assert any(note.startswith("[local]") for note in data.notes)
+    assert isinstance(data, ExperimentalData)
+
+
+def test_experimental_data_is_validated():
+    with pytest.raises(DataError, match="positive definite"):
+        ExperimentalData(control=[0.0, 1.0], y=[1.0, 2.0], covariance=np.diag([1.0, 0.0]), blocks=(("a", 0, 2),))
+    with pytest.raises(DataError, match="tile"):
+        ExperimentalData(control=[0.0, 1.0], y=[1.0, 2.0], covariance=np.eye(2), blocks=(("a", 0, 1),))
+
+
+# ------------------------------------------------------------------------------ bundled real data
+
+
+def test_gregoire_raw_file():
+    path = gregoire2013_beam4_path()
+    assert path.is_file()
+    mean, lower, upper = read_curve_csv(
+        path, control_column="cmod_mm", force_columns=["load_mean_N", "load_min_N", "load_max_N"]
+    )
+    assert mean.n_points == 5708 - 1  # 5708 data rows, file row 3 backtracks by 4.4e-6 mm and is dropped
+    assert "row 3" in mean.notes[0] and "1 backtracking point dropped" in mean.notes[0]
+    cmod, peak = mean.peak()
+    assert peak == pytest.approx(978.6185) and cmod == pytest.approx(0.01934611)
+    assert mean.control_range == pytest.approx((2e-5, 0.2031462))
+    assert np.all(lower.force <= mean.force) and np.all(mean.force <= upper.force)
+
+
+def test_gregoire_bundled_data():
+    data = gregoire2013_beam4()
+    assert data.y.shape == (40,) and data.covariance.shape == (40, 40)
+    assert data.blocks == (("gregoire2013_beam4", 0, 40),)
+    assert data.control[0] == pytest.approx(2e-5) and data.control[-1] == pytest.approx(0.2031462)
+    # the sampled peak: 40 points 0.0052 mm apart miss the raw peak (978.6 N at 0.0193 mm) slightly
+    i = int(np.argmax(data.y))
+    assert abs(data.control[i] - 0.0193) < 0.0052 and data.y[i] == pytest.approx(979.0, rel=0.03)
+    assert any("s = (max - min)/4 from the min/max envelope" in note for note in data.notes)
+    assert any("1 backtracking point dropped" in note and "row 3" in note for note in data.notes)
+    assert np.all(data.std > 0)
