@@ -175,7 +175,7 @@ def knn_from_population(space, points, Y, status, errors, y_exp, C_exp, k) -> Kn
 
 
 def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sobol", seed=0, k=5,
-               executor=None, store=None, progress=None) -> KnnResult:
+               executor=None, store=None, progress=None, stats=None) -> KnnResult:
     """Run the forward operator on a population and rank it against the data.
 
     Parameters
@@ -190,24 +190,22 @@ def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="s
         Runs the population in parallel (see :mod:`fracid.parallel`).
     store : RunStore, optional
         Stored runs are reused, new ones stored as they finish (an interrupted population resumes).
+    stats : fracid.parallel.BatchStats, optional
+        Filled with the numbers of runs computed, reused and failed.
     """
     if tuple(operator.names) != tuple(space.names):
         raise ValueError(f"operator parameters {operator.names} differ from the space's {space.names}")
     points = design(space, n, method, seed)
     if not 1 <= k <= len(points):
         raise ValueError(f"k = {k} must be between 1 and the population size {len(points)}")
-    records = evaluate_population(operator, points, executor=executor, store=store, progress=progress)
+    records = evaluate_population(operator, points, executor=executor, store=store, progress=progress, stats=stats)
     Y = np.array([r.y for r in records])
     return knn_from_population(space, points, Y, [r.status for r in records], [r.error for r in records],
                                y_exp, C_exp, k)
 
 
-def evaluate_population(operator, points, *, executor=None, store=None, progress=None):
-    """Forward runs of every point (through the run store and executor when given)."""
-    from fracid.inverse.sensitivity import evaluate_points
-
-    if store is None:
-        return evaluate_points(operator, points, None, executor)
+def evaluate_population(operator, points, *, executor=None, store=None, progress=None, stats=None):
+    """Forward runs of every point, through the executor and the run store when given."""
     from fracid.inverse.runs import run_population
 
-    return run_population(operator, points, executor=executor, store=store, progress=progress)
+    return run_population(operator, points, executor=executor, store=store, progress=progress, stats=stats)

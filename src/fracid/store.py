@@ -1,0 +1,405 @@
+"""A persistent store of forward runs: SQLite in WAL mode, one row per run, records as JSON with arrays.
+
+A run is identified by a key, the SHA-256 of a canonical JSON of everything that determines it
+(:func:`key_for`). Its record is a JSON-like dict that may hold numpy arrays, stored losslessly
+(:func:`encode_record`, :func:`decode_record`).
+
+Concurrency: any number of processes may read a store, but only one process should write it. In a
+batch (:func:`fracid.parallel.run_batch`) the workers compute and return records; the parent process
+alone writes them. A :class:`RunStore` cannot be sent to another process.
+
+Durability: every :meth:`RunStore.put` is its own transaction. SQLite in WAL mode guarantees that a
+process killed at any moment (SIGKILL included) loses no committed run and leaves no partial one.
+With ``synchronous=NORMAL`` an operating-system crash or power loss may roll back the last commits,
+but never corrupts the file.
+"""
+
+from __future__ import annotations
+
+import base64
+import dataclasses
+import hashlib
+import json
+import math
+import numbers
+import os
+import sqlite3
+import time
+from collections.abc import Iterable, Mapping
+from typing import Self
+
+import numpy as np
+
+__all__ = ["RunStore", "decode_record", "encode_record", "key_for"]
+
+_ARRAY_TAG = "__ndarray__"
+_SIGNIFICANT_DIGITS = 12
+_EXACT_INT_LIMIT = 10**_SIGNIFICANT_DIGITS
+_SQL_VARIABLES_PER_QUERY = 500
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS runs (
+    key TEXT PRIMARY KEY,
+    study TEXT,
+    created REAL,
+    status TEXT,
+    seconds REAL,
+    record BLOB
+)
+"""
+
+
+# ----------------------------------------------------------------------------------------------
+# keys
+
+
+def key_for(**parts) -> str:
+    """Key of a run: the SHA-256 (hex) of a canonical JSON of ``parts``.
+
+    Parameters
+    ----------
+    **parts
+        Everything that determines the run, e.g. ``model="gradient"``, ``specimen=bar``,
+        ``params=x``, ``control="cmod"``. Accepted values: None, bool, str, numbers, numpy scalars
+        and arrays, lists, tuples, sets, dicts with str keys and dataclass instances (as their type
+        name and the fields that take part in comparison), nested freely.
+
+    Returns
+    -------
+    str
+        64 hexadecimal characters, the same in every process and session.
+
+    Notes
+    -----
+    The key ignores dict order, and floats are rounded to 12 significant digits, so that parameter
+    vectors that differ by round-off share a key. Integers below 1e12 count as floats (``200`` and
+    ``200.0`` give the same key), tuples as lists.
+
+    Raises
+    ------
+    TypeError
+        If a value cannot be put in canonical form; the message names where it is.
+    """
+    canonical = {name: _canonical(value, name) for name, value in parts.items()}
+    text = json.dumps(canonical, sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=True)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
+def _canonical(value, where: str):
+    """``value`` as plain JSON types, floats rounded, dataclasses tagged with their type."""
+    if value is None or isinstance(value, (bool, np.bool_, str)):
+        return value.item() if isinstance(value, np.bool_) else value
+    if isinstance(value, numbers.Integral):
+        value = int(value)
+        return float(value) if abs(value) < _EXACT_INT_LIMIT else value
+    if isinstance(value, numbers.Real):
+        return _round(float(value))
+    if isinstance(value, np.ndarray):
+        return _canonical(value.tolist(), where)
+    if isinstance(value, Mapping):
+        return {_str_key(k, where): _canonical(v, f"{where}[{k!r}]") for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_canonical(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, (set, frozenset)):
+        items = [_canonical(v, f"{where}{{...}}") for v in value]
+        return sorted(items, key=lambda item: json.dumps(item, sort_keys=True))
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return _canonical_dataclass(value, where)
+    raise TypeError(
+        f"key_for: cannot put {where} = {value!r} (type {type(value).__name__}) in canonical form; "
+        "pass numbers, strings, lists, arrays, dicts with str keys or dataclasses"
+    )
+
+
+def _canonical_dataclass(value, where: str) -> dict:
+    """A dataclass as {"__type__": module.qualname, field: value, ...} (compared fields only)."""
+    kind = type(value)
+    out = {"__type__": f"{kind.__module__}.{kind.__qualname__}"}
+    for f in dataclasses.fields(value):
+        if f.compare:
+            out[f.name] = _canonical(getattr(value, f.name), f"{where}.{f.name}")
+    return out
+
+
+def _round(x: float) -> float:
+    """``x`` rounded to 12 significant digits; -0.0 becomes 0.0; nan and inf stay."""
+    if not math.isfinite(x):
+        return x
+    return float(f"{x:.{_SIGNIFICANT_DIGITS}g}") + 0.0
+
+
+def _str_key(key, where: str) -> str:
+    if not isinstance(key, str):
+        raise TypeError(f"{where}: dict keys must be str, got {key!r} ({type(key).__name__})")
+    return key
+
+
+# ----------------------------------------------------------------------------------------------
+# records
+
+
+def encode_record(record: Mapping) -> bytes:
+    """Serialise a record (a dict of JSON types and numpy arrays) to UTF-8 JSON bytes.
+
+    Arrays are stored bit for bit as ``{"__ndarray__": base64 of the C-order bytes, "dtype": ...,
+    "shape": [...]}``; any dtype but ``object`` is allowed. Numpy scalars become Python numbers,
+    tuples become lists. NaN and infinities are kept.
+
+    Raises
+    ------
+    TypeError
+        If ``record`` is not a dict or holds a value that is not storable (the message names it).
+    ValueError
+        If a dict uses the reserved key ``"__ndarray__"``.
+    """
+    if not isinstance(record, Mapping):
+        raise TypeError(f"a record must be a dict, got {type(record).__name__}")
+    plain = _to_json(record, "record")
+    return json.dumps(plain, separators=(",", ":"), allow_nan=True).encode("utf-8")
+
+
+def decode_record(blob: bytes | bytearray | memoryview | str) -> dict:
+    """Inverse of :func:`encode_record`: arrays come back with their dtype, shape and bytes."""
+    if isinstance(blob, (bytearray, memoryview)):
+        blob = bytes(blob)
+    return json.loads(blob, object_hook=_from_json)
+
+
+def _to_json(value, where: str):
+    """``value`` as JSON types, arrays as tagged dicts; errors name the offending entry."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, np.generic) and not isinstance(value, np.void):
+        value = value.item()
+        if isinstance(value, (bool, int, float, str)):
+            return value
+    if isinstance(value, (int, float)):
+        return value
+    if isinstance(value, np.ndarray):
+        return _encode_array(value, where)
+    if isinstance(value, Mapping):
+        return _encode_mapping(value, where)
+    if isinstance(value, (list, tuple)):
+        return [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    raise TypeError(
+        f"{where} = {value!r} (type {type(value).__name__}) cannot be stored; "
+        "records hold None, bool, int, float, str, lists, dicts with str keys and numpy arrays"
+    )
+
+
+def _encode_mapping(value: Mapping, where: str) -> dict:
+    if _ARRAY_TAG in value:
+        raise ValueError(f"{where}: the key {_ARRAY_TAG!r} is reserved for arrays")
+    return {_str_key(k, where): _to_json(v, f"{where}[{k!r}]") for k, v in value.items()}
+
+
+def _encode_array(array: np.ndarray, where: str) -> dict:
+    if array.dtype.hasobject:
+        raise TypeError(f"{where}: arrays of dtype {array.dtype} cannot be stored (convert to lists)")
+    data = np.ascontiguousarray(array).tobytes()
+    return {
+        _ARRAY_TAG: base64.b64encode(data).decode("ascii"),
+        "dtype": np.lib.format.dtype_to_descr(array.dtype),
+        "shape": list(array.shape),
+    }
+
+
+def _from_json(obj: dict):
+    if _ARRAY_TAG not in obj:
+        return obj
+    descr = obj["dtype"]
+    dtype = np.lib.format.descr_to_dtype(_as_descr(descr))
+    raw = base64.b64decode(obj[_ARRAY_TAG])
+    return np.frombuffer(raw, dtype=dtype).reshape(obj["shape"]).copy()
+
+
+def _as_descr(descr):
+    """JSON turned the tuples of a structured dtype's descr into lists; turn them back."""
+    if not isinstance(descr, list):
+        return descr
+    fields = []
+    for name, kind, *shape in descr:
+        name = tuple(name) if isinstance(name, list) else name  # (title, name)
+        fields.append((name, _as_descr(kind), *(tuple(s) for s in shape)))
+    return fields
+
+
+# ----------------------------------------------------------------------------------------------
+# the store
+
+
+class RunStore:
+    """Persistent store of runs, one SQLite file (WAL mode).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The database file; created (with its table) if missing. Its directory must exist.
+    readonly : bool
+        Open for reading only (the file must exist); for processes that only look up runs.
+    timeout : float
+        Seconds to wait for a lock held by another connection.
+
+    Notes
+    -----
+    Table ``runs(key TEXT PRIMARY KEY, study TEXT, created REAL, status TEXT, seconds REAL,
+    record BLOB)``, ``record`` being :func:`encode_record` bytes. Many processes may read, one
+    writes: in a batch the workers compute and the parent stores. Do not share an open store
+    across ``fork``; open one per process. Use it from the thread that opened it.
+
+    Examples
+    --------
+    >>> with RunStore("runs.sqlite") as store:                                # doctest: +SKIP
+    ...     key = key_for(model="gradient", specimen=bar, params=x)
+    ...     if key not in store:
+    ...         store.put(key, {"force": force}, status="ok", seconds=1.2, study="calibration")
+    ...     record = store.get(key)
+    """
+
+    def __init__(self, path, *, readonly: bool = False, timeout: float = 30.0):
+        self.path = os.fspath(path)
+        self.readonly = readonly
+        self._conn = _connect(self.path, readonly, timeout)
+        self.journal_mode = self._conn.execute("PRAGMA journal_mode").fetchone()[0]
+
+    # -- writing ------------------------------------------------------------------------------
+
+    def put(self, key: str, record, *, status: str, seconds: float, study: str = "") -> None:
+        """Store (or replace) the run ``key`` in one transaction.
+
+        Parameters
+        ----------
+        key : str
+            Usually from :func:`key_for`.
+        record : dict or bytes
+            The record, or its :func:`encode_record` bytes (e.g. encoded by a worker).
+        status : str
+            E.g. ``"ok"`` or ``"failed"``.
+        seconds : float
+            Time the run took [s].
+        study : str
+            A label to group runs (see :meth:`keys`).
+        """
+        _check_key(key)
+        blob = record if isinstance(record, bytes) else encode_record(record)
+        conn = self._writer()
+        conn.execute(
+            "INSERT OR REPLACE INTO runs (key, study, created, status, seconds, record) VALUES (?, ?, ?, ?, ?, ?)",
+            (key, str(study), time.time(), str(status), float(seconds), sqlite3.Binary(blob)),
+        )
+
+    # -- reading ------------------------------------------------------------------------------
+
+    def get(self, key: str) -> dict | None:
+        """The record of ``key``, or None if it is not stored."""
+        row = self._reader().execute("SELECT record FROM runs WHERE key = ?", (key,)).fetchone()
+        return None if row is None else decode_record(row[0])
+
+    def get_many(self, keys: Iterable[str]) -> dict:
+        """``{key: record}`` for those of ``keys`` that are stored."""
+        return {key: decode_record(blob) for key, blob in self._select("key, record", keys)}
+
+    def info(self, key: str) -> dict | None:
+        """``{"study", "created", "status", "seconds"}`` of the run ``key``, or None."""
+        sql = "SELECT study, created, status, seconds FROM runs WHERE key = ?"
+        row = self._reader().execute(sql, (key,)).fetchone()
+        return None if row is None else dict(zip(("study", "created", "status", "seconds"), row))
+
+    def statuses(self, keys: Iterable[str]) -> dict:
+        """``{key: status}`` for those of ``keys`` that are stored (records are not decoded)."""
+        return dict(self._select("key, status", keys))
+
+    def keys(self, study: str | None = None) -> list[str]:
+        """Stored keys in the order they were written, all or those of one ``study``."""
+        sql = "SELECT key FROM runs"
+        args: tuple = ()
+        if study is not None:
+            sql, args = sql + " WHERE study = ?", (study,)
+        return [row[0] for row in self._reader().execute(sql + " ORDER BY created, key", args)]
+
+    def __contains__(self, key) -> bool:
+        return self._reader().execute("SELECT 1 FROM runs WHERE key = ?", (key,)).fetchone() is not None
+
+    def __len__(self) -> int:
+        return self._reader().execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+
+    # -- life cycle ---------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Close the connection (idempotent)."""
+        if self._conn is not None:
+            self._conn.close()
+            self._conn = None
+
+    @property
+    def closed(self) -> bool:
+        return self._conn is None
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        state = "closed" if self.closed else ("read-only" if self.readonly else "open")
+        return f"RunStore({self.path!r}, {state})"
+
+    def __getstate__(self):
+        raise TypeError(
+            f"{self!r} cannot be sent to another process: workers compute and return records, "
+            "the parent process stores them"
+        )
+
+    # -- helpers ------------------------------------------------------------------------------
+
+    def _reader(self) -> sqlite3.Connection:
+        if self._conn is None:
+            raise RuntimeError(f"RunStore({self.path!r}) is closed")
+        return self._conn
+
+    def _writer(self) -> sqlite3.Connection:
+        if self.readonly:
+            raise PermissionError(f"RunStore({self.path!r}) was opened read-only")
+        return self._reader()
+
+    def _select(self, columns: str, keys: Iterable[str]):
+        """Rows of ``columns`` for ``keys``, in chunks that respect SQLite's variable limit."""
+        keys = list(dict.fromkeys(keys))
+        conn = self._reader()
+        for start in range(0, len(keys), _SQL_VARIABLES_PER_QUERY):
+            chunk = keys[start : start + _SQL_VARIABLES_PER_QUERY]
+            marks = ",".join("?" * len(chunk))
+            yield from conn.execute(f"SELECT {columns} FROM runs WHERE key IN ({marks})", chunk)
+
+
+def _connect(path: str, readonly: bool, timeout: float) -> sqlite3.Connection:
+    """Open ``path``: autocommit (each statement its own transaction), WAL, synchronous=NORMAL."""
+    if readonly and not os.path.exists(path):
+        raise FileNotFoundError(f"RunStore: no store at {path!r} to open read-only")
+    directory = os.path.dirname(os.path.abspath(path))
+    if not readonly and not os.path.isdir(directory):
+        raise FileNotFoundError(f"RunStore: the directory {directory!r} of {path!r} does not exist")
+    target = f"file:{_uri_path(path)}?mode=ro" if readonly else path
+    conn = sqlite3.connect(target, timeout=timeout, isolation_level=None, uri=readonly)
+    try:
+        if not readonly:
+            conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute(_SCHEMA)
+        conn.execute("PRAGMA synchronous=NORMAL")
+        conn.execute("SELECT 1 FROM runs LIMIT 1").fetchone()
+    except sqlite3.DatabaseError as exc:
+        conn.close()
+        raise sqlite3.DatabaseError(f"RunStore: cannot open {path!r} as a run store: {exc}") from exc
+    return conn
+
+
+def _uri_path(path: str) -> str:
+    from urllib.parse import quote
+
+    return quote(os.path.abspath(path))
+
+
+def _check_key(key) -> None:
+    if not isinstance(key, str) or not key:
+        raise TypeError(f"a run key must be a non-empty str (see key_for), got {key!r}")
