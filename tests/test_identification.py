@@ -116,3 +116,41 @@ def test_twin_noise_free_dogbone():
     space = ParameterSpace(("c", "beta"), [6.0, 150.0], [30.0, 600.0])
     res = identify(op, y, np.eye(y.size) * std**2, space, n=16, k=4, groups=[range(0, 6), range(6, 12)])
     np.testing.assert_allclose(res.x, truth, rtol=0.01)
+
+
+def test_twin_noisy_dogbone_truth_within_two_sigma():
+    from fracid.specimens.dogbone import DogBone
+
+    specimen = DogBone(size=50.0, h_fine=2.5)
+    params = fracid.DamageParameters(E=30000.0, kappa_i=1e-4, alpha=0.99, beta=300.0, c=16.0)
+    op = ForwardOperator([Observation(specimen, np.linspace(0.004, 0.05, 12))], params, ("c", "beta"))
+    truth = np.array([16.0, 300.0])
+    y = op(truth).y
+    std = 0.02 * np.abs(y).max()
+    noisy = y + np.random.default_rng(11).normal(scale=std, size=y.size)
+    space = ParameterSpace(("c", "beta"), [6.0, 150.0], [30.0, 600.0])
+    res = identify(op, noisy, np.eye(y.size) * std**2, space, n=16, k=4, groups=[range(0, 6), range(6, 12)])
+    assert np.all(np.abs(res.x - truth) <= 2 * res.std), (res.x, res.std)
+
+
+def test_global_and_local_blocks_from_experimental_data(bar_operator):
+    """Force curve plus the damaged-zone width (local data) as a second block, through fracid.data."""
+    from fracid.data import ExperimentalData, stack
+    from fracid.inverse.strategy import identify_data
+
+    op = ForwardOperator([Observation(BAR, POINTS, name="global"),
+                          Observation(BAR, POINTS[4:], quantity="damaged_zone_width", name="local")],
+                         fracid.DamageParameters(), ("c", "beta"))
+    y = op(TRUTH).y
+    force, width = y[:16], y[16:]
+    blocks = [ExperimentalData(POINTS, force, np.eye(16) * (1e-3 * force.max()) ** 2, (("global", 0, 16),), ("force",)),
+              ExperimentalData(POINTS[4:], width, np.eye(12) * (1e-3 * width.max()) ** 2, (("local", 0, 12),), ("width",))]
+    data = stack(*blocks)
+    res = identify_data(op, data, SPACE, n=32, k=4, groups=[range(0, 8), range(8, 16), range(16, 28)])
+    np.testing.assert_allclose(res.x, TRUTH, rtol=0.01)
+    assert [b[0] for b in res.blocks] == ["global", "local"]
+    # the width of the damaged zone fixes the internal length: the c-beta correlation drops
+    global_only = identify(bar_operator, force, blocks[0].covariance, SPACE, n=32, k=4, groups=GROUPS)
+    assert abs(res.correlation[0, 1]) < abs(global_only.correlation[0, 1])
+    with pytest.raises(ValueError, match="data hold"):
+        identify_data(bar_operator, data, SPACE)

@@ -126,3 +126,18 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
                              f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std"],
         converged=kalman.converged,
     )
+
+
+def identify_data(operator, data, space: ParameterSpace, **settings) -> IdentificationResult:
+    """:func:`identify` with measured data from :mod:`fracid.data` (its blocks and notes are kept).
+
+    ``data`` is an :class:`~fracid.data.ExperimentalData`; its blocks must line up with the
+    operator's observations (same number of values, in order).
+    """
+    if data.y.size != operator.n_outputs:
+        raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
+    for block, part in zip(data.blocks, operator.slices()):
+        name, start, stop = block
+        if (start, stop) != (part.start, part.stop):
+            raise ValueError(f"data block {name!r} spans [{start}, {stop}) but its observation spans [{part.start}, {part.stop})")
+    return identify(operator, data.y, data.covariance, space, blocks=list(data.blocks), notes=list(data.notes), **settings)
