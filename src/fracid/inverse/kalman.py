@@ -219,26 +219,9 @@ def batch_kalman(
     """Batch variant: all observations at once, iterated (iterated extended Kalman filter).
 
     x_{k+1} = x0 + K_k (y_exp - h(x_k) - S_k (x0 - x_k)),  K_k = C0 S_k^T (S_k C0 S_k^T + C_exp)^-1,
-    which is Gauss-Newton on the Bayesian objective; the covariance is the Joseph form at the end.
+    which is Gauss-Newton on the Bayesian objective: the step-by-step filter with a single group of
+    all observations and re-linearised global iterations.
     """
-    y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
-    result = KalmanResult(x=x0.copy(), C=C0.copy())
-    x = x0.copy()
-    for iteration in range(1, max_iterations + 1):
-        y, S, records = sensitivity(evaluate, x, None, executor)
-        result.runs += len(records)
-        result.run_equivalents += len(records)
-        innovation = y_exp - y - S @ (x0 - x)
-        x_new, C, _ = kalman_update(x0, C0, S, innovation, C_exp)
-        x_new = _clip(x_new, bounds)
-        result.history.append({"iteration": iteration, "step": 1, "observations": list(range(y_exp.size)),
-                               "x": x_new.copy(), "C": C.copy()})
-        result.iterations = iteration
-        done = _converged(x_new, x, C, tol)
-        x, result.x, result.C = x_new, x_new, C
-        if done:
-            result.converged = True
-            break
-    record = evaluate_points(evaluate, [result.x], None, executor)[0]
-    result.y, result.runs, result.run_equivalents = record.y, result.runs + 1, result.run_equivalents + 1
-    return result
+    n = np.asarray(y_exp).size
+    return kalman_filter(evaluate, y_exp, C_exp, x0, C0, groups=[np.arange(n)], max_iterations=max_iterations,
+                         tol=tol, restart="linearize", sensitivity=sensitivity, executor=executor, bounds=bounds)
