@@ -89,7 +89,7 @@ class IdentificationResult:
 
 
 def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sobol", seed=0, k=5,
-             groups=None, max_iterations=10, tol=0.01, executor=None, store=None, blocks=(), notes=(),
+             groups=None, max_iterations=10, tol=0.01, restart="linearize", executor=None, store=None, blocks=(), notes=(),
              progress=None) -> IdentificationResult:
     """KNN over a population for a global overview and the prior, then the Kalman filter to refine.
 
@@ -102,7 +102,7 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
         Bounds of the population (the filter may leave them, within the parameters' valid ranges).
     n, method, seed, k
         KNN population and neighbours (:func:`~fracid.inverse.knn.knn_search`).
-    groups, max_iterations, tol
+    groups, max_iterations, tol, restart
         Kalman filter settings (:func:`~fracid.inverse.kalman.kalman_filter`).
     executor, store
         Parallel execution and the persistent run store.
@@ -113,7 +113,7 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
                      store=store, progress=progress)
     bounds = DamageParameters.valid_bounds(space.names)
     kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, knn.C0, groups=groups, max_iterations=max_iterations,
-                           tol=tol, executor=executor, bounds=bounds)
+                           tol=tol, restart=restart, executor=executor, bounds=bounds)
     knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
                    "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}
     runs = {"knn": len(knn.points), "knn_failed": knn.n_failed, "kalman": kalman.runs,

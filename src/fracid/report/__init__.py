@@ -1,5 +1,7 @@
-"""Output of analysis results (VTK files for ParaView; optional dependencies imported when used)."""
+"""Output of analysis results (VTK files for ParaView, the HTML report of an identification;
+optional dependencies imported when used)."""
 
+from fracid.report.html import fit_metrics, write_report
 from fracid.report.vtk import bar_mesh, write_result_vtk, write_vtk
 
-__all__ = ["bar_mesh", "write_result_vtk", "write_vtk"]
+__all__ = ["bar_mesh", "fit_metrics", "write_report", "write_result_vtk", "write_vtk"]

@@ -1,0 +1,919 @@
+"""TOML configuration of a study, validated when it is loaded.
+
+:func:`load_config` reads a TOML file (stdlib ``tomllib``) and checks every key before anything
+runs: unknown keys are rejected at every level, every value is type- and range-checked, data files
+and their columns must exist, and the specimen and the model parameters are built once to run
+their own validation. Every problem raises :class:`ConfigError` (a ``ValueError``) with a
+one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
+``experiments[0].control_unit``), the value given and what is allowed. Relative file paths are
+resolved against the directory of the configuration file.
+
+The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
+:func:`build_operator`, :func:`build_space`, :func:`identify_settings`, :func:`simulate_settings`)
+are pure functions of the validated :class:`Config`.
+
+Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
+
+Schema
+------
+The sections ``[[experiments]]`` and ``[identify]`` are required for identification
+(``purpose="identify"``) and optional for a forward analysis (``purpose="simulate"``); when
+present they are always validated. Every other key is optional unless marked *required*.
+
+.. code-block:: toml
+
+    [model]                             # optional; defaults: gradient damage, DamageParameters()
+    type = "gradient-damage"            # "gradient-damage" | "local-damage" (mesh-dependent)
+    [model.parameters]                  # any subset of E nu kappa_i alpha beta c eta; the rest take
+                                        # the defaults of DamageParameters (E 20000, nu 0.2,
+                                        # kappa_i 1e-4, alpha 0.99, beta 300, c 1, eta 10)
+    E = 37000.0                         # MPa, E > 0
+    nu = 0.2                            # -, -1 < nu < 0.5
+    kappa_i = 6.6e-5                    # -, kappa_i > 0
+    alpha = 0.99                        # -, 0 <= alpha <= 1
+    beta = 600.0                        # -, beta >= 0
+    c = 9.0                             # mm^2, c > 0
+    eta = 10.0                          # -, eta >= 1
+
+    [specimen]                          # required
+    type = "notched-beam"               # required: "notched-beam" | "dogbone" | "bar"
+    control = "cmod"                    # the specimen's default if omitted:
+                                        #   notched-beam: "cmod" (default) | "deflection"
+                                        #   dogbone:      "elongation" (default) | "platen_displacement"
+                                        #   bar:          "end_displacement" (default) | "weak_zone_elongation"
+    # every other key is a field of the specimen class, type-checked (lengths in mm):
+    #   notched-beam (NotchedBeam): depth thickness length span notch_depth notch_width plate_width
+    #                               h_fine h_coarse fine_width
+    #   dogbone (DogBone):          size thickness gauge_length h_fine fine_height h_coarse
+    #                               notch_radius notch_width platens ("glued" | "hinged")
+    #                               platen_height platen_stiffness hinge_offset
+    #   bar (BarWithWeakZone):      length area (mm^2) weak_zone_width weak_zone_factor
+    #                               weakening ("modulus" | "area") profile ("step" | "hat")
+    #                               n_elements (integer)
+    h_fine = 1.0
+
+    [[experiments]]                     # one or more data blocks, stacked in this order into y_exp
+    file = "load_cmod.csv"              # required: CSV with a header row, relative to this file
+    control_column = "cmod_mm"          # required: column of the control quantity
+    control_unit = "mm"                 # required: "mm" | "um" | "m" (scaled to mm)
+    force_unit = "N"                    # required: quantity "force": "N" | "kN" | "MN" (scaled to N);
+                                        #   a local quantity: its unit, "mm" | "um" | "m" (scaled to mm)
+    kind = "envelope"                   # required: "repeats" | "envelope" | "single"
+    #   repeats:  force_columns = ["F1", "F2", ...]   (>= 2 columns: mean and sample std of the repeats)
+    #   envelope: mean_column, lower_column, upper_column   (std = (upper - lower) / 4)
+    #   single:   force_columns = ["F"]  (exactly 1) and either std (absolute, in force_unit, > 0)
+    #             or relative_std (fraction of |y|, > 0)
+    mean_column = "load_mean_N"
+    lower_column = "load_min_N"
+    upper_column = "load_max_N"
+    n_points = 40                       # required: integer >= 3, equally spaced control values
+    control_range = [0.001, 0.2]        # optional [start, stop], 0 < start < stop, in control_unit;
+                                        #   default: the range common to the columns
+    quantity = "force"                  # "force" (default) or a local observable of the specimen:
+                                        #   notched-beam, dogbone: "fpz_width"; bar: "damaged_zone_width"
+    name = "global"                     # block name; default "global" (force) or the quantity's name
+
+    [identify]                          # required for identification
+    parameters = ["kappa_i", "beta", "c"]   # required: model parameters to identify, no duplicates
+    [identify.bounds]                   # required: [lower, upper] for every identified parameter,
+                                        #   lower < upper, both inside the parameter's valid range
+    kappa_i = [4e-5, 1.2e-4]
+    beta = [100.0, 2000.0]
+    c = [1.0, 30.0]                     # mm^2
+    log = ["beta"]                      # optional: sampled uniformly in log(x); needs lower > 0
+    [identify.knn]                      # optional
+    n = 64                              # integer >= 2 (grid: points per parameter), default 64
+    method = "sobol"                    # "sobol" (default) | "lhs" | "grid"
+    k = 5                               # neighbours, 1 <= k <= population (n, or n**p for grid), default 5
+    seed = 0                            # integer >= 0, default 0
+    [identify.kalman]                   # optional
+    groups = 4                          # consecutive observation groups, 1 <= groups <= n_y (total
+                                        #   n_points); omitted: one observation per step
+    max_iterations = 10                 # integer >= 1, default 10
+    tol = 0.01                          # > 0, in standard deviations, default 0.01
+    restart = "linearize"               # "linearize" (default) | "prior-mean"
+
+    [output]                            # optional
+    directory = "results"               # default "results", relative to this file unless absolute
+    vtk_steps = []                      # integers >= 0: steps whose fields go to VTK (simulate)
+
+    [simulate]                          # optional: settings of a forward analysis
+    target = 0.3                        # mm, > 0; default: the specimen's
+    stop_force_fraction = 0.1           # 0 < f < 1, default 0.1: stop below f x peak force
+    damage_threshold = 0.0              # 0 <= t < 1, default 0: damage counted in widths
+
+Example
+-------
+>>> from fracid.config import load_config, build_data, build_operator, build_space, identify_settings
+>>> from fracid.inverse.strategy import identify_data
+>>> cfg = load_config("study.toml")                                   # doctest: +SKIP
+>>> data = build_data(cfg)                                            # doctest: +SKIP
+>>> result = identify_data(build_operator(cfg, data), data, build_space(cfg),
+...                        **identify_settings(cfg))                  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import inspect
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fracid.model.parameters import DamageParameters, _range_text
+
+__all__ = [
+    "Config",
+    "ConfigError",
+    "ExperimentConfig",
+    "IdentifyConfig",
+    "KalmanConfig",
+    "KnnConfig",
+    "ModelConfig",
+    "OutputConfig",
+    "SimulateConfig",
+    "SpecimenConfig",
+    "build_data",
+    "build_operator",
+    "build_parameters",
+    "build_space",
+    "build_specimen",
+    "identify_settings",
+    "load_config",
+    "simulate_settings",
+]
+
+
+class ConfigError(ValueError):
+    """An invalid configuration: the message names the file, the dotted key, the value and what is allowed."""
+
+
+# ------------------------------------------------------------------------------------ vocabularies
+
+_MODEL_TYPES = {"gradient-damage": "gradient", "local-damage": "local"}
+_CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
+_FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
+_LOCAL_UNITS = dict(_CONTROL_UNITS)
+_KINDS = ("repeats", "envelope", "single")
+_METHODS = ("sobol", "lhs", "grid")
+_RESTARTS = ("linearize", "prior-mean")
+_PURPOSES = ("identify", "simulate")
+
+
+def _specimen_class(kind: str):
+    if kind == "notched-beam":
+        from fracid.specimens.beam import NotchedBeam
+
+        return NotchedBeam
+    if kind == "dogbone":
+        from fracid.specimens.dogbone import DogBone
+
+        return DogBone
+    from fracid.specimens.bar import BarWithWeakZone
+
+    return BarWithWeakZone
+
+
+#: specimen type -> (controls, the first being the default; local observables [mm])
+_SPECIMENS = {
+    "notched-beam": (("cmod", "deflection"), ("fpz_width",)),
+    "dogbone": (("elongation", "platen_displacement"), ("fpz_width",)),
+    "bar": (("end_displacement", "weak_zone_elongation"), ("damaged_zone_width",)),
+}
+
+_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate")
+_MODEL_KEYS = ("type", "parameters")
+_EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
+                    "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
+                    "name")
+_KIND_KEYS = {
+    "repeats": ("force_columns",),
+    "envelope": ("mean_column", "lower_column", "upper_column"),
+    "single": ("force_columns", "std", "relative_std"),
+}
+_IDENTIFY_KEYS = ("parameters", "bounds", "knn", "kalman")
+_KNN_KEYS = ("n", "method", "k", "seed")
+_KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
+_OUTPUT_KEYS = ("directory", "vtk_steps")
+_SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
+
+
+# ------------------------------------------------------------------------------ validated config
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """``[model]``: the model type and the parameter values given (the rest are defaults)."""
+
+    type: str = "gradient-damage"
+    parameters: tuple = ()  # ((name, value), ...) as given
+
+    @property
+    def regularization(self) -> str:
+        """``"gradient"`` or ``"local"`` (the ``regularization`` argument of the forward model)."""
+        return _MODEL_TYPES[self.type]
+
+
+@dataclass(frozen=True)
+class SpecimenConfig:
+    """``[specimen]``: type, control (resolved to the default when omitted) and the dataclass fields given."""
+
+    type: str
+    control: str
+    options: tuple = ()  # ((field, value), ...) as given, type-checked
+
+
+@dataclass(frozen=True)
+class ExperimentConfig:
+    """One ``[[experiments]]`` block (``index`` is its position, ``file`` an absolute path)."""
+
+    index: int
+    file: Path
+    control_column: str
+    control_unit: str
+    force_unit: str
+    kind: str
+    n_points: int
+    force_columns: tuple = ()
+    mean_column: str | None = None
+    lower_column: str | None = None
+    upper_column: str | None = None
+    std: float | None = None
+    relative_std: float | None = None
+    control_range: tuple | None = None  # in control_unit, as given
+    quantity: str = "force"
+    name: str = "global"
+
+    @property
+    def control_scale(self) -> float:
+        """Multiplier from ``control_unit`` to mm."""
+        return _CONTROL_UNITS[self.control_unit]
+
+    @property
+    def force_scale(self) -> float:
+        """Multiplier from ``force_unit`` to N (force) or to mm (local quantity)."""
+        return (_FORCE_UNITS if self.quantity == "force" else _LOCAL_UNITS)[self.force_unit]
+
+    @property
+    def control_range_mm(self) -> tuple | None:
+        """``control_range`` in mm."""
+        if self.control_range is None:
+            return None
+        return tuple(v * self.control_scale for v in self.control_range)
+
+
+@dataclass(frozen=True)
+class KnnConfig:
+    """``[identify.knn]``."""
+
+    n: int = 64
+    method: str = "sobol"
+    k: int = 5
+    seed: int = 0
+
+    def population(self, p: int) -> int:
+        """Number of forward runs for p parameters."""
+        return self.n**p if self.method == "grid" else self.n
+
+
+@dataclass(frozen=True)
+class KalmanConfig:
+    """``[identify.kalman]``; ``groups`` None = one observation per step."""
+
+    groups: int | None = None
+    max_iterations: int = 10
+    tol: float = 0.01
+    restart: str = "linearize"
+
+
+@dataclass(frozen=True)
+class IdentifyConfig:
+    """``[identify]``: identified parameters, their bounds and log flags, KNN and Kalman settings."""
+
+    parameters: tuple
+    lower: tuple
+    upper: tuple
+    log: tuple = ()  # names sampled in log scale
+    knn: KnnConfig = KnnConfig()
+    kalman: KalmanConfig = KalmanConfig()
+
+
+@dataclass(frozen=True)
+class OutputConfig:
+    """``[output]``: ``directory`` absolute (resolved against the config file)."""
+
+    directory: Path
+    vtk_steps: tuple = ()
+
+
+@dataclass(frozen=True)
+class SimulateConfig:
+    """``[simulate]``: target [mm] (None: the specimen's), stop_force_fraction, damage_threshold."""
+
+    target: float | None = None
+    stop_force_fraction: float = 0.1
+    damage_threshold: float = 0.0
+
+
+@dataclass(frozen=True)
+class Config:
+    """A validated configuration (see the module docstring for the schema)."""
+
+    path: Path
+    purpose: str
+    model: ModelConfig
+    specimen: SpecimenConfig
+    experiments: tuple  # of ExperimentConfig; empty if none given
+    identify: IdentifyConfig | None
+    output: OutputConfig
+    simulate: SimulateConfig
+
+    @property
+    def base_dir(self) -> Path:
+        """Directory against which relative paths are resolved."""
+        return self.path.parent
+
+    @property
+    def n_y(self) -> int:
+        """Number of measured values (sum of the blocks' n_points)."""
+        return sum(e.n_points for e in self.experiments)
+
+
+# ---------------------------------------------------------------------------------- validation
+
+
+def _show(value) -> str:
+    if isinstance(value, dict):
+        text = "a table {" + ", ".join(value) + "}"
+    else:
+        text = repr(value)
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+class _Checker:
+    """Raises ConfigError messages naming the file, the dotted key, the value and what is allowed."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, key: str, value, allowed: str):
+        raise ConfigError(f"{self.path}: {key} = {_show(value)}: {allowed}")
+
+    def missing(self, key: str, allowed: str):
+        raise ConfigError(f"{self.path}: {key} is missing (no value given); it is required: {allowed}")
+
+    def table(self, key: str, value, allowed_keys) -> dict:
+        if not isinstance(value, dict):
+            self.fail(key, value, f"must be a table (section) with keys {', '.join(allowed_keys)}")
+        prefix = f"{key}." if key else ""
+        for k, v in value.items():
+            if k not in allowed_keys:
+                self.fail(prefix + k, v, f"unknown key; allowed keys here: {', '.join(allowed_keys)}")
+        return value
+
+    def number(self, key, value, allowed="must be a number", ok=lambda v: True) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not ok(value):
+            self.fail(key, value, allowed)
+        return float(value)
+
+    def integer(self, key, value, allowed="must be an integer", ok=lambda v: True) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not ok(value):
+            self.fail(key, value, allowed)
+        return int(value)
+
+    def string(self, key, value, allowed="must be a string") -> str:
+        if not isinstance(value, str) or not value:
+            self.fail(key, value, allowed)
+        return value
+
+    def choice(self, key, value, choices) -> str:
+        text = "must be one of " + ", ".join(repr(c) for c in choices)
+        if not isinstance(value, str) or value not in choices:
+            self.fail(key, value, text)
+        return value
+
+    def pair(self, key, value, allowed) -> tuple[float, float]:
+        """Two finite numbers [a, b]; any defect names the whole list."""
+        if not (isinstance(value, list) and len(value) == 2):
+            self.fail(key, value, allowed)
+        for v in value:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                self.fail(key, value, allowed)
+        return float(value[0]), float(value[1])
+
+    def strings(self, key, value, what="column names") -> tuple:
+        if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+            self.fail(key, value, f"must be a list of {what} (strings)")
+        duplicates = sorted({v for v in value if value.count(v) > 1})
+        if duplicates:
+            self.fail(key, value, f"must not repeat a name; repeated: {', '.join(map(repr, duplicates))}")
+        return tuple(value)
+
+    def file(self, key, value, base: Path) -> Path:
+        self.string(key, value, "must be a file path (string)")
+        given = Path(value).expanduser()
+        resolved = (given if given.is_absolute() else base / given).resolve()
+        where = f"{resolved}" if given.is_absolute() else f"resolved relative to the config file: {resolved}"
+        if not resolved.exists():
+            self.fail(key, value, f"file not found ({where})")
+        if not resolved.is_file():
+            self.fail(key, value, f"not a file ({where})")
+        return resolved
+
+
+def _read_toml(path: Path) -> dict:
+    try:
+        with open(path, "rb") as handle:
+            return tomllib.load(handle)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: configuration file not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path}: is a directory, not a configuration file") from None
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{path}: not a UTF-8 text file ({err})") from None
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{path}: not valid TOML: {err}") from None
+
+
+def _parameter_allowed(name: str) -> str:
+    return f"must be a number in the valid range {_range_text(name)} [{DamageParameters.units()[name]}]"
+
+
+def _valid_parameter(name: str, value: float) -> bool:
+    try:
+        DamageParameters(**{name: value})
+    except ValueError:
+        return False
+    return True
+
+
+def _model(ck: _Checker, raw) -> ModelConfig:
+    if raw is None:
+        return ModelConfig()
+    ck.table("model", raw, _MODEL_KEYS)
+    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), tuple(_MODEL_TYPES))
+    params = ck.table("model.parameters", raw.get("parameters", {}), DamageParameters.names())
+    values = []
+    for name, value in params.items():
+        key = f"model.parameters.{name}"
+        allowed = _parameter_allowed(name)
+        v = ck.number(key, value, allowed)
+        if not _valid_parameter(name, v):
+            ck.fail(key, value, allowed)
+        values.append((name, v))
+    return ModelConfig(type=kind, parameters=tuple(values))
+
+
+def _field_kind(field: dataclasses.Field) -> str:
+    text = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", str(field.type))
+    return text.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
+
+
+def _specimen_error_key(message: str, fields, given) -> str | None:
+    """The specimen field a validation message is about: the first named one the user gave, else the first named."""
+    found = []
+    for name in fields:
+        match = re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", message)
+        if match:
+            found.append((match.start(), name))
+    found.sort()
+    for _, name in found:
+        if name in given:
+            return name
+    return found[0][1] if found else None
+
+
+def _specimen(ck: _Checker, raw) -> SpecimenConfig:
+    if raw is None:
+        ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in _SPECIMENS))
+    if not isinstance(raw, dict):
+        ck.fail("specimen", raw, "must be a table (section)")
+    if "type" not in raw:
+        ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in _SPECIMENS))
+    kind = ck.choice("specimen.type", raw["type"], tuple(_SPECIMENS))
+    cls = _specimen_class(kind)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    ck.table("specimen", raw, ("type", "control", *fields))
+    controls, _ = _SPECIMENS[kind]
+    control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
+    options = {}
+    for name, value in raw.items():
+        if name in ("type", "control"):
+            continue
+        key, ftype = f"specimen.{name}", _field_kind(fields[name])
+        if ftype == "float":
+            options[name] = ck.number(key, value, f"must be a number (field {name} of {cls.__name__})")
+        elif ftype == "int":
+            options[name] = ck.integer(key, value, f"must be an integer (field {name} of {cls.__name__})")
+        elif ftype == "str":
+            options[name] = ck.string(key, value, f"must be a string (field {name} of {cls.__name__})")
+        else:
+            options[name] = value
+    try:
+        cls(**options)
+    except (TypeError, ValueError) as err:
+        name = _specimen_error_key(str(err), fields, options)
+        if name is None:
+            raise ConfigError(f"{ck.path}: specimen ({kind}) is invalid: {err}") from None
+        value = options.get(name, getattr(cls, name, None))
+        given = "" if name in options else " (default)"
+        raise ConfigError(f"{ck.path}: specimen.{name} = {_show(value)}{given}: {err}") from None
+    return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
+
+
+def _csv_header(ck: _Checker, key: str, path: Path) -> list[str]:
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:
+            for cells in csv.reader(handle):
+                if any(cell.strip() for cell in cells):
+                    return [cell.strip() for cell in cells]
+    except (UnicodeDecodeError, csv.Error) as err:
+        raise ConfigError(f"{ck.path}: {key} = {_show(str(path))}: not a readable UTF-8 CSV file ({err})") from None
+    raise ConfigError(f"{ck.path}: {key} = {_show(str(path))}: the file is empty (no header row)")
+
+
+def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig) -> ExperimentConfig:
+    prefix = f"experiments[{i}]"
+    ck.table(prefix, raw, _EXPERIMENT_KEYS)
+
+    def required(name):
+        if name not in raw:
+            ck.missing(f"{prefix}.{name}", _REQUIRED_TEXT[name])
+        return raw[name]
+
+    _, observables = _SPECIMENS[specimen.type]
+    quantity = ck.choice(f"{prefix}.quantity", raw.get("quantity", "force"), ("force", *observables))
+    file = ck.file(f"{prefix}.file", required("file"), base)
+    control_column = ck.string(f"{prefix}.control_column", required("control_column"), "must be a column name")
+    control_unit = ck.choice(f"{prefix}.control_unit", required("control_unit"), tuple(_CONTROL_UNITS))
+    units = _FORCE_UNITS if quantity == "force" else _LOCAL_UNITS
+    if "force_unit" not in raw:
+        ck.missing(f"{prefix}.force_unit", f"the unit of {quantity!r}, one of " + ", ".join(map(repr, units)))
+    force_unit = ck.choice(f"{prefix}.force_unit", raw["force_unit"], tuple(units))
+    kind = ck.choice(f"{prefix}.kind", required("kind"), _KINDS)
+    for name in raw:
+        if name in {k for ks in _KIND_KEYS.values() for k in ks} and name not in _KIND_KEYS[kind]:
+            ck.fail(f"{prefix}.{name}", raw[name], f"not used by kind {kind!r}, which takes "
+                    + ", ".join(_KIND_KEYS[kind]))
+    n_points = ck.integer(f"{prefix}.n_points", required("n_points"), "must be an integer >= 3", lambda v: v >= 3)
+
+    header = _csv_header(ck, f"{prefix}.file", file)
+    available = "available columns: " + ", ".join(repr(c) for c in header)
+
+    def column(name, value):
+        key = f"{prefix}.{name}"
+        ck.string(key, value, "must be a column name (string)")
+        if value not in header:
+            ck.fail(key, value, f"the file {file} has no such column; {available}")
+        return value
+
+    column("control_column", control_column)
+    options = {}
+    if kind in ("repeats", "single"):
+        key = f"{prefix}.force_columns"
+        names = ck.strings(key, required("force_columns"))
+        if kind == "repeats" and len(names) < 2:
+            ck.fail(key, raw["force_columns"], "kind 'repeats' needs at least 2 columns (one per repeated test)")
+        if kind == "single" and len(names) != 1:
+            ck.fail(key, raw["force_columns"], "kind 'single' takes exactly 1 column")
+        for name in names:
+            if name not in header:
+                ck.fail(key, raw["force_columns"], f"the file {file} has no column {name!r}; {available}")
+        options["force_columns"] = names
+    else:
+        for name in _KIND_KEYS["envelope"]:
+            options[name] = column(name, required(name))
+    if kind == "single":
+        given = [name for name in ("std", "relative_std") if name in raw]
+        if len(given) != 1:
+            key = f"{prefix}.{given[1] if given else 'std'}"
+            text = "kind 'single' needs exactly one of std (absolute, in force_unit, > 0) or relative_std (fraction of |y|, > 0)"
+            if not given:
+                ck.missing(key, text)
+            ck.fail(key, raw[given[1]], text)
+        name = given[0]
+        unit = f" [{force_unit}]" if name == "std" else " (fraction of |y|)"
+        options[name] = ck.number(f"{prefix}.{name}", raw[name], f"must be a number > 0{unit}", lambda v: v > 0)
+    control_range = None
+    if "control_range" in raw:
+        value = raw["control_range"]
+        allowed = f"must be [start, stop] with 0 < start < stop [{control_unit}]"
+        a, b = ck.pair(f"{prefix}.control_range", value, allowed)
+        if not 0 < a < b:
+            ck.fail(f"{prefix}.control_range", value, allowed)
+        control_range = (a, b)
+    default_name = "global" if quantity == "force" else quantity
+    name = ck.string(f"{prefix}.name", raw.get("name", default_name), "must be a non-empty string")
+    return ExperimentConfig(index=i, file=file, control_column=control_column, control_unit=control_unit,
+                            force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
+                            quantity=quantity, name=name, **options)
+
+
+_REQUIRED_TEXT = {
+    "file": "a CSV file path, relative to the config file",
+    "control_column": "the name of the control column",
+    "control_unit": "one of " + ", ".join(map(repr, _CONTROL_UNITS)),
+    "kind": "one of " + ", ".join(map(repr, _KINDS)),
+    "n_points": "an integer >= 3",
+    "force_columns": "a list of force column names",
+    "mean_column": "the name of the mean column (kind 'envelope')",
+    "lower_column": "the name of the lower-envelope column (kind 'envelope')",
+    "upper_column": "the name of the upper-envelope column (kind 'envelope')",
+}
+
+
+def _experiments(ck: _Checker, raw, base: Path, specimen: SpecimenConfig, needed: bool) -> tuple:
+    if raw is None:
+        if needed:
+            ck.missing("experiments", "one or more [[experiments]] blocks (data files) for identification")
+        return ()
+    if not isinstance(raw, list) or not raw:
+        ck.fail("experiments", raw, "must be one or more [[experiments]] tables")
+    return tuple(_experiment(ck, i, block, base, specimen) for i, block in enumerate(raw))
+
+
+def _identify(ck: _Checker, raw, n_y: int | None, needed: bool) -> IdentifyConfig | None:
+    if raw is None:
+        if needed:
+            ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
+        return None
+    ck.table("identify", raw, _IDENTIFY_KEYS)
+    names_all = DamageParameters.names()
+    if "parameters" not in raw:
+        ck.missing("identify.parameters", "a list of model parameters among " + ", ".join(names_all))
+    value = raw["parameters"]
+    if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
+        ck.fail("identify.parameters", value, "must be a non-empty list of model parameters among " + ", ".join(names_all))
+    for name in value:
+        if name not in names_all:
+            ck.fail("identify.parameters", value, f"{name!r} is not a model parameter; allowed: {', '.join(names_all)}")
+    duplicates = sorted({v for v in value if value.count(v) > 1})
+    if duplicates:
+        ck.fail("identify.parameters", value, f"duplicate parameter {', '.join(map(repr, duplicates))}; list each once")
+    names = tuple(value)
+
+    if "bounds" not in raw:
+        ck.missing("identify.bounds", "a table with [lower, upper] for " + ", ".join(names))
+    bounds = ck.table("identify.bounds", raw["bounds"], (*names, "log"))
+    lower, upper = [], []
+    for name in names:
+        key = f"identify.bounds.{name}"
+        unit = DamageParameters.units()[name]
+        allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(name)} [{unit}]"
+        if name not in bounds:
+            ck.missing(key, f"[lower, upper] bounds of the identified parameter {name} [{unit}]")
+        pair = bounds[name]
+        lo, hi = ck.pair(key, pair, allowed)
+        if not lo < hi:
+            ck.fail(key, pair, f"lower = {lo:g} must be below upper = {hi:g} ({allowed})")
+        for which, v in (("lower", lo), ("upper", hi)):
+            if not _valid_parameter(name, v):
+                ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(name)} [{unit}]")
+        lower.append(lo)
+        upper.append(hi)
+    log = ()
+    if "log" in bounds:
+        log = ck.strings("identify.bounds.log", bounds["log"], "identified parameters")
+        for name in log:
+            if name not in names:
+                ck.fail("identify.bounds.log", bounds["log"],
+                        f"{name!r} is not an identified parameter; allowed: {', '.join(names)}")
+            lo = lower[names.index(name)]
+            if not lo > 0:
+                ck.fail("identify.bounds.log", bounds["log"],
+                        f"log scale for {name!r} needs a lower bound > 0, but identify.bounds.{name} has lower = {lo:g}")
+
+    raw_knn = ck.table("identify.knn", raw.get("knn", {}), _KNN_KEYS)
+    n = ck.integer("identify.knn.n", raw_knn.get("n", 64), "must be an integer >= 2", lambda v: v >= 2)
+    method = ck.choice("identify.knn.method", raw_knn.get("method", "sobol"), _METHODS)
+    seed = ck.integer("identify.knn.seed", raw_knn.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0)
+    knn = KnnConfig(n=n, method=method, k=5, seed=seed)
+    population = knn.population(len(names))
+    how = f"n**p = {n}**{len(names)}" if method == "grid" else f"n = {n}"
+    k_value = raw_knn.get("k", 5)
+    k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), k_value,
+                   f"must be an integer with 1 <= k <= the population size {population} ({how}, method {method!r})",
+                   lambda v: 1 <= v <= population)
+    knn = dataclasses.replace(knn, k=k)
+
+    raw_kf = ck.table("identify.kalman", raw.get("kalman", {}), _KALMAN_KEYS)
+    groups = None
+    if "groups" in raw_kf:
+        top = n_y if n_y else None
+        allowed = (f"must be an integer with 1 <= groups <= n_y = {top} (the total n_points of the experiments)"
+                   if top else "must be an integer >= 1")
+        groups = ck.integer("identify.kalman.groups", raw_kf["groups"], allowed,
+                            lambda v: v >= 1 and (top is None or v <= top))
+    kalman = KalmanConfig(
+        groups=groups,
+        max_iterations=ck.integer("identify.kalman.max_iterations", raw_kf.get("max_iterations", 10),
+                                  "must be an integer >= 1", lambda v: v >= 1),
+        tol=ck.number("identify.kalman.tol", raw_kf.get("tol", 0.01), "must be a number > 0 [standard deviations]",
+                      lambda v: v > 0),
+        restart=ck.choice("identify.kalman.restart", raw_kf.get("restart", "linearize"), _RESTARTS),
+    )
+    return IdentifyConfig(parameters=names, lower=tuple(lower), upper=tuple(upper), log=log, knn=knn, kalman=kalman)
+
+
+def _output(ck: _Checker, raw, base: Path) -> OutputConfig:
+    raw = ck.table("output", {} if raw is None else raw, _OUTPUT_KEYS)
+    directory = ck.string("output.directory", raw.get("directory", "results"), "must be a directory path (string)")
+    path = Path(directory).expanduser()
+    path = (path if path.is_absolute() else base / path).resolve()
+    steps = raw.get("vtk_steps", [])
+    allowed = "must be a list of step numbers (integers >= 0)"
+    if not isinstance(steps, list):
+        ck.fail("output.vtk_steps", steps, allowed)
+    for step in steps:
+        if isinstance(step, bool) or not isinstance(step, int) or step < 0:
+            ck.fail("output.vtk_steps", steps, allowed)
+    return OutputConfig(directory=path, vtk_steps=tuple(sorted(set(steps))))
+
+
+def _simulate(ck: _Checker, raw) -> SimulateConfig:
+    raw = ck.table("simulate", {} if raw is None else raw, _SIMULATE_KEYS)
+    target = None
+    if "target" in raw:
+        target = ck.number("simulate.target", raw["target"], "must be a number > 0 [mm] (final control value)",
+                           lambda v: v > 0)
+    return SimulateConfig(
+        target=target,
+        stop_force_fraction=ck.number("simulate.stop_force_fraction", raw.get("stop_force_fraction", 0.1),
+                                      "must be a number with 0 < f < 1 (fraction of the peak force)",
+                                      lambda v: 0 < v < 1),
+        damage_threshold=ck.number("simulate.damage_threshold", raw.get("damage_threshold", 0.0),
+                                   "must be a number with 0 <= t < 1 (damage)", lambda v: 0 <= v < 1),
+    )
+
+
+def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config:
+    """Read and validate a TOML configuration.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The TOML file; relative paths inside it are resolved against its directory.
+    purpose : {"identify", "simulate"}
+        ``"identify"`` requires ``[[experiments]]`` and ``[identify]``; ``"simulate"`` does not
+        (they are validated when present).
+
+    Returns
+    -------
+    Config
+        Frozen, validated configuration.
+
+    Raises
+    ------
+    ConfigError
+        For any invalid, missing or unknown key, naming the file, the key, the value and what is allowed.
+    """
+    if purpose not in _PURPOSES:
+        raise ValueError(f"purpose = {purpose!r}; choose 'identify' or 'simulate'")
+    path = Path(path).expanduser().resolve()
+    ck = _Checker(path)
+    raw = ck.table("", _read_toml(path), _TOP_KEYS)
+    base = path.parent
+    model = _model(ck, raw.get("model"))
+    specimen = _specimen(ck, raw.get("specimen"))
+    experiments = _experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
+    n_y = sum(e.n_points for e in experiments) or None
+    identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify")
+    output = _output(ck, raw.get("output"), base)
+    simulate = _simulate(ck, raw.get("simulate"))
+    return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
+                  identify=identify, output=output, simulate=simulate)
+
+
+# ------------------------------------------------------------------------------------ builders
+
+
+def _require(cfg: Config, section: str):
+    value = getattr(cfg, section)
+    if not value:
+        what = "[[experiments]] blocks" if section == "experiments" else f"an [{section}] section"
+        raise ConfigError(f"{cfg.path}: {section} is missing (no value given); identification needs {what}")
+    return value
+
+
+def build_parameters(cfg: Config) -> DamageParameters:
+    """The model parameters: those given in ``[model.parameters]``, the rest the defaults."""
+    return DamageParameters(**dict(cfg.model.parameters))
+
+
+def build_specimen(cfg: Config):
+    """The specimen object (NotchedBeam, DogBone or BarWithWeakZone) with the fields given."""
+    return _specimen_class(cfg.specimen.type)(**dict(cfg.specimen.options))
+
+
+def _experiment_data(exp: ExperimentConfig):
+    from fracid.data import from_envelope, from_repeats, read_curve_csv, with_std
+
+    if exp.kind == "envelope":
+        columns = [exp.mean_column, exp.lower_column, exp.upper_column]
+    else:
+        columns = list(exp.force_columns)
+    curves = read_curve_csv(exp.file, control_column=exp.control_column, force_columns=columns,
+                            control_unit_scale=exp.control_scale, force_unit_scale=exp.force_scale)
+    span = exp.control_range_mm
+    if exp.kind == "repeats":
+        return from_repeats(curves, exp.n_points, span, name=exp.name)
+    if exp.kind == "envelope":
+        return from_envelope(*curves, exp.n_points, span, name=exp.name)
+    if exp.std is not None:
+        return with_std(curves[0], exp.std * exp.force_scale, exp.n_points, span, name=exp.name)
+    return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True)
+
+
+def build_data(cfg: Config):
+    """The measured data: one block per ``[[experiments]]`` entry, stacked in order.
+
+    Raises
+    ------
+    ConfigError
+        Wrapping any :class:`fracid.data.DataError` (bad rows, a range beyond the data, ...) with
+        ``experiments[i]`` and the file named.
+    """
+    from fracid.data import DataError, stack
+
+    blocks = []
+    for exp in _require(cfg, "experiments"):
+        try:
+            blocks.append(_experiment_data(exp))
+        except DataError as err:
+            raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
+    return blocks[0] if len(blocks) == 1 else stack(*blocks)
+
+
+def build_operator(cfg: Config, data):
+    """The forward operator: one Observation per experiment block, at the data's control points.
+
+    ``data`` is the result of :func:`build_data` (its blocks line up with ``[[experiments]]``).
+    """
+    from fracid.inverse.forward_operator import ForwardOperator, Observation
+
+    experiments = _require(cfg, "experiments")
+    identify = _require(cfg, "identify")
+    if len(data.blocks) != len(experiments):
+        raise ConfigError(f"{cfg.path}: experiments: the data hold {len(data.blocks)} blocks but the configuration "
+                          f"has {len(experiments)} [[experiments]] entries; build the data with build_data(cfg)")
+    specimen = build_specimen(cfg)
+    observations = []
+    for exp, (name, start, stop) in zip(experiments, data.blocks):
+        try:
+            observations.append(Observation(specimen, data.control[start:stop], quantity=exp.quantity,
+                                            control=cfg.specimen.control, name=name))
+        except ValueError as err:
+            raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
+                              f"{_show(exp.control_range and list(exp.control_range))}: {err}") from None
+    return ForwardOperator(observations, build_parameters(cfg), identify.parameters,
+                           regularization=cfg.model.regularization)
+
+
+def build_space(cfg: Config):
+    """The parameter space of the KNN population: identified names, bounds, log flags."""
+    from fracid.inverse.knn import ParameterSpace
+
+    identify = _require(cfg, "identify")
+    return ParameterSpace(identify.parameters, lower=list(identify.lower), upper=list(identify.upper),
+                          log=tuple(name in identify.log for name in identify.parameters))
+
+
+def identify_settings(cfg: Config) -> dict:
+    """Keyword arguments of :func:`fracid.inverse.strategy.identify_data` (and ``identify``).
+
+    ``n``, ``method``, ``seed``, ``k``, ``groups`` (None, or ``groups`` consecutive index arrays
+    covering the n_y observations), ``max_iterations``, ``tol`` and ``restart`` (only when
+    ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
+    (executor, store, progress) is not configuration: add it at the call.
+    """
+    from fracid.inverse.strategy import identify
+
+    settings = _require(cfg, "identify")
+    knn, kalman = settings.knn, settings.kalman
+    groups = None
+    if kalman.groups is not None:
+        groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), kalman.groups)]
+    out = {"n": knn.n, "method": knn.method, "seed": knn.seed, "k": knn.k, "groups": groups,
+           "max_iterations": kalman.max_iterations, "tol": kalman.tol}
+    if "restart" in inspect.signature(identify).parameters:
+        out["restart"] = kalman.restart
+    elif kalman.restart != "linearize":
+        raise ConfigError(f"{cfg.path}: identify.kalman.restart = {kalman.restart!r}: this version of "
+                          "fracid.inverse.strategy.identify cannot forward it; only 'linearize' (the default) is available")
+    return out
+
+
+def simulate_settings(cfg: Config) -> dict:
+    """Keyword arguments of :func:`fracid.forward.simulate` besides the specimen and parameters:
+    ``regularization``, ``control``, ``target``, ``stop_force_fraction``, ``damage_threshold`` and
+    ``field_steps`` (the VTK steps, or ``"last"`` when none are listed)."""
+    sim = cfg.simulate
+    return {"regularization": cfg.model.regularization, "control": cfg.specimen.control, "target": sim.target,
+            "stop_force_fraction": sim.stop_force_fraction, "damage_threshold": sim.damage_threshold,
+            "field_steps": list(cfg.output.vtk_steps) if cfg.output.vtk_steps else "last"}

@@ -1,0 +1,371 @@
+"""Figures of an identification result (matplotlib, Agg canvas; no pyplot global state).
+
+Every ``*_figure`` function takes an :class:`~fracid.inverse.strategy.IdentificationResult` (or any
+object with the same attributes; lists from a JSON file are accepted) and returns a
+:class:`matplotlib.figure.Figure`, or ``None`` when the result holds nothing to draw (no Kalman
+history, no KNN population, a single parameter for the map). :func:`to_png` renders a figure to PNG
+bytes at :data:`DPI`.
+
+Units: control [mm], force [N], parameters in the units of
+:meth:`~fracid.model.parameters.DamageParameters.units`.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+
+from fracid.model.parameters import DamageParameters
+
+#: resolution of the PNG images [dots per inch]
+DPI = 110
+
+_MEASURED = "#1f77b4"
+_COMPUTED = "#d62728"
+_NEIGHBOUR = "#ff7f0e"
+_FAILED = "#7f7f7f"
+_ESTIMATE = "#d62728"
+
+
+# ------------------------------------------------------------------------------------ helpers
+
+
+def to_png(fig: Figure, dpi: int = DPI) -> bytes:
+    """The figure as PNG bytes (rendered by the Agg canvas)."""
+    if not isinstance(fig.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(fig)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi)
+    return buffer.getvalue()
+
+
+def _new_figure(width: float, height: float) -> Figure:
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def parameter_label(name: str) -> str:
+    """Axis label of a parameter with its unit, e.g. ``"c [mm^2]"``, ``"beta [-]"``."""
+    unit = DamageParameters.units().get(name)
+    return f"{name} [{unit}]" if unit else str(name)
+
+
+def block_quantity(name: str) -> str:
+    """Axis label of the measured quantity of a data block: a width [mm] if its name says so,
+    else the force [N]."""
+    lowered = str(name).lower()
+    if "width" in lowered or "fpz" in lowered:
+        return f"{name} [mm]"
+    return "force [N]"
+
+
+def _float_array(values, fill=np.inf) -> np.ndarray:
+    """Array of floats; None (JSON null for inf/nan) becomes ``fill``."""
+    if values is None:
+        return np.array([], float)
+    array = np.asarray(values, dtype=object)
+    if array.dtype == object:
+        array = np.where(np.equal(array, None), fill, array)
+    return np.asarray(array, dtype=float)
+
+
+def result_blocks(result) -> list[tuple[str, int, int]]:
+    """(name, start, stop) of every data block of the result; one block ``"data"`` if none."""
+    n = int(np.size(result.y_exp))
+    blocks = [(str(b[0]), int(b[1]), int(b[2])) for b in (result.blocks or [])]
+    return blocks or [("data", 0, n)]
+
+
+def knn_arrays(result):
+    """Population ``points`` (N, p), objective ``f`` (inf where failed), boolean ``failed``,
+    ranking ``order`` and ``k`` of the result's KNN search; ``None`` without a population."""
+    knn = result.knn or {}
+    points = knn.get("points")
+    if points is None or np.size(points) == 0:
+        return None
+    p = len(result.names)
+    points = _float_array(points, np.nan).reshape(-1, p)
+    f = _float_array(knn.get("f"), np.inf)
+    if f.size != len(points):
+        f = np.full(len(points), np.inf)
+    status = list(knn.get("status") or ["ok"] * len(points))
+    failed = np.array([s != "ok" for s in status]) | ~np.isfinite(f)
+    order = knn.get("order")
+    order = np.argsort(np.where(failed, np.inf, f), kind="stable") if order is None else np.asarray(order, int)
+    k = int(knn.get("k") or 0)
+    return points, f, failed, order, k
+
+
+def _log_axis(values) -> bool:
+    """Log scale for a parameter axis spanning more than two decades of positive values."""
+    values = np.asarray(values, float)
+    values = values[np.isfinite(values)]
+    return values.size > 1 and np.all(values > 0) and values.max() / values.min() > 100.0
+
+
+def _parameter_axis(ax, axis: str, values) -> None:
+    """Log scale for a parameter spanning decades, else linear with scientific notation for small
+    or large magnitudes (e.g. kappa_i ~ 1e-4) so tick labels stay short."""
+    if _log_axis(values):
+        (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
+    else:
+        ax.ticklabel_format(axis=axis, style="sci", scilimits=(-3, 4), useMathText=True)
+
+
+def _objective_for_log(f: np.ndarray, failed: np.ndarray):
+    """Objective values safe for a log axis (zeros raised to a floor) and the height of failed runs."""
+    good = f[~failed & np.isfinite(f)]
+    positive = good[good > 0]
+    floor = positive.min() / 10.0 if positive.size else 1e-12
+    shown = np.where(failed | ~np.isfinite(f), np.nan, np.maximum(f, floor))
+    top = (np.nanmax(shown) if good.size else 1.0) * 5.0
+    return shown, top, floor
+
+
+def _ellipse(centre, cov, n_std=2.0, n=200) -> np.ndarray:
+    """Points (n, 2) of the n_std ellipse of a 2x2 covariance (Mahalanobis distance n_std)."""
+    vals, vecs = np.linalg.eigh(0.5 * (cov + cov.T))
+    vals = np.maximum(vals, 0.0)
+    t = np.linspace(0.0, 2.0 * np.pi, n)
+    circle = np.stack([np.cos(t), np.sin(t)])
+    return (np.asarray(centre, float)[:, None] + n_std * vecs @ (np.sqrt(vals)[:, None] * circle)).T
+
+
+def strongest_pair(result) -> tuple[int, int] | None:
+    """Indices (i, j), i < j, of the two parameters with the largest |correlation|; None for p < 2."""
+    p = len(result.names)
+    if p < 2:
+        return None
+    corr = np.asarray(result.correlation, float)
+    best, pair = -1.0, (0, 1)
+    for i in range(p):
+        for j in range(i + 1, p):
+            value = abs(corr[i, j]) if np.isfinite(corr[i, j]) else -0.5
+            if value > best:
+                best, pair = value, (i, j)
+    return pair
+
+
+# ------------------------------------------------------------------------------------ figures
+
+
+def fit_figure(result, control=None) -> Figure:
+    """Measured points with their +/- 2 std band and the curve computed at the estimate, per block.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    control : array_like, optional
+        Control value [mm] of every entry of y (e.g. ``ExperimentalData.control``, the blocks
+        concatenated). Without it the x axis is the index of the point in its block.
+    """
+    y_exp = _float_array(result.y_exp, np.nan)
+    std = _float_array(result.std_exp, np.nan)
+    y_fit = _float_array(result.y_fit, np.nan) if result.y_fit is not None else np.full_like(y_exp, np.nan)
+    if control is not None:
+        control = _float_array(control, np.nan)
+        if control.shape != y_exp.shape:
+            raise ValueError(f"control has {control.size} values but the result holds {y_exp.size} measured values")
+    blocks = result_blocks(result)
+    ncols = 1 if len(blocks) == 1 else 2
+    nrows = math.ceil(len(blocks) / ncols)
+    fig = _new_figure(6.4 * ncols, 4.0 * nrows)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax, (name, start, stop) in zip(axes, blocks):
+        part = slice(start, stop)
+        x = control[part] if control is not None else np.arange(stop - start, dtype=float)
+        y, s, fit = y_exp[part], std[part], y_fit[part]
+        sort = np.argsort(x, kind="stable")
+        ax.fill_between(x[sort], (y - 2 * s)[sort], (y + 2 * s)[sort], color=_MEASURED, alpha=0.2, lw=0,
+                        label="measured +/- 2 std")
+        ax.plot(x, y, "o", color=_MEASURED, ms=3.5, label="measured")
+        if np.any(np.isfinite(fit)):
+            ax.plot(x[sort], fit[sort], "-", color=_COMPUTED, lw=1.6, label="computed at the estimate")
+        ax.set_xlabel("control [mm]" if control is not None else "point index in the block [-]")
+        ax.set_ylabel(block_quantity(name))
+        ax.set_title(name)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small")
+    for ax in axes[len(blocks):]:
+        ax.set_visible(False)
+    return fig
+
+
+def kalman_figure(result) -> Figure | None:
+    """Estimate of every parameter after every Kalman step with its +/- 2 std band.
+
+    x axis: cumulative step index over the global iterations (0 = the prior from KNN when known);
+    dotted vertical lines separate the global iterations; the horizontal line is the final value.
+    """
+    history = list(result.history or [])
+    if not history:
+        return None
+    names = list(result.names)
+    p = len(names)
+    xs = np.array([_float_array(h["x"], np.nan).reshape(p) for h in history])
+    stds = np.array([np.sqrt(np.maximum(np.diag(_float_array(h["C"], np.nan).reshape(p, p)), 0.0)) for h in history])
+    index = np.arange(1, len(history) + 1)
+    knn = result.knn or {}
+    if knn.get("x0") is not None and knn.get("C0") is not None:
+        x0 = _float_array(knn["x0"], np.nan).reshape(p)
+        s0 = np.sqrt(np.maximum(np.diag(_float_array(knn["C0"], np.nan).reshape(p, p)), 0.0))
+        xs, stds, index = np.vstack([x0, xs]), np.vstack([s0, stds]), np.concatenate([[0], index])
+    iterations = [h.get("iteration", 1) for h in history]
+    boundaries = [i + 0.5 for i in range(1, len(history)) if iterations[i] != iterations[i - 1]]
+    final = _float_array(result.x, np.nan).reshape(p)
+    fig = _new_figure(7.5, 2.3 * p + 0.6)
+    axes = fig.subplots(p, 1, sharex=True, squeeze=False).ravel()
+    for j, ax in enumerate(axes):
+        ax.fill_between(index, xs[:, j] - 2 * stds[:, j], xs[:, j] + 2 * stds[:, j], color=_MEASURED, alpha=0.2,
+                        lw=0, label="+/- 2 std")
+        ax.plot(index, xs[:, j], "-o", color=_MEASURED, ms=2.5, lw=1.0, label="estimate")
+        ax.axhline(final[j], color=_ESTIMATE, lw=1.0, ls="--", label=f"final {final[j]:.4g}")
+        for b in boundaries:
+            ax.axvline(b, color="k", lw=0.8, ls=":")
+        ax.set_ylabel(parameter_label(names[j]))
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useMathText=True)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="x-small", loc="best")
+    n_iter = len(dict.fromkeys(iterations))
+    axes[0].set_title(f"Kalman filter: {len(history)} steps in {n_iter} global iteration(s)"
+                      + (" (step 0: KNN prior)" if index[0] == 0 else ""))
+    axes[-1].set_xlabel("cumulative step [-] (dotted: new global iteration)")
+    return fig
+
+
+def knn_objective_figure(result) -> Figure | None:
+    """Objective f (log scale) of every population point against each parameter.
+
+    Failed runs are drawn as grey crosses above the largest objective; the k nearest neighbours are
+    highlighted and the final estimate is a vertical line.
+    """
+    arrays = knn_arrays(result)
+    if arrays is None:
+        return None
+    points, f, failed, order, k = arrays
+    names = list(result.names)
+    p = len(names)
+    shown, top, _ = _objective_for_log(f, failed)
+    nearest = np.zeros(len(points), bool)
+    nearest[order[:k]] = True
+    final = _float_array(result.x, np.nan).reshape(p)
+    ncols = min(p, 3)
+    nrows = math.ceil(p / ncols)
+    fig = _new_figure(4.3 * ncols, 3.6 * nrows)
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharey=True).ravel()
+    for j, ax in enumerate(axes[:p]):
+        ok = ~failed
+        ax.plot(points[ok & ~nearest, j], shown[ok & ~nearest], "o", color=_MEASURED, ms=4, alpha=0.7,
+                label="population")
+        ax.plot(points[nearest, j], shown[nearest], "o", mfc="none", mec=_NEIGHBOUR, mew=1.8, ms=8,
+                label=f"{k} nearest")
+        if failed.any():
+            ax.plot(points[failed, j], np.full(failed.sum(), top), "x", color=_FAILED, ms=7, mew=1.5,
+                    label=f"failed ({failed.sum()})")
+        ax.axvline(final[j], color=_ESTIMATE, lw=1.2, label=f"estimate {final[j]:.4g}")
+        ax.set_yscale("log")
+        _parameter_axis(ax, "x", points[:, j])
+        ax.set_xlabel(parameter_label(names[j]))
+        ax.grid(True, which="both", alpha=0.25)
+    axes[0].set_ylabel("objective f [-]")
+    axes[0].legend(fontsize="x-small", loc="best")
+    for ax in axes[p:]:
+        ax.set_visible(False)
+    fig.suptitle(f"KNN population: {len(points)} runs, objective f = (y_exp - y)^T C_exp^-1 (y_exp - y)",
+                 fontsize="medium")
+    return fig
+
+
+def knn_map_figure(result) -> Figure | None:
+    """Population over the two most correlated parameters, coloured by log10 f, with the k nearest
+    and the estimate with its 2-std ellipse (and the KNN prior's, dashed). None for one parameter."""
+    pair = strongest_pair(result)
+    arrays = knn_arrays(result)
+    if pair is None or arrays is None:
+        return None
+    i, j = pair
+    points, f, failed, order, k = arrays
+    names = list(result.names)
+    shown, _, _ = _objective_for_log(f, failed)
+    ok = ~failed
+    fig = _new_figure(6.4, 5.0)
+    ax = fig.subplots()
+    colour = np.log10(shown[ok])
+    norm = Normalize(vmin=np.nanmin(colour), vmax=np.nanmax(colour)) if colour.size else None
+    scatter = ax.scatter(points[ok, i], points[ok, j], c=colour, cmap="viridis_r", norm=norm, s=30,
+                         edgecolors="none", label="population")
+    fig.colorbar(scatter, ax=ax, label="log10 f [-]")
+    near = order[:k]
+    ax.plot(points[near, i], points[near, j], "o", mfc="none", mec=_NEIGHBOUR, mew=1.8, ms=10, label=f"{k} nearest")
+    if failed.any():
+        ax.plot(points[failed, i], points[failed, j], "x", color=_FAILED, ms=7, mew=1.5,
+                label=f"failed ({failed.sum()})")
+    x = _float_array(result.x, np.nan)
+    C = _float_array(result.C, np.nan).reshape(len(names), len(names))
+    sub = np.ix_([i, j], [i, j])
+    knn = result.knn or {}
+    if knn.get("x0") is not None and knn.get("C0") is not None:
+        x0 = _float_array(knn["x0"], np.nan)
+        C0 = _float_array(knn["C0"], np.nan).reshape(len(names), len(names))
+        e0 = _ellipse(x0[[i, j]], C0[sub])
+        ax.plot(e0[:, 0], e0[:, 1], "--", color=_NEIGHBOUR, lw=1.0, label="KNN prior, 2 std")
+    ellipse = _ellipse(x[[i, j]], C[sub])
+    ax.plot(ellipse[:, 0], ellipse[:, 1], "-", color=_ESTIMATE, lw=1.4, label="estimate, 2 std")
+    ax.plot([x[i]], [x[j]], "*", color=_ESTIMATE, ms=14, mec="k", mew=0.6, label="estimate")
+    _parameter_axis(ax, "x", points[:, i])
+    _parameter_axis(ax, "y", points[:, j])
+    corr = float(np.asarray(result.correlation, float)[i, j])
+    ax.set_title(f"{names[i]} - {names[j]} (correlation {corr:+.3f})")
+    ax.set_xlabel(parameter_label(names[i]))
+    ax.set_ylabel(parameter_label(names[j]))
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="x-small", loc="best")
+    return fig
+
+
+def correlation_figure(result) -> Figure:
+    """Heat map of the correlation matrix of the estimate, values written in each cell."""
+    names = list(result.names)
+    corr = np.asarray(result.correlation, float)
+    p = len(names)
+    size = 2.2 + 0.8 * p
+    fig = _new_figure(size + 1.4, size)
+    ax = fig.subplots()
+    image = ax.imshow(corr, cmap="RdBu_r", vmin=-1.0, vmax=1.0, aspect="auto")
+    fig.colorbar(image, ax=ax, label="correlation [-]")
+    for a in range(p):
+        for b in range(p):
+            value = corr[a, b]
+            ax.text(b, a, f"{value:+.2f}" if np.isfinite(value) else "n/a", ha="center", va="center",
+                    color="white" if np.isfinite(value) and abs(value) > 0.6 else "black", fontsize=10)
+    ax.set_xticks(range(p), names)
+    ax.set_yticks(range(p), names)
+    ax.set_title("correlation of the identified parameters")
+    return fig
+
+
+# ------------------------------------------------------------------------------------ forward runs
+
+
+def curve_figure(result) -> Figure:
+    """Force versus the control quantity of a forward run, with its local observables beside it."""
+    local = [n for n in ("fpz_width", "damaged_zone_width") if n in result.observables]
+    fig = _new_figure(10.0 if local else 6.0, 4.0)
+    axes = fig.subplots(1, 2 if local else 1, squeeze=False)[0]
+    axes[0].plot(result.control, result.force, "-o", ms=2.5)
+    axes[0].set_xlabel(f"{result.control_name} [mm]")
+    axes[0].set_ylabel("force [N]")
+    axes[0].set_title(f"peak {result.peak_force:.4g} N ({result.status})", fontsize=9)
+    axes[0].grid(alpha=0.3)
+    if local:
+        axes[1].plot(result.control, result.observables[local[0]], "-o", ms=2.5, color=_ESTIMATE)
+        axes[1].set_xlabel(f"{result.control_name} [mm]")
+        axes[1].set_ylabel(f"{local[0].replace('_', ' ')} [mm]")
+        axes[1].grid(alpha=0.3)
+    return fig

@@ -1,0 +1,403 @@
+"""fracid.config: TOML configurations are validated when loaded; every error names the file, key and value.
+
+No forward runs: loading, building data, operator, space and settings only.
+"""
+
+import dataclasses
+import inspect
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fracid.config import (
+    ConfigError,
+    build_data,
+    build_operator,
+    build_parameters,
+    build_space,
+    build_specimen,
+    identify_settings,
+    load_config,
+    simulate_settings,
+)
+from fracid.data import gregoire2013_beam4_path
+from fracid.inverse.forward_operator import ForwardOperator
+from fracid.inverse.knn import ParameterSpace
+from fracid.inverse.strategy import identify, identify_data
+from fracid.model.parameters import DamageParameters
+from fracid.specimens.bar import BarWithWeakZone
+from fracid.specimens.beam import NotchedBeam
+
+CONFIGS = Path(__file__).parent / "configs"
+
+# The valid beam identification (bundled Gregoire data copied next to the file as load_cmod.csv).
+BEAM = """\
+[model]
+type = "gradient-damage"
+[model.parameters]
+E = 37000.0
+kappa_i = 6.6e-5
+c = 9.0
+
+[specimen]
+type = "notched-beam"
+control = "cmod"
+h_fine = 2.0
+
+[[experiments]]
+file = "load_cmod.csv"
+control_column = "cmod_mm"
+control_unit = "mm"
+force_unit = "N"
+kind = "envelope"
+mean_column = "load_mean_N"
+lower_column = "load_min_N"
+upper_column = "load_max_N"
+n_points = 40
+
+[identify]
+parameters = ["kappa_i", "beta", "c"]
+[identify.bounds]
+kappa_i = [4e-5, 1.2e-4]
+beta = [100.0, 2000.0]
+c = [1.0, 30.0]
+log = ["beta"]
+[identify.knn]
+n = 64
+method = "sobol"
+k = 5
+seed = 0
+[identify.kalman]
+groups = 4
+max_iterations = 10
+tol = 0.01
+restart = "linearize"
+
+[output]
+directory = "results"
+vtk_steps = []
+"""
+
+BAR_SIMULATE = """\
+[model]
+type = "local-damage"
+[model.parameters]
+E = 20000.0
+kappa_i = 1e-4
+c = 2.0
+
+[specimen]
+type = "bar"
+control = "weak_zone_elongation"
+length = 100
+weak_zone_width = 10.0
+profile = "hat"
+n_elements = 120
+
+[simulate]
+target = 0.05
+stop_force_fraction = 0.2
+damage_threshold = 0.1
+
+[output]
+directory = "/tmp/fracid-bar-out"
+vtk_steps = [20, 10]
+"""
+
+
+def write(tmp_path, text, name="study.toml"):
+    """The configuration in tmp_path, with the bundled Gregoire data beside it."""
+    shutil.copy(gregoire2013_beam4_path(), tmp_path / "load_cmod.csv")
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def variant(old, new, base=BEAM):
+    assert old in base, old
+    return base.replace(old, new, 1)
+
+
+# ------------------------------------------------------------------------------------ valid configs
+
+
+def test_valid_beam_config_loads_and_builds_everything(tmp_path):
+    path = write(tmp_path, BEAM)
+    cfg = load_config(path)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cfg.purpose = "simulate"
+
+    params = build_parameters(cfg)
+    assert params == DamageParameters(E=37000.0, kappa_i=6.6e-5, c=9.0)
+    specimen = build_specimen(cfg)
+    assert specimen == NotchedBeam(h_fine=2.0)
+
+    data = build_data(cfg)
+    assert data.y.shape == (40,) and data.covariance.shape == (40, 40)
+    assert data.blocks == (("global", 0, 40),)
+
+    operator = build_operator(cfg, data)
+    assert isinstance(operator, ForwardOperator)
+    assert operator.n_outputs == 40
+    assert operator.names == ("kappa_i", "beta", "c") and operator.regularization == "gradient"
+    assert operator.base == params
+    (obs,) = operator.observations
+    assert obs.quantity == "force" and obs.control == "cmod" and obs.specimen == specimen
+    np.testing.assert_array_equal(obs.control_points, data.control)
+
+    space = build_space(cfg)
+    assert isinstance(space, ParameterSpace) and len(space.names) == 3
+    np.testing.assert_allclose(space.lower, [4e-5, 100.0, 1.0])
+    np.testing.assert_allclose(space.upper, [1.2e-4, 2000.0, 30.0])
+    assert space.log == (False, True, False)
+
+    settings = identify_settings(cfg)
+    assert {k: settings[k] for k in ("n", "method", "seed", "k", "max_iterations", "tol")} == {
+        "n": 64, "method": "sobol", "seed": 0, "k": 5, "max_iterations": 10, "tol": 0.01}
+    groups = settings["groups"]
+    assert len(groups) == 4
+    np.testing.assert_array_equal(np.concatenate(groups), np.arange(40))
+    # every setting is a keyword that identify_data forwards to identify
+    accepted = set(inspect.signature(identify).parameters)
+    assert set(settings) <= accepted
+    assert "settings" in inspect.signature(identify_data).parameters
+
+    assert cfg.output.directory == tmp_path / "results"
+    assert cfg.output.vtk_steps == ()
+
+
+def test_valid_bar_simulate_config(tmp_path):
+    cfg = load_config(write(tmp_path, BAR_SIMULATE), purpose="simulate")
+    assert cfg.experiments == () and cfg.identify is None
+    bar = build_specimen(cfg)
+    assert bar == BarWithWeakZone(length=100.0, weak_zone_width=10.0, profile="hat", n_elements=120)
+    assert isinstance(bar.length, float) and isinstance(bar.n_elements, int)
+    assert build_parameters(cfg) == DamageParameters(E=20000.0, kappa_i=1e-4, c=2.0)
+    assert simulate_settings(cfg) == {
+        "regularization": "local", "control": "weak_zone_elongation", "target": 0.05,
+        "stop_force_fraction": 0.2, "damage_threshold": 0.1, "field_steps": [10, 20]}
+    assert cfg.output.directory == Path("/tmp/fracid-bar-out")
+    # the same file is not enough for an identification
+    with pytest.raises(ConfigError, match=r"experiments is missing"):
+        load_config(tmp_path / "study.toml")
+
+
+def test_defaults_fill_optional_sections(tmp_path):
+    text = 'specimen = { type = "dogbone", size = 200.0 }\n'
+    cfg = load_config(write(tmp_path, text), purpose="simulate")
+    assert cfg.specimen.control == "elongation"
+    assert cfg.model.regularization == "gradient" and build_parameters(cfg) == DamageParameters()
+    assert cfg.output.directory == tmp_path / "results"
+    assert simulate_settings(cfg)["target"] is None and simulate_settings(cfg)["field_steps"] == "last"
+
+
+@pytest.mark.parametrize("name, purpose", [("beam_identify.toml", "identify"), ("bar_simulate.toml", "simulate")])
+def test_example_files_load(name, purpose):
+    cfg = load_config(CONFIGS / name, purpose=purpose)
+    build_specimen(cfg)
+    if purpose == "identify":
+        data = build_data(cfg)
+        assert build_operator(cfg, data).n_outputs == data.n_y == 40
+
+
+def test_units_scale_and_blocks_stack(tmp_path):
+    """Repeats in kN against um, plus a local block in um with an absolute std: scaled to N and mm."""
+    control_um = np.linspace(0.0, 200.0, 21)
+    rows = ["u_um,F1_kN,F2_kN,width_um"] + [
+        f"{u},{1e-3 * u},{1.1e-3 * u},{10 * u}" for u in control_um]
+    (tmp_path / "bar.csv").write_text("\n".join(rows) + "\n")
+    text = """\
+[specimen]
+type = "bar"
+n_elements = 100
+
+[[experiments]]
+file = "bar.csv"
+control_column = "u_um"
+control_unit = "um"
+force_unit = "kN"
+kind = "repeats"
+force_columns = ["F1_kN", "F2_kN"]
+n_points = 5
+control_range = [40.0, 200.0]
+
+[[experiments]]
+file = "bar.csv"
+control_column = "u_um"
+control_unit = "um"
+force_unit = "um"
+kind = "single"
+force_columns = ["width_um"]
+std = 50.0
+n_points = 3
+control_range = [100.0, 200.0]
+quantity = "damaged_zone_width"
+
+[identify]
+parameters = ["c"]
+bounds = { c = [0.5, 4.0] }
+knn = { method = "grid", n = 5, k = 5 }
+"""
+    cfg = load_config(write(tmp_path, text))
+    data = build_data(cfg)
+    assert [b[0] for b in data.blocks] == ["global", "damaged_zone_width"]
+    np.testing.assert_allclose(data.control, [0.04, 0.08, 0.12, 0.16, 0.2, 0.1, 0.15, 0.2])
+    np.testing.assert_allclose(data.y[:5], 1.05 * np.array([40.0, 80.0, 120.0, 160.0, 200.0]))  # N
+    np.testing.assert_allclose(data.y[5:], [1.0, 1.5, 2.0])  # mm
+    np.testing.assert_allclose(data.std[5:], 0.05)  # 50 um
+    operator = build_operator(cfg, data)
+    assert [o.quantity for o in operator.observations] == ["force", "damaged_zone_width"]
+    assert [o.control for o in operator.observations] == ["end_displacement"] * 2
+    assert operator.n_outputs == 8
+    settings = identify_settings(cfg)
+    assert settings["groups"] is None and settings["method"] == "grid"
+
+
+def test_specimen_maps_match_the_specimens():
+    """The controls and observables the config accepts are those the specimens provide."""
+    from fracid.config import _SPECIMENS, _specimen_class
+
+    params = DamageParameters()
+    for kind, (controls, observables) in _SPECIMENS.items():
+        cls = _specimen_class(kind)
+        assert cls.default_control == controls[0]
+        assert set(cls().observers(params)) == set(observables)
+    problem = BarWithWeakZone(n_elements=20).build_problem(params)
+    assert set(problem.functionals) == set(_SPECIMENS["bar"][0])
+
+
+def test_restart_is_forwarded_when_identify_takes_it(tmp_path):
+    cfg = load_config(write(tmp_path, variant('restart = "linearize"', 'restart = "prior-mean"')))
+    if "restart" in inspect.signature(identify).parameters:
+        assert identify_settings(cfg)["restart"] == "prior-mean"
+    else:
+        with pytest.raises(ConfigError, match=r"identify.kalman.restart = 'prior-mean'"):
+            identify_settings(cfg)
+
+
+def test_single_curve_with_relative_std(tmp_path):
+    text = variant('kind = "envelope"\nmean_column = "load_mean_N"\nlower_column = "load_min_N"\n'
+                   'upper_column = "load_max_N"',
+                   'kind = "single"\nforce_columns = ["load_mean_N"]\nrelative_std = 0.05')
+    data = build_data(load_config(write(tmp_path, text)))
+    assert data.n_y == 40
+    np.testing.assert_allclose(data.std, np.maximum(0.05 * np.abs(data.y), 0.01 * np.abs(data.y).max()))
+
+
+def test_data_errors_are_wrapped(tmp_path):
+    text = variant("n_points = 40", "n_points = 40\ncontrol_range = [0.001, 9.0]")
+    cfg = load_config(write(tmp_path, text))
+    with pytest.raises(ConfigError) as info:
+        build_data(cfg)
+    message = str(info.value)
+    assert "experiments[0]" in message and str(tmp_path / "load_cmod.csv") in message and "9" in message
+
+
+def test_toml_syntax_error_names_file_and_line(tmp_path):
+    path = write(tmp_path, variant('seed = 0', 'seed = '))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    line = BEAM.splitlines().index("seed = 0") + 1
+    assert str(path) in str(info.value) and f"line {line}" in str(info.value)
+
+
+def test_missing_config_file(tmp_path):
+    with pytest.raises(ConfigError, match="configuration file not found"):
+        load_config(tmp_path / "nope.toml")
+
+
+# ------------------------------------------------------------------------------------- bad configs
+
+BAD = [
+    pytest.param(BEAM + "\n[outputs]\ndirectory = 'x'\n", "identify",
+                 ["outputs", "unknown key; allowed keys here: model, specimen, experiments"], id="unknown-top-level-key"),
+    pytest.param(variant("seed = 0", "seed = 0\nneighbours = 7"), "identify",
+                 ["identify.knn.neighbours", "7", "unknown key; allowed keys here: n, method, k, seed"],
+                 id="unknown-key-in-section"),
+    pytest.param(variant("kappa_i = 6.6e-5\nc = 9.0", "kappa_i = 6.6e-5\nc = -9.0"), "identify",
+                 ["model.parameters.c", "-9.0", "0 < c", "mm^2"], id="negative-c"),
+    pytest.param(variant("c = 9.0", "c = 9.0\nalpha = 1.2"), "identify",
+                 ["model.parameters.alpha", "1.2", "0 <= alpha <= 1"], id="alpha-above-1"),
+    pytest.param(variant("c = 9.0", "c = 9.0\nnu = 0.5"), "identify",
+                 ["model.parameters.nu", "0.5", "-1 < nu < 0.5"], id="nu-0.5"),
+    pytest.param(variant("c = [1.0, 30.0]", "c = [30.0, 1.0]"), "identify",
+                 ["identify.bounds.c", "[30.0, 1.0]", "must be below upper"], id="bounds-reversed"),
+    pytest.param(variant("c = [1.0, 30.0]", "c = [0.0, 30.0]"), "identify",
+                 ["identify.bounds.c", "[0.0, 30.0]", "lower bound 0 is outside the valid range 0 < c"],
+                 id="bounds-outside-valid-range"),
+    pytest.param(variant('file = "load_cmod.csv"', 'file = "data/missing.csv"'), "identify",
+                 ["experiments[0].file", "'data/missing.csv'", "file not found (resolved relative to the config file"],
+                 id="missing-data-file"),
+    pytest.param(variant('mean_column = "load_mean_N"', 'mean_column = "load_avg_N"'), "identify",
+                 ["experiments[0].mean_column", "'load_avg_N'", "available columns: 'cmod_mm', 'load_mean_N'"],
+                 id="wrong-column-name"),
+    pytest.param(variant('control_unit = "mm"\n', ""), "identify",
+                 ["experiments[0].control_unit", "missing", "'mm', 'um', 'm'"], id="unit-missing"),
+    pytest.param(variant('force_unit = "N"', 'force_unit = "lbf"'), "identify",
+                 ["experiments[0].force_unit", "'lbf'", "one of 'N', 'kN', 'MN'"], id="unknown-unit"),
+    pytest.param(variant("n = 64\nmethod = \"sobol\"\nk = 5", "n = 8\nmethod = \"sobol\"\nk = 9"), "identify",
+                 ["identify.knn.k", "9", "population size 8"], id="k-above-population"),
+    pytest.param(variant('type = "notched-beam"', 'type = "beam"'), "identify",
+                 ["specimen.type", "'beam'", "one of 'notched-beam', 'dogbone', 'bar'"], id="unknown-specimen-type"),
+    pytest.param(variant('control = "cmod"', 'control = "elongation"'), "identify",
+                 ["specimen.control", "'elongation'", "one of 'cmod', 'deflection'"], id="unknown-control"),
+    pytest.param(variant('parameters = ["kappa_i", "beta", "c"]', 'parameters = ["kappa_i", "beta", "l"]'), "identify",
+                 ["identify.parameters", "'l'", "not a model parameter"], id="not-a-model-parameter"),
+    pytest.param(variant('parameters = ["kappa_i", "beta", "c"]', 'parameters = ["kappa_i", "beta", "c", "beta"]'),
+                 "identify", ["identify.parameters", "['kappa_i', 'beta', 'c', 'beta']", "duplicate parameter 'beta'"],
+                 id="duplicate-parameter"),
+    pytest.param(variant("beta = [100.0, 2000.0]", "beta = [0.0, 2000.0]"), "identify",
+                 ["identify.bounds.log", "['beta']", "lower bound > 0", "lower = 0"], id="log-with-lower-0"),
+    pytest.param(variant("n_points = 40", "n_points = 2"), "identify",
+                 ["experiments[0].n_points", "2", "integer >= 3"], id="n_points-below-3"),
+    pytest.param(variant('upper_column = "load_max_N"\n', ""), "identify",
+                 ["experiments[0].upper_column", "missing", "kind 'envelope'"], id="envelope-missing-column"),
+    pytest.param(variant("E = 37000.0", 'E = "37000"'), "identify",
+                 ["model.parameters.E", "'37000'", "must be a number"], id="string-for-number"),
+    pytest.param(variant("h_fine = 2.0", "h_fine = 2.0\nnotch_depth = 60.0"), "identify",
+                 ["specimen.notch_depth", "60.0", "must be smaller than depth"], id="specimen-own-validation"),
+    pytest.param(variant("h_fine = 2.0", "h_fine = 2.0\nwidht = 60.0"), "identify",
+                 ["specimen.widht", "60.0", "unknown key; allowed keys here: type, control, depth"],
+                 id="unknown-specimen-field"),
+    pytest.param(variant("h_fine = 2.0", 'h_fine = "fine"'), "identify",
+                 ["specimen.h_fine", "'fine'", "must be a number"], id="specimen-field-type"),
+    pytest.param(variant("groups = 4", "groups = 41"), "identify",
+                 ["identify.kalman.groups", "41", "n_y = 40"], id="too-many-groups"),
+    pytest.param(variant('restart = "linearize"', 'restart = "again"'), "identify",
+                 ["identify.kalman.restart", "'again'", "'linearize', 'prior-mean'"], id="unknown-restart"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\nquantity = "damaged_zone_width"'), "identify",
+                 ["experiments[0].quantity", "'damaged_zone_width'", "one of 'force', 'fpz_width'"],
+                 id="quantity-not-an-observable"),
+    pytest.param(variant("n_points = 40", "n_points = 40\ncontrol_range = [0.2, 0.1]"), "identify",
+                 ["experiments[0].control_range", "[0.2, 0.1]", "0 < start < stop"], id="control-range-reversed"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nstd = 20.0"), "identify",
+                 ["experiments[0].std", "20.0", "not used by kind 'envelope'"], id="key-of-another-kind"),
+    pytest.param(variant("c = [1.0, 30.0]\n", ""), "identify",
+                 ["identify.bounds.c", "missing"], id="bounds-missing"),
+    pytest.param(variant("c = [1.0, 30.0]", "c = [1.0, 30.0]\nE = [1e4, 5e4]"), "identify",
+                 ["identify.bounds.E", "[10000.0, 50000.0]", "unknown key; allowed keys here: kappa_i, beta, c, log"],
+                 id="bounds-of-unidentified-parameter"),
+    pytest.param(variant("vtk_steps = []", "vtk_steps = [1, -2]"), "identify",
+                 ["output.vtk_steps", "[1, -2]", "integers >= 0"], id="negative-vtk-step"),
+    pytest.param(BAR_SIMULATE.replace("stop_force_fraction = 0.2", "stop_force_fraction = 1.0"), "simulate",
+                 ["simulate.stop_force_fraction", "1.0", "0 < f < 1"], id="stop-fraction-1"),
+    pytest.param(BAR_SIMULATE.replace("n_elements = 120", "n_elements = 12.5"), "simulate",
+                 ["specimen.n_elements", "12.5", "must be an integer"], id="float-for-integer"),
+    pytest.param(BAR_SIMULATE.replace('type = "local-damage"', 'type = "nonlocal"'), "simulate",
+                 ["model.type", "'nonlocal'", "one of 'gradient-damage', 'local-damage'"], id="unknown-model-type"),
+]
+
+
+@pytest.mark.parametrize("text, purpose, words", BAD)
+def test_bad_config_is_named(tmp_path, text, purpose, words):
+    path = write(tmp_path, text)
+    with pytest.raises(ConfigError) as info:
+        load_config(path, purpose=purpose)
+    message = str(info.value)
+    assert isinstance(info.value, ValueError)
+    assert "\n" not in message  # one paragraph
+    assert message.startswith(str(path))
+    for word in words:
+        assert word in message, f"{word!r} not in: {message}"
