@@ -369,3 +369,24 @@ def curve_figure(result) -> Figure:
         axes[1].set_ylabel(f"{local[0].replace('_', ' ')} [mm]")
         axes[1].grid(alpha=0.3)
     return fig
+
+
+def sensitivity_figure(history, control=None) -> Figure:
+    """Normalised sensitivities along the load history (left) and the share of each parameter's
+    prior variance removed by the data up to each step (right)."""
+    n = history.S.shape[0]
+    x = np.arange(n) if control is None else np.asarray(control, float)
+    fig = _new_figure(10.0, 4.0)
+    left, right = fig.subplots(1, 2)
+    for j, name in enumerate(history.names):
+        left.plot(x, history.normalised[:, j], "-o", ms=2.5, label=name)
+        right.plot(x, history.variance_share[:, j], "-o", ms=2.5, label=name)
+    left.axhline(0.0, color="k", lw=0.5)
+    left.set_ylabel("d y / d x_j * x_j / max|y|  [-]")
+    right.set_ylabel("share of prior variance removed [-]")
+    right.set_ylim(-0.02, 1.02)
+    for ax in (left, right):
+        ax.set_xlabel("control [mm]" if control is not None else "observation")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return fig
