@@ -94,8 +94,7 @@ def run_identify(args, config_path=None) -> int:
     operator, space, settings = build_operator(cfg, data), build_space(cfg), identify_settings(cfg)
     out = _out_dir(args, cfg)
     start = time.perf_counter()
-    workers = 1 if args.workers == 1 else args.workers
-    with RunStore(out / "runs.sqlite") as store, make_executor(workers, args.scheduler) as executor:
+    with RunStore(out / "runs.sqlite") as store, make_executor(args.workers, args.scheduler) as executor:
         result = identify_data(operator, data, space, executor=executor, store=store,
                                progress=None if not args.quiet else False, **settings)
     result.runs["wall_seconds"] = time.perf_counter() - start
