@@ -305,6 +305,17 @@ def _parse_table(
     return values, lines
 
 
+def integer_at_least(value, minimum: int, what: str) -> int:
+    """``value`` as an int, or a DataError naming ``what`` if it is not an integer >= ``minimum``."""
+    try:
+        value = operator.index(value)
+    except TypeError:
+        raise DataError(f"{what} must be an integer, got {value!r}") from None
+    if value < minimum:
+        raise DataError(f"{what} must be >= {minimum}, got {value}")
+    return value
+
+
 def read_curve_csv(
     path: str | os.PathLike,
     *,
@@ -362,12 +373,7 @@ def read_curve_csv(
     names = _column_names(force_columns)
     c_scale = _check_scale(control_unit_scale, "control_unit_scale", positive=True)
     f_scale = _check_scale(force_unit_scale, "force_unit_scale", positive=False)
-    try:
-        min_points = operator.index(min_points)
-    except TypeError:
-        raise DataError(f"min_points must be an integer, got {min_points!r}") from None
-    if min_points < 2:
-        raise DataError(f"min_points must be >= 2, got {min_points}")
+    min_points = integer_at_least(min_points, 2, "min_points")
 
     header, data = _read_rows(path, delimiter)
     wanted = [control_column, *names]

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg
 
-from fracid.data.curves import Curve, DataError, read_curve_csv
+from fracid.data.curves import Curve, DataError, integer_at_least, read_curve_csv
 
 #: default standard-deviation floor, fraction of the peak |y| of a block
 DEFAULT_STD_FLOOR = 0.01
@@ -145,12 +145,7 @@ def sample_points(start: float, stop: float, n: int) -> np.ndarray:
     DataError
         If n < 2 or not start < stop.
     """
-    try:
-        n = operator.index(n)
-    except TypeError:
-        raise DataError(f"the number of points must be an integer, got {n!r}") from None
-    if n < 2:
-        raise DataError(f"the number of points must be >= 2, got {n}")
+    n = integer_at_least(n, 2, "the number of points")
     a, b = float(start), float(stop)
     if not (math.isfinite(a) and math.isfinite(b) and a < b):
         raise DataError(f"the control range needs finite start < stop, got [{start!r}, {stop!r}] mm")

@@ -46,18 +46,19 @@ class ParameterSpace:
     def from_unit(self, u: np.ndarray) -> np.ndarray:
         """Map points of the unit cube to parameter values."""
         u = np.atleast_2d(u)
-        lin = self.lower + u * (self.upper - self.lower)
-        logv = np.exp(np.log(np.where(self.lower > 0, self.lower, 1.0))
-                      + u * (np.log(np.where(self.upper > 0, self.upper, 1.0)) - np.log(np.where(self.lower > 0, self.lower, 1.0))))
-        return np.where(np.array(self.log), logv, lin)
+        lo, hi = _safe_log(self.lower), _safe_log(self.upper)
+        return np.where(np.array(self.log), np.exp(lo + u * (hi - lo)), self.lower + u * (self.upper - self.lower))
 
     def to_unit(self, x: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`from_unit`."""
         x = np.atleast_2d(x)
-        lin = (x - self.lower) / (self.upper - self.lower)
-        safe = lambda v: np.log(np.where(v > 0, v, 1.0))  # noqa: E731
-        logu = (safe(x) - safe(self.lower)) / (safe(self.upper) - safe(self.lower))
-        return np.where(np.array(self.log), logu, lin)
+        lo, hi = _safe_log(self.lower), _safe_log(self.upper)
+        return np.where(np.array(self.log), (_safe_log(x) - lo) / (hi - lo), (x - self.lower) / (self.upper - self.lower))
+
+
+def _safe_log(v):
+    """log where v > 0 (log-scale parameters have positive bounds), 0 elsewhere (linear ones, unused)."""
+    return np.log(np.where(v > 0, v, 1.0))
 
 
 def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) -> np.ndarray:

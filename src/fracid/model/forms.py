@@ -66,6 +66,14 @@ def _damage(params, const, kappa):
     return omega * const.damageable, d_omega * const.damageable
 
 
+def _secant_equilibrium(B, const, w, ue, omega):
+    """Shared by both models: B^T D eps at the points, the internal forces and the secant stiffness."""
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
+    w_sec = w * (1.0 - omega) * const.E
+    bt_sigma = _bt(sigma_eff, B)  # (n_el, n_q, n_u)
+    return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), _btdb(B * w_sec[..., None, None], const.DB)
+
+
 def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
     """Implicit gradient-enhanced damage: residuals of equilibrium and of the diffusion equation.
 
@@ -85,13 +93,9 @@ def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_
     eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
     kappa, loading = update_history(kappa_old, ebar)
     omega, d_omega = _damage(params, const, kappa)
-    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
-    w_sec = w * (1.0 - omega) * const.E
-    bt_sigma = _bt(sigma_eff, B)  # B^T D eps, (n_el, n_q, n_u)
-    f_u = np.einsum("eqi,eq->ei", bt_sigma, w_sec)
+    bt_sigma, f_u, out_tangent[:, :nu, :nu] = _secant_equilibrium(B, const, w, ue, omega)
     f_eq = (w * eq) @ N
     f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
-    out_tangent[:, :nu, :nu] = _btdb(B * w_sec[..., None, None], const.DB)
     w_ue = -(w * const.E * d_omega * loading)
     out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
     out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
@@ -105,11 +109,7 @@ def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent
     eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
     kappa, loading = update_history(kappa_old, eq)
     omega, d_omega = _damage(params, const, kappa)
-    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
-    w_sec = w * (1.0 - omega) * const.E
-    bt_sigma = _bt(sigma_eff, B)
-    f_u = np.einsum("eqi,eq->ei", bt_sigma, w_sec)
-    secant = _btdb(B * w_sec[..., None, None], const.DB)
+    bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
     softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1), _bt(d_eq, B))
     out_tangent[:] = secant - softening
     return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)

@@ -7,7 +7,8 @@ import numpy as np
 from fracid.model.damage import kappa_at_damage
 
 
-def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool, along_range=(-np.inf, np.inf)) -> float:
+def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool, along_range=(-np.inf, np.inf),
+              spacing=None) -> float:
     """Largest extent, across the crack path, of the zone where kappa exceeds ``kappa_threshold``.
 
     The crack path is the line ``x_axis = 0`` (a symmetry line of the model). Integration points
@@ -28,6 +29,9 @@ def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool, along_ran
         Whether only one side of the path is modelled.
     along_range : (float, float)
         Part of the path considered [mm] (the ligament: damage at supports or platens is not FPZ).
+    spacing : callable, optional
+        ``_half_spacing`` of the points' distances from the path, when the caller has it already
+        (the points do not change during an analysis).
     """
     along = points[:, 1 - axis]
     damaged = (kappa > kappa_threshold) & (along >= along_range[0]) & (along <= along_range[1])
@@ -37,7 +41,8 @@ def fpz_width(points, kappa, kappa_threshold, axis: int, mirror: bool, along_ran
     # the bands are the distinct positions of points along the path (structured meshes)
     bands, band = np.unique(np.round(along[damaged], 9), return_inverse=True)
     extent = np.zeros(bands.size)
-    np.maximum.at(extent, band, across[damaged] + _half_spacing(across)(across[damaged]))
+    spacing = spacing or _half_spacing(across)
+    np.maximum.at(extent, band, across[damaged] + spacing(across[damaged]))
     width = float(extent.max())
     return 2.0 * width if mirror else width
 
@@ -54,7 +59,12 @@ def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool,
     """Observer f(problem, q, arrays) -> FPZ width [mm] for :func:`~fracid.model.path_following.follow_path`."""
     kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
 
+    cache = {}  # per problem: the points and their spacing across the path, computed once
+
     def observe(problem, q, arrays):
-        return fpz_width(problem.disc.points.reshape(-1, 2), arrays.kappa.ravel(), kappa_t, axis, mirror, along_range)
+        if cache.get("problem") is not problem:
+            points = problem.disc.points.reshape(-1, 2)
+            cache.update(problem=problem, points=points, spacing=_half_spacing(np.abs(points[:, axis])))
+        return fpz_width(cache["points"], arrays.kappa.ravel(), kappa_t, axis, mirror, along_range, cache["spacing"])
 
     return observe
