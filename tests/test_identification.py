@@ -154,3 +154,24 @@ def test_global_and_local_blocks_from_experimental_data(bar_operator):
     assert abs(res.correlation[0, 1]) < abs(global_only.correlation[0, 1])
     with pytest.raises(ValueError, match="data hold"):
         identify_data(bar_operator, data, SPACE)
+
+
+def test_force_and_local_data_of_one_test_share_one_forward_run(monkeypatch):
+    import fracid.inverse.forward_operator as fo
+
+    both = ForwardOperator([Observation(BAR, POINTS, name="global"),
+                            Observation(fracid.BarWithWeakZone(n_elements=100), POINTS[4:],
+                                        quantity="damaged_zone_width", name="local", damage_threshold=0.3)],
+                           fracid.DamageParameters(), ("c", "beta"))
+    separate = [ForwardOperator([obs], fracid.DamageParameters(), ("c", "beta")) for obs in both.observations]
+    calls = []
+    original = fo.simulate
+    monkeypatch.setattr(fo, "simulate", lambda *a, **kw: calls.append(kw) or original(*a, **kw))
+    y = both(TRUTH).y
+    assert len(calls) == 1 and calls[0]["damage_threshold"] == 0.3  # equal frozen specimens: one run
+    np.testing.assert_allclose(y, np.concatenate([op(TRUTH).y for op in separate]), rtol=1e-9)
+    assert len(calls) == 3
+    # a threshold changes the measured width, so it is part of the observation
+    loose = ForwardOperator([Observation(BAR, POINTS[4:], quantity="damaged_zone_width")], fracid.DamageParameters(),
+                            ("c", "beta"))
+    assert np.all(loose(TRUTH).y >= y[16:]) and np.any(loose(TRUTH).y > y[16:])

@@ -36,6 +36,11 @@ class Observation:
         The specimen's control quantity (its default if None).
     name : str
         Label of the block.
+    damage_threshold : float
+        Damage above which a point counts in a local width observable [-] (0: any damage).
+
+    Observations of the same specimen object, control and threshold share one forward run (the
+    force curve and the FPZ width of one test come from the same analysis).
     """
 
     specimen: object
@@ -43,6 +48,16 @@ class Observation:
     quantity: str = "force"
     control: str | None = None
     name: str = "global"
+    damage_threshold: float = 0.0
+
+    @property
+    def run_key(self) -> tuple:
+        """Observations with equal keys are computed by one forward run."""
+        try:
+            specimen = (hash(self.specimen), self.specimen)  # equal frozen specimens share a run
+        except TypeError:
+            specimen = id(self.specimen)
+        return (specimen, self.control, self.damage_threshold)
 
     def __post_init__(self):
         points = np.asarray(self.control_points, dtype=float)
@@ -132,34 +147,43 @@ class ForwardOperator:
         """Evaluate h(x); only the first ``needed`` outputs are guaranteed (runs stop early)."""
         start = time.perf_counter()
         x = np.asarray(x, dtype=float)
-        y = np.full(self.n_outputs, np.nan)
-        record = RunRecord(x=x, y=y)
+        record = RunRecord(x=x, y=np.full(self.n_outputs, np.nan))
         try:
             params = self.parameters(x)
         except ValueError as err:
             record.status, record.error = "failed", f"invalid parameters: {err}"
             return record
         limit = self.n_outputs if needed is None else int(needed)
-        for obs, part in zip(self.observations, self.slices()):
-            if part.start >= limit:
-                break
-            last = min(part.stop, limit) - part.start  # points of this block that are needed
-            target = float(obs.control_points[last - 1])
-            run, error, retried = self._run(obs, params, target, obs.control_points[:last])
-            record.retried |= retried
-            if run is None:
-                record.status, record.error = "failed", error
-                record.reached.append(0.0)
-                break
-            record.reached.append(float(run.control[-1]))
-            x_run = run.control
-            values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
-            y[part.start : part.start + last] = np.interp(obs.control_points[:last], x_run, values)
-            if error:
-                record.status, record.error = "failed", error
+        for group in self._run_groups(limit):
+            if not self._fill(record, group, params, limit):
                 break
         record.seconds = time.perf_counter() - start
         return record
+
+    def _run_groups(self, limit):
+        """Needed observations (obs, slice) grouped by shared run, in order of first appearance."""
+        groups = {}
+        for obs, part in zip(self.observations, self.slices()):
+            if part.start < limit:
+                groups.setdefault(obs.run_key, []).append((obs, part))
+        return list(groups.values())
+
+    def _fill(self, record, group, params, limit) -> bool:
+        """Run one group's analysis to its largest needed control value and sample its blocks."""
+        wanted = [obs.control_points[: min(part.stop, limit) - part.start] for obs, part in group]
+        checkpoints = np.unique(np.concatenate(wanted))
+        lead = group[0][0]
+        run, error, retried = self._run(lead, params, float(checkpoints[-1]), checkpoints)
+        record.retried |= retried
+        if run is None:
+            record.status, record.error = "failed", error
+            record.reached.append(0.0)
+            return False
+        record.reached.append(float(run.control[-1]))
+        for (obs, part), points in zip(group, wanted):
+            values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
+            record.y[part.start : part.start + points.size] = np.interp(points, run.control, values)
+        return True
 
     def _run(self, obs, params, target, checkpoints):
         """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
@@ -168,7 +192,7 @@ class ForwardOperator:
             try:
                 result = simulate(obs.specimen, params, regularization=self.regularization, control=obs.control,
                                   target=target, stop_force_fraction=None, steps=steps, field_steps=None,
-                                  checkpoints=checkpoints)
+                                  checkpoints=checkpoints, damage_threshold=obs.damage_threshold)
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)

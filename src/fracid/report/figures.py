@@ -390,3 +390,72 @@ def sensitivity_figure(history, control=None) -> Figure:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     return fig
+
+
+# ------------------------------------------------------------------------------------ size effect
+
+
+def size_effect_figure(sizes, sigma_computed, fit=None, sigma_measured=None, measured_std=None,
+                       calibrated=None) -> Figure:
+    """Nominal strength against size on log-log axes, with Bazant's size effect law when fitted.
+
+    Parameters
+    ----------
+    sizes : array_like
+        Specimen sizes D [mm].
+    sigma_computed : array_like
+        Computed nominal strengths at ``sizes`` [MPa]; nan (a failed run) is left out.
+    fit : SizeEffectFit, optional
+        Drawn as the law over the sizes' range, with its asymptotes: the strength criterion
+        sigma_N = B f_t and LEFM sigma_N = B f_t sqrt(D0 / D) (slope -1/2), which cross at D0.
+    sigma_measured, measured_std : array_like, optional
+        Measured nominal strengths at ``sizes`` and their standard deviations [MPa] (error bars of
+        +/- 1 std); nan where a size was not tested.
+    calibrated : array_like of bool, optional
+        True for the sizes whose data calibrated the model: their computed points are filled,
+        those of the other (predicted) sizes hollow. None: no distinction.
+    """
+    D = _float_array(sizes, np.nan)
+    computed = _float_array(sigma_computed, np.nan)
+    if computed.shape != D.shape:
+        raise ValueError(f"sigma_computed has {computed.size} values but sizes has {D.size}")
+    fig = _new_figure(6.4, 4.6)
+    ax = fig.subplots()
+    shown = [computed]
+    if fit is not None:
+        _size_effect_law(ax, fit, D)
+    if sigma_measured is not None:
+        measured = _float_array(sigma_measured, np.nan)
+        std = None if measured_std is None else _float_array(measured_std, np.nan)
+        shown.append(measured)
+        ax.errorbar(D, measured, yerr=std, fmt="s", color=_MEASURED, ms=6, capsize=3,
+                    label="measured" + (" +/- 1 std" if std is not None else ""))
+    if calibrated is None:
+        ax.plot(D, computed, "o", color=_COMPUTED, ms=7, label="computed")
+    else:
+        used = np.asarray(calibrated, dtype=bool)
+        if used.shape != D.shape:
+            raise ValueError(f"calibrated has {used.size} values but sizes has {D.size}; give one flag per size")
+        ax.plot(D[used], computed[used], "o", color=_COMPUTED, ms=7, label="computed, calibration sizes")
+        ax.plot(D[~used], computed[~used], "o", mfc="white", mec=_COMPUTED, mew=1.6, ms=7,
+                label="computed, predicted sizes")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if fit is not None:
+        # the LEFM line grows without bound as D -> 0: cap the axis just above the law and the points
+        ax.set_ylim(top=1.6 * np.nanmax(np.concatenate([[fit.B_ft], *shown])))
+    ax.set_xlabel("size D [mm]")
+    ax.set_ylabel("nominal strength sigma_N [MPa]")
+    ax.grid(True, which="both", alpha=0.25)
+    ax.legend(fontsize="small", loc="lower left")
+    return fig
+
+
+def _size_effect_law(ax, fit, D) -> None:
+    """The fitted law and its two asymptotes over a range wide enough to show where they meet."""
+    span = np.concatenate([D[np.isfinite(D) & (D > 0)], [fit.D0]])
+    grid = np.geomspace(span.min() / 2.0, span.max() * 2.0, 200)
+    ax.plot(grid, fit.predict(grid), "-", color=_ESTIMATE, lw=1.6,
+            label=f"size effect law: B f_t = {fit.B_ft:.3g} MPa, D0 = {fit.D0:.3g} mm")
+    ax.axhline(fit.B_ft, color="k", lw=0.9, ls="--", label="strength criterion")
+    ax.plot(grid, fit.B_ft * np.sqrt(fit.D0 / grid), "k-.", lw=0.9, label="LEFM, slope -1/2")
