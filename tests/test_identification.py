@@ -169,7 +169,8 @@ def test_force_and_local_data_of_one_test_share_one_forward_run(monkeypatch):
     monkeypatch.setattr(fo, "simulate", lambda *a, **kw: calls.append(kw) or original(*a, **kw))
     y = both(TRUTH).y
     assert len(calls) == 1 and calls[0]["damage_threshold"] == 0.3  # equal frozen specimens: one run
-    np.testing.assert_allclose(y, np.concatenate([op(TRUTH).y for op in separate]), rtol=1e-9)
+    # equal up to the Newton tolerance: the shared run also stops at the force block's checkpoints
+    np.testing.assert_allclose(y, np.concatenate([op(TRUTH).y for op in separate]), rtol=1e-4)
     assert len(calls) == 3
     # a threshold changes the measured width, so it is part of the observation
     loose = ForwardOperator([Observation(BAR, POINTS[4:], quantity="damaged_zone_width")], fracid.DamageParameters(),

@@ -52,18 +52,15 @@ class Observation:
 
     @property
     def run_key(self) -> tuple:
-        """Observations with equal keys are computed by one forward run."""
+        """(specimen, control, threshold): observations with compatible keys share one forward run.
+
+        The force does not depend on the threshold, so a force observation has threshold None.
+        """
         try:
             specimen = (hash(self.specimen), self.specimen)  # equal frozen specimens share a run
         except TypeError:
             specimen = id(self.specimen)
-        return (specimen, self.control, self.damage_threshold)
-
-    def __post_init__(self):
-        points = np.asarray(self.control_points, dtype=float)
-        if points.ndim != 1 or points.size == 0 or np.any(np.diff(points) <= 0) or points[0] <= 0:
-            raise ValueError(f"observation {self.name!r}: control points must be positive and increasing")
-        object.__setattr__(self, "control_points", points)
+        return (specimen, self.control, None if self.quantity == "force" else self.damage_threshold)
 
 
 @dataclass
@@ -154,26 +151,33 @@ class ForwardOperator:
             record.status, record.error = "failed", f"invalid parameters: {err}"
             return record
         limit = self.n_outputs if needed is None else int(needed)
-        for group in self._run_groups(limit):
-            if not self._fill(record, group, params, limit):
+        for threshold, group in self._run_groups(limit):
+            if not self._fill(record, group, params, limit, threshold):
                 break
         record.seconds = time.perf_counter() - start
         return record
 
     def _run_groups(self, limit):
         """Needed observations (obs, slice) grouped by shared run, in order of first appearance."""
-        groups = {}
+        groups = []  # [(specimen, control), threshold or None, members]
         for obs, part in zip(self.observations, self.slices()):
-            if part.start < limit:
-                groups.setdefault(obs.run_key, []).append((obs, part))
-        return list(groups.values())
+            if part.start >= limit:
+                continue
+            *test, threshold = obs.run_key
+            for group in groups:
+                if group[0] == test and (group[1] == threshold or None in (group[1], threshold)):
+                    group[1] = threshold if group[1] is None else group[1]
+                    group[2].append((obs, part))
+                    break
+            else:
+                groups.append([test, threshold, [(obs, part)]])
+        return [(threshold or 0.0, members) for _, threshold, members in groups]
 
-    def _fill(self, record, group, params, limit) -> bool:
+    def _fill(self, record, group, params, limit, threshold) -> bool:
         """Run one group's analysis to its largest needed control value and sample its blocks."""
         wanted = [obs.control_points[: min(part.stop, limit) - part.start] for obs, part in group]
         checkpoints = np.unique(np.concatenate(wanted))
-        lead = group[0][0]
-        run, error, retried = self._run(lead, params, float(checkpoints[-1]), checkpoints)
+        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold)
         record.retried |= retried
         if run is None:
             record.status, record.error = "failed", error
@@ -185,14 +189,14 @@ class ForwardOperator:
             record.y[part.start : part.start + points.size] = np.interp(points, run.control, values)
         return True
 
-    def _run(self, obs, params, target, checkpoints):
+    def _run(self, obs, params, target, checkpoints, threshold):
         """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
         error = ""
         for attempt, steps in enumerate(self._step_rules(obs, target)):
             try:
                 result = simulate(obs.specimen, params, regularization=self.regularization, control=obs.control,
                                   target=target, stop_force_fraction=None, steps=steps, field_steps=None,
-                                  checkpoints=checkpoints, damage_threshold=obs.damage_threshold)
+                                  checkpoints=checkpoints, damage_threshold=threshold)
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)

@@ -19,6 +19,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
 
 from fracid.model.parameters import DamageParameters
 
@@ -428,7 +429,7 @@ def size_effect_figure(sizes, sigma_computed, fit=None, sigma_measured=None, mea
         measured = _float_array(sigma_measured, np.nan)
         std = None if measured_std is None else _float_array(measured_std, np.nan)
         shown.append(measured)
-        ax.errorbar(D, measured, yerr=std, fmt="s", color=_MEASURED, ms=6, capsize=3,
+        ax.errorbar(D, measured, yerr=std, fmt="s", color=_MEASURED, mfc="none", ms=9, capsize=3,
                     label="measured" + (" +/- 1 std" if std is not None else ""))
     if calibrated is None:
         ax.plot(D, computed, "o", color=_COMPUTED, ms=7, label="computed")
@@ -441,14 +442,29 @@ def size_effect_figure(sizes, sigma_computed, fit=None, sigma_measured=None, mea
                 label="computed, predicted sizes")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    _plain_log_ticks(ax.xaxis)
+    _plain_log_ticks(ax.yaxis)
     if fit is not None:
         # the LEFM line grows without bound as D -> 0: cap the axis just above the law and the points
         ax.set_ylim(top=1.6 * np.nanmax(np.concatenate([[fit.B_ft], *shown])))
     ax.set_xlabel("size D [mm]")
     ax.set_ylabel("nominal strength sigma_N [MPa]")
     ax.grid(True, which="both", alpha=0.25)
-    ax.legend(fontsize="small", loc="lower left")
+    ax.legend(fontsize="small", loc="best")
     return fig
+
+
+def _plain_log_ticks(axis) -> None:
+    """Plain numbers (0.8, 2, 1000) on a log axis rather than powers of ten; the minor ticks are
+    labelled only when the axis spans less than a decade (a strength axis often does), as there
+    are then at most eight of them."""
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+
+    def minor(value, _):
+        low, high = axis.get_view_interval()
+        return f"{value:g}" if high < 10.0 * low else ""
+
+    axis.set_minor_formatter(FuncFormatter(minor))
 
 
 def _size_effect_law(ax, fit, D) -> None:
