@@ -288,3 +288,21 @@ def test_gregoire_bundled_data():
     assert any("s = (max - min)/4 from the min/max envelope" in note for note in data.notes)
     assert any("1 backtracking point dropped" in note and "row 3" in note for note in data.notes)
     assert np.all(data.std > 0)
+
+
+def test_block_weights_scale_the_objective_of_their_block():
+    from fracid.data import ExperimentalData, DataError
+    from fracid.inverse.knn import objective
+
+    data = ExperimentalData([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], np.diag([0.1, 0.2, 0.3]),
+                            (("global", 0, 2), ("local", 2, 3)))
+    y = np.array([[1.5, 2.5, 3.5]])
+    f_global, f_local = (objective(data.y[s], data.covariance[s, s], y[:, s])[0]
+                         for s in (slice(0, 2), slice(2, 3)))
+    weighted = data.weighted({"global": 0.5, "local": 4.0})
+    assert objective(weighted.y, weighted.covariance, y)[0] == pytest.approx(0.5 * f_global + 4.0 * f_local)
+    assert any("'local' weighted p = 4" in note for note in weighted.notes)
+    with pytest.raises(DataError, match="'fpz'"):
+        data.weighted({"fpz": 2.0})
+    with pytest.raises(DataError, match="-1"):
+        data.weighted({"local": -1.0})

@@ -20,7 +20,7 @@ import math
 import operator
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 
@@ -105,6 +105,28 @@ class ExperimentalData:
     def std(self) -> np.ndarray:
         """Standard deviation of each entry, sqrt(diag(covariance)) [N or the local unit]."""
         return np.sqrt(np.diag(self.covariance))
+
+    def weighted(self, weights: dict) -> "ExperimentalData":
+        """The data with block weights p_b: f = sum_b p_b f_b (SPEC 3, e.g. p1 global, p2 local).
+
+        The objective f = r^T C^-1 r of a block times p_b is the objective with its covariance
+        divided by p_b, so the Kalman filter and KNN see the same weighting.
+
+        Parameters
+        ----------
+        weights : dict of str -> float
+            Block name -> p_b > 0; blocks not named keep p = 1.
+        """
+        scale = np.ones(self.n_y)
+        names = [b[0] for b in self.blocks]
+        for name, p in weights.items():
+            if name not in names:
+                raise DataError(f"weight for block {name!r}: no such block; blocks: {', '.join(names)}")
+            if not (np.isfinite(p) and p > 0):
+                raise DataError(f"weight of block {name!r} = {p!r}: it must be a number > 0")
+            scale[self.block(name)] = 1.0 / np.sqrt(p)
+        notes = [f"block {name!r} weighted p = {p:g} (covariance divided by p)" for name, p in weights.items() if p != 1]
+        return replace(self, covariance=self.covariance * np.outer(scale, scale), notes=self.notes + tuple(notes))
 
     def block(self, name: str) -> slice:
         """Slice of ``y`` holding the block ``name``."""
