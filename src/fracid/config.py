@@ -72,6 +72,15 @@ present they are always validated. Every other key is optional unless marked *re
     quantity = "force"                  # "force" (default) or a local observable of the specimen:
                                         #   notched-beam, dogbone: "fpz_width"; bar: "damaged_zone_width"
     name = "global"                     # block name; default "global" (force) or the quantity's name
+    specimen = { size = 200.0 }         # optional: fields of [specimen] overridden for this test (a size
+                                        #   series: one block per size); blocks of the same specimen
+                                        #   share one forward run
+    weight = 1.0                        # optional p_b > 0: f = sum p_b f_b (global p1, local p2); the
+                                        #   block's covariance is divided by p_b
+    damage_threshold = 0.5              # optional, local quantity only: 0 <= t < 1, damage counted in
+                                        #   the width (default 0: any damage)
+    role = "calibration"                # "calibration" (default) | "prediction": predicted at the
+                                        #   estimate by `fracid study`, not calibrated on
 
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: model parameters to identify, no duplicates
@@ -92,6 +101,13 @@ present they are always validated. Every other key is optional unless marked *re
     max_iterations = 10                 # integer >= 1, default 10
     tol = 0.01                          # > 0, in standard deviations, default 0.01
     restart = "linearize"               # "linearize" (default) | "prior-mean"
+
+    [study]                             # optional: the checks of `fracid study`
+    starts = 3                          # multi-start Kalman filters from distinct population points
+                                        #   (0 or 1: no check), default 3
+    replicates = 5                      # identifications on data with noise added (0: none; else >= 2)
+    seed = 0                            # seed of the replicates' noise, default 0
+    tolerance = 0.1                     # largest relative std called "identified", default 0.1
 
     [output]                            # optional
     directory = "results"               # default "results", relative to this file unless absolute
@@ -147,6 +163,9 @@ __all__ = [
     "identify_settings",
     "load_config",
     "simulate_settings",
+    "build_held_out",
+    "study_settings",
+    "StudyConfig",
 ]
 
 
@@ -187,11 +206,11 @@ _SPECIMENS = {
     "bar": (("end_displacement", "weak_zone_elongation"), ("damaged_zone_width",)),
 }
 
-_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate")
+_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study")
 _MODEL_KEYS = ("type", "parameters")
 _EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                     "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
-                    "name")
+                    "name", "specimen", "weight", "damage_threshold", "role")
 _KIND_KEYS = {
     "repeats": ("force_columns",),
     "envelope": ("mean_column", "lower_column", "upper_column"),
@@ -202,6 +221,8 @@ _KNN_KEYS = ("n", "method", "k", "seed")
 _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
+_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance")
+_ROLES = ("calibration", "prediction")
 
 
 # ------------------------------------------------------------------------------ validated config
@@ -249,6 +270,10 @@ class ExperimentConfig:
     control_range: tuple | None = None  # in control_unit, as given
     quantity: str = "force"
     name: str = "global"
+    specimen: tuple = ()  # ((field, value), ...) overriding [specimen] for this test (e.g. its size)
+    weight: float = 1.0
+    damage_threshold: float = 0.0
+    role: str = "calibration"
 
     @property
     def control_scale(self) -> float:
@@ -322,6 +347,16 @@ class SimulateConfig:
 
 
 @dataclass(frozen=True)
+class StudyConfig:
+    """``[study]``: multi-start points, noisy replicates, their seed, and the tolerance of the verdict."""
+
+    starts: int = 3
+    replicates: int = 5
+    seed: int = 0
+    tolerance: float = 0.1
+
+
+@dataclass(frozen=True)
 class Config:
     """A validated configuration (see the module docstring for the schema)."""
 
@@ -333,6 +368,7 @@ class Config:
     identify: IdentifyConfig | None
     output: OutputConfig
     simulate: SimulateConfig
+    study: StudyConfig = StudyConfig()
 
     @property
     def base_dir(self) -> Path:
@@ -340,9 +376,14 @@ class Config:
         return self.path.parent
 
     @property
+    def calibration(self) -> tuple:
+        """The experiments used for calibration (role "calibration")."""
+        return tuple(e for e in self.experiments if e.role == "calibration")
+
+    @property
     def n_y(self) -> int:
-        """Number of measured values (sum of the blocks' n_points)."""
-        return sum(e.n_points for e in self.experiments)
+        """Number of measured values used for calibration (sum of their blocks' n_points)."""
+        return sum(e.n_points for e in self.calibration)
 
 
 # ---------------------------------------------------------------------------------- validation
@@ -489,6 +530,38 @@ def _specimen_error_key(message: str, fields, given) -> str | None:
     return found[0][1] if found else None
 
 
+def _specimen_options(ck: _Checker, prefix: str, raw: dict, cls) -> dict:
+    """Type-check specimen fields (``raw`` holds field names only)."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    options = {}
+    for name, value in raw.items():
+        key, ftype = f"{prefix}.{name}", _field_kind(fields[name])
+        if ftype == "float":
+            options[name] = ck.number(key, value, f"must be a number (field {name} of {cls.__name__})")
+        elif ftype == "int":
+            options[name] = ck.integer(key, value, f"must be an integer (field {name} of {cls.__name__})")
+        elif ftype == "str":
+            options[name] = ck.string(key, value, f"must be a string (field {name} of {cls.__name__})")
+        else:
+            options[name] = value
+    return options
+
+
+def _check_specimen(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+    """Build the specimen once so its own validation runs; errors name the key under ``prefix``."""
+    try:
+        cls(**options)
+    except (TypeError, ValueError) as err:
+        fields = {f.name: f for f in dataclasses.fields(cls)}
+        name = _specimen_error_key(str(err), fields, options)
+        if name is None:
+            raise ConfigError(f"{ck.path}: {prefix} ({kind}) is invalid: {err}") from None
+        value = options.get(name, getattr(cls, name, None))
+        where = f"{prefix}.{name}" if name in given else f"specimen.{name}"
+        default = "" if name in options else " (default)"
+        raise ConfigError(f"{ck.path}: {where} = {_show(value)}{default}: {err}") from None
+
+
 def _specimen(ck: _Checker, raw) -> SpecimenConfig:
     if raw is None:
         ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in _SPECIMENS))
@@ -502,28 +575,8 @@ def _specimen(ck: _Checker, raw) -> SpecimenConfig:
     ck.table("specimen", raw, ("type", "control", *fields))
     controls, _ = _SPECIMENS[kind]
     control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
-    options = {}
-    for name, value in raw.items():
-        if name in ("type", "control"):
-            continue
-        key, ftype = f"specimen.{name}", _field_kind(fields[name])
-        if ftype == "float":
-            options[name] = ck.number(key, value, f"must be a number (field {name} of {cls.__name__})")
-        elif ftype == "int":
-            options[name] = ck.integer(key, value, f"must be an integer (field {name} of {cls.__name__})")
-        elif ftype == "str":
-            options[name] = ck.string(key, value, f"must be a string (field {name} of {cls.__name__})")
-        else:
-            options[name] = value
-    try:
-        cls(**options)
-    except (TypeError, ValueError) as err:
-        name = _specimen_error_key(str(err), fields, options)
-        if name is None:
-            raise ConfigError(f"{ck.path}: specimen ({kind}) is invalid: {err}") from None
-        value = options.get(name, getattr(cls, name, None))
-        given = "" if name in options else " (default)"
-        raise ConfigError(f"{ck.path}: specimen.{name} = {_show(value)}{given}: {err}") from None
+    options = _specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
+    _check_specimen(ck, "specimen", kind, cls, options, options)
     return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
 
 
@@ -610,9 +663,27 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
         control_range = (a, b)
     default_name = "global" if quantity == "force" else quantity
     name = ck.string(f"{prefix}.name", raw.get("name", default_name), "must be a non-empty string")
+    overrides = ()
+    if "specimen" in raw:
+        cls = _specimen_class(specimen.type)
+        fields = [f.name for f in dataclasses.fields(cls)]
+        given = _specimen_options(ck, f"{prefix}.specimen", ck.table(f"{prefix}.specimen", raw["specimen"], fields), cls)
+        _check_specimen(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)
+        overrides = tuple(given.items())
+    weight = ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0 (p in f = sum p_b f_b)",
+                       lambda v: v > 0)
+    threshold = 0.0
+    if "damage_threshold" in raw:
+        if quantity == "force":
+            ck.fail(f"{prefix}.damage_threshold", raw["damage_threshold"],
+                    "applies to a local quantity only (this block's quantity is 'force')")
+        threshold = ck.number(f"{prefix}.damage_threshold", raw["damage_threshold"],
+                              "must be a number with 0 <= t < 1 (damage counted in the width)", lambda v: 0 <= v < 1)
+    role = ck.choice(f"{prefix}.role", raw.get("role", "calibration"), _ROLES)
     return ExperimentConfig(index=i, file=file, control_column=control_column, control_unit=control_unit,
                             force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
-                            quantity=quantity, name=name, **options)
+                            quantity=quantity, name=name, specimen=overrides, weight=weight,
+                            damage_threshold=threshold, role=role, **options)
 
 
 _REQUIRED_TEXT = {
@@ -752,6 +823,20 @@ def _simulate(ck: _Checker, raw) -> SimulateConfig:
     )
 
 
+def _study(ck: _Checker, raw) -> StudyConfig:
+    raw = ck.table("study", {} if raw is None else raw, _STUDY_KEYS)
+    return StudyConfig(
+        starts=ck.integer("study.starts", raw.get("starts", 3), "must be an integer >= 0 (0 or 1: no multi-start check)",
+                          lambda v: v >= 0),
+        replicates=ck.integer("study.replicates", raw.get("replicates", 5),
+                              "must be 0 (no stability check) or an integer >= 2", lambda v: v == 0 or v >= 2),
+        seed=ck.integer("study.seed", raw.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0),
+        tolerance=ck.number("study.tolerance", raw.get("tolerance", 0.1),
+                            "must be a number with 0 < t < 1 (largest relative std called identified)",
+                            lambda v: 0 < v < 1),
+    )
+
+
 def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config:
     """Read and validate a TOML configuration.
 
@@ -782,12 +867,15 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     model = _model(ck, raw.get("model"))
     specimen = _specimen(ck, raw.get("specimen"))
     experiments = _experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
-    n_y = sum(e.n_points for e in experiments) or None
+    n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
+    if experiments and not n_y and purpose == "identify":
+        ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
     identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify")
     output = _output(ck, raw.get("output"), base)
     simulate = _simulate(ck, raw.get("simulate"))
+    study = _study(ck, raw.get("study"))
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
-                  identify=identify, output=output, simulate=simulate)
+                  identify=identify, output=output, simulate=simulate, study=study)
 
 
 # ------------------------------------------------------------------------------------ builders
@@ -806,9 +894,13 @@ def build_parameters(cfg: Config) -> DamageParameters:
     return DamageParameters(**dict(cfg.model.parameters))
 
 
-def build_specimen(cfg: Config):
-    """The specimen object (NotchedBeam, DogBone or BarWithWeakZone) with the fields given."""
-    return _specimen_class(cfg.specimen.type)(**dict(cfg.specimen.options))
+def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
+    """The specimen object (NotchedBeam, DogBone or BarWithWeakZone) with the fields given; with an
+    experiment, its ``specimen`` overrides applied (e.g. the size of one specimen of a series)."""
+    options = dict(cfg.specimen.options)
+    if experiment is not None:
+        options.update(dict(experiment.specimen))
+    return _specimen_class(cfg.specimen.type)(**options)
 
 
 def _experiment_data(exp: ExperimentConfig):
@@ -830,8 +922,22 @@ def _experiment_data(exp: ExperimentConfig):
     return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True)
 
 
+def _stacked_data(cfg: Config, experiments):
+    from fracid.data import DataError, stack
+
+    blocks = []
+    for exp in experiments:
+        try:
+            block = _experiment_data(exp)
+            blocks.append(block.weighted({exp.name: exp.weight}) if exp.weight != 1.0 else block)
+        except DataError as err:
+            raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
+    return blocks[0] if len(blocks) == 1 else stack(*blocks)
+
+
 def build_data(cfg: Config):
-    """The measured data: one block per ``[[experiments]]`` entry, stacked in order.
+    """The calibration data: one block per ``[[experiments]]`` entry with role "calibration",
+    stacked in order, each block's covariance divided by its ``weight``.
 
     Raises
     ------
@@ -839,40 +945,55 @@ def build_data(cfg: Config):
         Wrapping any :class:`fracid.data.DataError` (bad rows, a range beyond the data, ...) with
         ``experiments[i]`` and the file named.
     """
-    from fracid.data import DataError, stack
-
-    blocks = []
-    for exp in _require(cfg, "experiments"):
-        try:
-            blocks.append(_experiment_data(exp))
-        except DataError as err:
-            raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
-    return blocks[0] if len(blocks) == 1 else stack(*blocks)
+    _require(cfg, "experiments")
+    return _stacked_data(cfg, cfg.calibration)
 
 
-def build_operator(cfg: Config, data):
-    """The forward operator: one Observation per experiment block, at the data's control points.
-
-    ``data`` is the result of :func:`build_data` (its blocks line up with ``[[experiments]]``).
-    """
+def _operator(cfg: Config, experiments, data):
     from fracid.inverse.forward_operator import ForwardOperator, Observation
 
-    experiments = _require(cfg, "experiments")
     identify = _require(cfg, "identify")
     if len(data.blocks) != len(experiments):
         raise ConfigError(f"{cfg.path}: experiments: the data hold {len(data.blocks)} blocks but the configuration "
-                          f"has {len(experiments)} [[experiments]] entries; build the data with build_data(cfg)")
-    specimen = build_specimen(cfg)
+                          f"has {len(experiments)} such [[experiments]] entries; build the data with build_data(cfg)")
     observations = []
     for exp, (name, start, stop) in zip(experiments, data.blocks):
         try:
-            observations.append(Observation(specimen, data.control[start:stop], quantity=exp.quantity,
-                                            control=cfg.specimen.control, name=name))
+            observations.append(Observation(build_specimen(cfg, exp), data.control[start:stop], quantity=exp.quantity,
+                                            control=cfg.specimen.control, name=name,
+                                            damage_threshold=exp.damage_threshold))
         except ValueError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
                               f"{_show(exp.control_range and list(exp.control_range))}: {err}") from None
     return ForwardOperator(observations, build_parameters(cfg), identify.parameters,
                            regularization=cfg.model.regularization)
+
+
+def build_operator(cfg: Config, data):
+    """The forward operator: one Observation per calibration experiment, at the data's control points.
+
+    ``data`` is the result of :func:`build_data` (its blocks line up with the calibration
+    ``[[experiments]]``). Blocks of the same specimen share one forward run.
+    """
+    _require(cfg, "experiments")
+    return _operator(cfg, cfg.calibration, data)
+
+
+def build_held_out(cfg: Config) -> list:
+    """(operator, data) per experiment with role "prediction": data predicted, not calibrated on."""
+    held = [e for e in cfg.experiments if e.role == "prediction"]
+    out = []
+    for exp in held:
+        data = _stacked_data(cfg, [exp])
+        out.append((_operator(cfg, [exp], data), data))
+    return out
+
+
+def study_settings(cfg: Config) -> dict:
+    """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``."""
+    study = cfg.study
+    return {**identify_settings(cfg), "starts": study.starts, "replicates": study.replicates,
+            "noise_seed": study.seed, "tolerance": study.tolerance}
 
 
 def build_space(cfg: Config):

@@ -111,7 +111,16 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
     y_exp, C_exp = np.asarray(y_exp, float), np.asarray(C_exp, float)
     knn = knn_search(operator, y_exp, C_exp, space, n=n, method=method, seed=seed, k=k, executor=executor,
                      store=store, progress=progress)
-    bounds = DamageParameters.valid_bounds(space.names)
+    return refine(operator, y_exp, C_exp, knn, groups=groups, max_iterations=max_iterations, tol=tol,
+                  restart=restart, executor=executor, blocks=blocks, notes=notes, method=method, seed=seed,
+                  started=start)
+
+
+def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0.01, restart="linearize",
+           executor=None, blocks=(), notes=(), method="", seed=0, started=None) -> IdentificationResult:
+    """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :func:`identify`."""
+    start = time.perf_counter() if started is None else started
+    bounds = DamageParameters.valid_bounds(knn.space.names)
     kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, knn.C0, groups=groups, max_iterations=max_iterations,
                            tol=tol, restart=restart, executor=executor, bounds=bounds)
     knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
@@ -120,9 +129,9 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
             "kalman_run_equivalents": kalman.run_equivalents, "kalman_iterations": kalman.iterations,
             "wall_seconds": time.perf_counter() - start}
     return IdentificationResult(
-        names=list(space.names), x=kalman.x, C=kalman.C, y_exp=y_exp, y_fit=kalman.y,
+        names=list(knn.space.names), x=kalman.x, C=kalman.C, y_exp=y_exp, y_fit=kalman.y,
         std_exp=np.sqrt(np.diag(C_exp)), blocks=list(blocks), history=kalman.history, knn=knn_summary, runs=runs,
-        notes=list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {k}",
+        notes=list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {knn.k}",
                              f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std"],
         converged=kalman.converged,
     )

@@ -1,0 +1,235 @@
+"""The identification strategy as one study (SPEC 4), ending in a verdict per parameter.
+
+KNN over a population (overview, prior) -> sensitivity along the load history at the KNN estimate
+(which stage of the test informs which parameter) -> uniqueness (valley of the objective over the
+population) -> Kalman filter -> multi-start check -> stability under noise -> prediction of data not
+used for calibration -> verdict. The sensitivities need a point, which is why they follow the KNN
+search rather than precede it; every other stage runs in the order of the thesis's strategy.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fracid.inverse.analyses import sensitivity_history
+from fracid.inverse.knn import knn_search
+from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError
+from fracid.inverse.stability import stability as stability_check
+from fracid.inverse.strategy import refine
+from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
+from fracid.inverse.verdict import DataDescription, parameter_verdicts
+from fracid.model.parameters import DamageParameters
+
+
+@dataclass
+class Prediction:
+    """Data not used for calibration, computed at the estimate.
+
+    Attributes
+    ----------
+    name : str
+    control, y_exp, std_exp : ndarray
+        The held-out data.
+    y, std : ndarray
+        Computed at the estimate, and its standard deviation from the estimate's covariance
+        (S C S^T, linearised).
+    status : str
+        "ok" or the failure reason.
+    """
+
+    name: str
+    control: np.ndarray
+    y_exp: np.ndarray
+    std_exp: np.ndarray
+    y: np.ndarray
+    std: np.ndarray
+    status: str = "ok"
+
+    @property
+    def relative_rms(self) -> float:
+        """RMS of (computed - measured) / max |measured|."""
+        return float(np.sqrt(np.mean((self.y - self.y_exp) ** 2)) / np.max(np.abs(self.y_exp)))
+
+    @property
+    def chi2_per_point(self) -> float:
+        """Mean of ((computed - measured) / sqrt(std_exp^2 + std^2))^2: about 1 when the prediction holds."""
+        return float(np.mean((self.y - self.y_exp) ** 2 / (self.std_exp**2 + self.std**2)))
+
+
+def predict(operator, data, x, C, *, executor=None, name="prediction") -> Prediction:
+    """Compute held-out data at the estimate x with the uncertainty propagated from C."""
+    nan = np.full(data.n_y, np.nan)
+    try:
+        y, S, _ = CentralDifferences()(operator, x, None, executor)
+    except ForwardRunError as err:
+        return Prediction(name, data.control, data.y, data.std, nan, nan, status=str(err))
+    std = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", S, C, S), 0.0))
+    return Prediction(name, data.control, data.y, data.std, y, std)
+
+
+def describe_data(operator) -> DataDescription:
+    """Number of specimens with a force curve and whether local data are present."""
+    sizes = {obs.run_key[0] for obs in operator.observations if obs.quantity == "force"}
+    return DataDescription(sizes=max(len(sizes), 1), local=any(o.quantity != "force" for o in operator.observations))
+
+
+@dataclass
+class StudyResult:
+    """Everything a study computed; :meth:`save` writes it, :func:`fracid.report.study` reports it."""
+
+    identification: object
+    sensitivity: object
+    maps: list
+    valley_extent: np.ndarray
+    multi_start: object
+    stability: object
+    predictions: list
+    verdict: object
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def names(self) -> list:
+        return list(self.identification.names)
+
+    def summary(self) -> str:
+        lines = ["Verdict:", self.verdict.text(DamageParameters.units())]
+        if self.predictions:
+            lines.append("Predictions of data not used for calibration:")
+            lines += [f"  {p.name}: RMS {p.relative_rms:.1%} of the peak, chi2/point {p.chi2_per_point:.2f}"
+                      for p in self.predictions if p.status == "ok"]
+            lines += [f"  {p.name}: failed ({p.status})" for p in self.predictions if p.status != "ok"]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        ident = self.identification.to_dict()
+        out = {"identification": ident, "verdict": self.verdict.as_dict(),
+               "valley_extent": dict(zip(self.names, self.valley_extent.tolist())),
+               "maps": [{"pair": list(m.names), "correlation_in_valley": m.correlation, "valley_points": int(m.valley.sum()),
+                         "level": m.level} for m in self.maps],
+               "timings_seconds": self.timings}
+        if self.sensitivity is not None:
+            out["sensitivity"] = {"normalised": self.sensitivity.normalised.tolist(),
+                                  "variance_share": self.sensitivity.variance_share.tolist(), "x": self.sensitivity.x.tolist()}
+        if self.multi_start is not None:
+            ms = self.multi_start
+            out["multi_start"] = {"starts": ms.starts.tolist(), "ends": ms.ends.tolist(), "std": ms.stds.tolist(),
+                                  "f": ms.f.tolist(), "distance_in_std": ms.distance.tolist()}
+        if self.stability is not None:
+            st = self.stability
+            out["stability"] = {"estimates": st.estimates.tolist(), "errors": st.errors, "seed": st.seed,
+                                "noise_level": st.noise_level, "scatter": st.scatter.tolist(),
+                                "relative_scatter": st.relative_scatter.tolist(),
+                                "amplification": st.amplification.tolist()}
+        out["predictions"] = [{"name": p.name, "control": p.control.tolist(), "y_exp": p.y_exp.tolist(),
+                               "y": p.y.tolist(), "std": p.std.tolist(), "status": p.status,
+                               "relative_rms": p.relative_rms if p.status == "ok" else None,
+                               "chi2_per_point": p.chi2_per_point if p.status == "ok" else None}
+                              for p in self.predictions]
+        return json.loads(json.dumps(out, allow_nan=True).replace("NaN", "null").replace("Infinity", "null"))
+
+    def save(self, directory) -> Path:
+        """Write study.json, verdict.txt and the CSV tables into ``directory``."""
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        (directory / "study.json").write_text(json.dumps(self.to_dict(), indent=1))
+        (directory / "verdict.txt").write_text(self.summary() + "\n")
+        header = ",".join(self.names)
+        ident = self.identification
+        population = np.column_stack([np.asarray(ident.knn["points"], float), np.asarray(ident.knn["f"], float)])
+        np.savetxt(directory / "population.csv", population, delimiter=",", header=header + ",f", comments="")
+        if self.sensitivity is not None:
+            table = np.column_stack([self.sensitivity.normalised, self.sensitivity.variance_share])
+            cols = [f"S_{n}" for n in self.names] + [f"variance_removed_{n}" for n in self.names]
+            np.savetxt(directory / "sensitivity.csv", table, delimiter=",", header=",".join(cols), comments="")
+        if self.stability is not None:
+            np.savetxt(directory / "stability.csv", self.stability.estimates, delimiter=",", header=header, comments="")
+        return directory
+
+
+def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates: int = 5, noise_seed: int = 0,
+              tolerance: float = 0.1, n=64, method="sobol", seed=0, k=5, groups=None, max_iterations=10, tol=0.01,
+              restart="linearize", executor=None, store=None, progress=None, log=print) -> StudyResult:
+    """Run the identification strategy with its checks and return the verdict.
+
+    Parameters
+    ----------
+    operator : ForwardOperator
+        Computes the calibration data.
+    data : ExperimentalData
+        Calibration data; its blocks line up with the operator's observations.
+    space : ParameterSpace
+        Bounds of the population; also the prior of the multi-start filters and the reference of
+        the variance removed.
+    held_out : sequence of (ForwardOperator, ExperimentalData)
+        Data not used for calibration, predicted at the estimate.
+    starts : int
+        Starting points of the multi-start check (0 or 1: skipped).
+    replicates : int
+        Noisy replicates of the stability check (0: skipped).
+    noise_seed : int
+        Seed of the replicates' noise.
+    tolerance : float
+        Largest relative standard deviation called identified.
+    n, method, seed, k, groups, max_iterations, tol, restart
+        KNN and Kalman settings, as in :func:`~fracid.inverse.strategy.identify`.
+    log : callable(str)
+        Receives one line per stage.
+    """
+    if data.y.size != operator.n_outputs:
+        raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
+    timings, clock = {}, time.perf_counter()
+
+    def stage(name):
+        nonlocal clock
+        now = time.perf_counter()
+        timings[name] = now - clock
+        clock = now
+
+    y, C = data.y, data.covariance
+    kalman = {"groups": groups, "max_iterations": max_iterations, "tol": tol, "restart": restart}
+    bounds = DamageParameters.valid_bounds(space.names)
+    C_bounds = bounds_covariance(space)
+    log(f"KNN: population of {n} ({method})")
+    knn = knn_search(operator, y, C, space, n=n, method=method, seed=seed, k=k, executor=executor, store=store,
+                     progress=progress)
+    stage("knn")
+    log("sensitivity along the load history at the KNN estimate")
+    history = sensitivity_history(operator, knn.x0, C, C_bounds, names=space.names, blocks=data.blocks,
+                                  executor=executor)
+    stage("sensitivity")
+    maps, extent = objective_maps(knn), valley_extent(knn)
+    log("Kalman filter from the KNN prior")
+    ident = refine(operator, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
+                   method=method, seed=seed, **kalman)
+    stage("kalman")
+    ms = None
+    if starts > 1:
+        points = starting_points(knn, starts)
+        log(f"multi-start check from {len(points)} starting points")
+        if len(points) > 1:
+            ms = multi_start(operator, y, C, points, C_bounds, bounds=bounds, executor=executor, **kalman)
+        stage("multi_start")
+    st = None
+    if replicates:
+        log(f"stability check: {replicates} noisy replicates")
+        st = stability_check(operator, y, C, knn.x0, knn.C0, replicates=replicates, seed=noise_seed, bounds=bounds,
+                             executor=executor, **kalman)
+        stage("stability")
+    predictions = []
+    for op, held in held_out:
+        name = ", ".join(b[0] for b in held.blocks)
+        log(f"prediction of {name}")
+        predictions.append(predict(op, held, ident.x, ident.C, executor=executor, name=name))
+    if held_out:
+        stage("prediction")
+    verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
+                                 tolerance=tolerance, multi_start=ms, stability=st)
+    return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings)
+
+
+__all__ = ["Prediction", "StudyResult", "describe_data", "predict", "run_study"]
