@@ -129,3 +129,90 @@ def test_bad_workers_option(capsys):
 def test_example_runs(example, capsys):
     runpy.run_path(str(example), run_name="__main__")
     assert capsys.readouterr().out.strip()
+
+
+BAR_SERIES = """
+[model.parameters]
+c = 1.0
+beta = 300.0
+
+[specimen]
+type = "bar"
+n_elements = 60
+{experiments}
+[identify]
+parameters = ["c", "beta"]
+[identify.bounds]
+c = [0.5, 4.0]
+beta = [100.0, 500.0]
+[identify.knn]
+n = 16
+k = 4
+[identify.kalman]
+groups = 2
+
+[study]
+starts = 2
+replicates = 2
+"""
+
+EXPERIMENT = """
+[[experiments]]
+file = "bar{L}.csv"
+control_column = "u_mm"
+control_unit = "mm"
+force_unit = "N"
+kind = "single"
+force_columns = ["F_N"]
+std = 0.02
+n_points = 10
+control_range = [{start}, {stop}]
+name = "L{L}"
+specimen = {{ length = {L}.0 }}
+role = "{role}"
+"""
+
+
+@pytest.fixture()
+def bar_series(tmp_path):
+    """Bars of three lengths with (c, beta) = (2, 250): two for calibration, one held out."""
+    blocks = []
+    for L, role in ((60, "calibration"), (100, "calibration"), (160, "prediction")):
+        bar = fracid.BarWithWeakZone(length=float(L), n_elements=60)
+        stop = 0.03 * L / 100 + 0.01
+        run = fracid.simulate(bar, fracid.DamageParameters(c=2.0, beta=250.0), target=stop, stop_force_fraction=None,
+                              checkpoints=np.linspace(0.001, stop, 40))
+        np.savetxt(tmp_path / f"bar{L}.csv", np.column_stack([run.control, run.force]), delimiter=",",
+                   header="u_mm,F_N", comments="")
+        blocks.append(EXPERIMENT.format(L=L, start=0.002, stop=round(stop, 4), role=role))
+    (tmp_path / "series.toml").write_text(BAR_SERIES.format(experiments="".join(blocks)))
+    return tmp_path / "series.toml"
+
+
+def test_study_writes_verdict_figures_predictions_and_size_effect(bar_series, tmp_path):
+    out = tmp_path / "out"
+    assert cli.main(["study", str(bar_series), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    study = json.loads((out / "study.json").read_text())
+    verdicts = {v["name"]: v for v in study["verdict"]["parameters"]}
+    assert set(verdicts) == {"c", "beta"} and all(v["status"] in ("identified", "correlated") for v in verdicts.values())
+    assert len(study["multi_start"]["ends"]) == 2 and len(study["stability"]["estimates"]) == 2
+    [prediction] = study["predictions"]
+    assert prediction["name"] == "L160" and prediction["relative_rms"] < 0.02  # noise-free data, a model that holds
+    assert {p.name for p in (out / "figures").glob("*.png")} >= {"sensitivity.png", "valley.png", "stability.png",
+                                                                 "predictions.png", "size_effect.png"}
+    sizes = np.loadtxt(out / "size_effect.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(sizes[:, 0], [60, 100, 160])
+    html = (out / "report.html").read_text()
+    assert "Verdict" in html and "Multi-start check" in html
+    assert (out / "verdict.txt").read_text().startswith("Verdict:")
+
+
+def test_sensitivity_and_size_effect_commands(bar_series, tmp_path):
+    out = tmp_path / "s"
+    assert cli.main(["sensitivity", str(bar_series), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    table = np.loadtxt(out / "sensitivity.csv", delimiter=",", skiprows=1)
+    assert table.shape == (20, 2 + 2 * 2) and np.all(np.diff(table[:, -1]) >= -1e-9)  # information only grows
+    assert cli.main(["size-effect", str(bar_series), "--out", str(out), "--sizes", "240", "--quiet"]) == 0
+    sizes = np.loadtxt(out / "size_effect.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(sizes[:, 0], [60, 100, 160, 240])
+    assert (out / "size_effect.png").exists()

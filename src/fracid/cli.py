@@ -2,6 +2,11 @@
 
     fracid simulate CONFIG    forward analysis: curve (CSV), plot (PNG), fields (VTK)
     fracid identify CONFIG    KNN + Kalman filter: result (JSON), fitted curves (CSV), figures, HTML report
+    fracid study CONFIG       the whole strategy: KNN, sensitivity, uniqueness, Kalman filter, multi-start,
+                              stability, prediction of held-out data, size effect; a verdict per parameter
+    fracid sensitivity CONFIG normalised sensitivities and information along the load history at the
+                              configured parameter values
+    fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
     fracid demo               identification of the bundled real test (Gregoire et al. 2013 beam)
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet. Configuration errors
@@ -28,9 +33,14 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="fracid", description="Parameter identification for localized-failure models.")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("simulate", "forward analysis of the configured specimen"),
-                       ("identify", "identify parameters from measured data (KNN + Kalman filter)")):
+                       ("identify", "identify parameters from measured data (KNN + Kalman filter)"),
+                       ("study", "identification with uniqueness, stability and prediction checks, and a verdict"),
+                       ("sensitivity", "sensitivities and information along the load history"),
+                       ("size-effect", "nominal strength versus size and Bazant's size effect law")):
         p = sub.add_parser(name, parents=[common], help=text)
         p.add_argument("config", type=Path, help="TOML configuration file")
+        if name == "size-effect":
+            p.add_argument("--sizes", type=float, nargs="+", help="sizes D [mm] (default: those of the experiments)")
     sub.add_parser("demo", parents=[common], help="identify the bundled real beam test (Gregoire et al. 2013)")
     return parser
 
@@ -117,6 +127,135 @@ def run_identify(args, config_path=None) -> int:
     return 0
 
 
+def _size_effect(cfg, params, executor, sizes=(), quiet=True):
+    """Nominal strength at ``params`` over the sizes of the force experiments (and ``sizes``), the
+    measured nominal strength of those experiments, and Bazant fits of both.
+
+    Returns (figure arguments, series, fits) or None when fewer than three sizes are involved.
+    """
+    from dataclasses import replace
+
+    from fracid.config import build_experiment_data, build_specimen
+    from fracid.inverse.size_effect import fit_size_effect, nominal_strength, size_effect_series, specimen_size
+
+    specimens, measured, calibrated = {}, {}, set()
+    for exp in cfg.experiments:
+        if exp.quantity != "force":
+            continue
+        specimen = build_specimen(cfg, exp)
+        D = specimen_size(specimen)
+        specimens[D] = specimen
+        peak = float(np.max(build_experiment_data(cfg, exp).y))
+        measured.setdefault(D, []).append(nominal_strength(specimen, peak))
+        if exp.role == "calibration":
+            calibrated.add(D)
+    base = next(iter(specimens.values()), None) or build_specimen(cfg)
+    size_field = "size" if hasattr(base, "size") else "depth" if hasattr(base, "depth") else "length"
+    for D in sizes or ():
+        specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
+    if len(specimens) < 3:
+        return None
+    order = sorted(specimens)
+    series = size_effect_series(params, [specimens[D] for D in order], regularization=cfg.model.regularization,
+                                executor=executor, progress=False if quiet else None)
+    fits = {"computed": fit_size_effect(series.sizes[series.ok], series.sigma_N[series.ok])
+            if series.ok.sum() >= 3 else None}
+    sigma_measured = np.array([np.mean(measured[D]) if D in measured else np.nan for D in order])
+    if np.isfinite(sigma_measured).sum() >= 3:
+        have = np.isfinite(sigma_measured)
+        fits["measured"] = fit_size_effect(np.array(order)[have], sigma_measured[have])
+    figure = {"sizes": series.sizes, "sigma_computed": series.sigma_N, "fit": fits["computed"],
+              "sigma_measured": sigma_measured if np.isfinite(sigma_measured).any() else None,
+              "calibrated": np.array([D in calibrated for D in order])}
+    return figure, series, fits
+
+
+def _save_size_effect(out: Path, series, fits) -> None:
+    import json
+
+    np.savetxt(out / "size_effect.csv", np.column_stack([series.sizes, series.peak_force, series.sigma_N]),
+               delimiter=",", header="D_mm,peak_force_N,nominal_strength_MPa", comments="")
+    (out / "size_effect.json").write_text(json.dumps({k: (v.as_dict() if v is not None else None)
+                                                      for k, v in fits.items()}, indent=1))
+
+
+def run_study_command(args) -> int:
+    from fracid.config import (build_data, build_held_out, build_operator, build_space, load_config,
+                               study_settings)
+    from fracid.inverse.study import run_study
+    from fracid.parallel import make_executor
+    from fracid.report.study import write_study
+    from fracid.store import RunStore
+
+    cfg = load_config(args.config, purpose="identify")
+    data = build_data(cfg)
+    operator, space, settings = build_operator(cfg, data), build_space(cfg), study_settings(cfg)
+    held_out = build_held_out(cfg)
+    out = _out_dir(args, cfg)
+    with RunStore(out / "runs.sqlite") as store, make_executor(args.workers, args.scheduler) as executor:
+        study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
+                          progress=None if not args.quiet else False, log=lambda text: _say(args, text), **settings)
+        size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
+    figure = None
+    if size is not None:
+        figure, series, fits = size
+        _save_size_effect(out, series, fits)
+    written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}", size_effect=figure)
+    _say(args, study.summary())
+    _say(args, f"wrote in {out}: " + ", ".join(str(Path(p).relative_to(out)) for p in written))
+    return 0
+
+
+def run_sensitivity_command(args) -> int:
+    from fracid.config import build_data, build_operator, build_parameters, build_space, load_config
+    from fracid.inverse.analyses import sensitivity_history
+    from fracid.inverse.uniqueness import bounds_covariance
+    from fracid.parallel import make_executor
+    from fracid.report.figures import sensitivity_figure, to_png
+
+    cfg = load_config(args.config, purpose="identify")
+    data = build_data(cfg)
+    operator, space = build_operator(cfg, data), build_space(cfg)
+    params = build_parameters(cfg)
+    x = np.array([getattr(params, n) for n in space.names])
+    out = _out_dir(args, cfg)
+    with make_executor(args.workers, args.scheduler) as executor:
+        history = sensitivity_history(operator, x, data.covariance, bounds_covariance(space), names=space.names,
+                                      blocks=data.blocks, executor=executor)
+    columns = ["control_mm", "y"] + [f"S_{n}" for n in space.names] + [f"variance_removed_{n}" for n in space.names]
+    np.savetxt(out / "sensitivity.csv", np.column_stack([data.control, history.y, history.normalised,
+                                                         history.variance_share]),
+               delimiter=",", header=",".join(columns), comments="")
+    (out / "sensitivity.png").write_bytes(to_png(sensitivity_figure(history, data.control)))
+    final = ", ".join(f"{n} {v:.0%}" for n, v in zip(space.names, history.variance_share[-1]))
+    _say(args, f"sensitivities at {dict(zip(space.names, x.tolist()))}; share of the prior (bounds) variance removed "
+               f"by all data: {final}\nwrote in {out}: sensitivity.csv, sensitivity.png")
+    return 0
+
+
+def run_size_effect_command(args) -> int:
+    from fracid.config import build_parameters, load_config
+    from fracid.parallel import make_executor
+    from fracid.report.figures import size_effect_figure, to_png
+
+    cfg = load_config(args.config, purpose="simulate")
+    out = _out_dir(args, cfg)
+    with make_executor(args.workers, args.scheduler) as executor:
+        size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
+    if size is None:
+        print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
+              "[experiments.specimen] sizes", file=sys.stderr)
+        return 2
+    figure, series, fits = size
+    _save_size_effect(out, series, fits)
+    (out / "size_effect.png").write_bytes(to_png(size_effect_figure(**figure)))
+    fit = fits["computed"]
+    text = "" if fit is None else f"; Bazant fit B f_t = {fit.B_ft:.4g} MPa, D0 = {fit.D0:.4g} mm"
+    _say(args, "nominal strength [MPa]: " + ", ".join(f"D {D:g}: {s:.4g}" for D, s in zip(series.sizes, series.sigma_N))
+         + text + f"\nwrote in {out}: size_effect.csv, size_effect.json, size_effect.png")
+    return 0
+
+
 def _write_figures(directory: Path, result, control) -> None:
     """The report's figures as PNG files too."""
     from fracid.report import figures
@@ -142,6 +281,12 @@ def main(argv=None) -> int:
             return run_simulate(args)
         if args.command == "identify":
             return run_identify(args)
+        if args.command == "study":
+            return run_study_command(args)
+        if args.command == "sensitivity":
+            return run_sensitivity_command(args)
+        if args.command == "size-effect":
+            return run_size_effect_command(args)
         if args.out is None:  # not next to the bundled config inside the installation
             args.out = Path.cwd() / "fracid-demo"
         return run_identify(args, demo_config_path())

@@ -164,6 +164,7 @@ __all__ = [
     "load_config",
     "simulate_settings",
     "build_held_out",
+    "build_experiment_data",
     "study_settings",
     "StudyConfig",
 ]
@@ -933,6 +934,11 @@ def _stacked_data(cfg: Config, experiments):
         except DataError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
     return blocks[0] if len(blocks) == 1 else stack(*blocks)
+
+
+def build_experiment_data(cfg: Config, experiment: ExperimentConfig):
+    """The data of one experiment (any role), weighted."""
+    return _stacked_data(cfg, [experiment])
 
 
 def build_data(cfg: Config):

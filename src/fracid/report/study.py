@@ -1,0 +1,169 @@
+"""Figures and report of a study (:func:`fracid.inverse.study.run_study`).
+
+:func:`write_study` writes the JSON and CSV tables of the study, its figures as PNG files and one
+HTML report: the identification report of :func:`fracid.report.html.write_report` followed by the
+study's sections (verdict, sensitivity, uniqueness, multi-start, stability, predictions, size effect).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from fracid.model.parameters import DamageParameters
+from fracid.report.figures import (_ESTIMATE, _MEASURED, _NEIGHBOUR, _new_figure, _parameter_axis, parameter_label,
+                                   sensitivity_figure, size_effect_figure, to_png)
+from fracid.report.html import _e, _image, _table, write_report
+
+
+def valley_figure(maps, multi_start=None, truth=None):
+    """Objective over each parameter pair (population coloured by log10(f - f_min + 1)), the valley
+    (points within the chi^2 level of the minimum) and the multi-start starts and ends."""
+    if not maps:
+        return None
+    fig = _new_figure(5.2 * len(maps), 4.4)
+    axes = np.atleast_1d(fig.subplots(1, len(maps)))
+    for ax, m in zip(axes, maps):
+        excess = m.f - m.f.min()
+        sc = ax.scatter(m.points[:, 0], m.points[:, 1], c=np.log10(excess + 1.0), cmap="viridis_r", s=25,
+                        edgecolors="none")
+        fig.colorbar(sc, ax=ax, label="log10(f - f_min + 1) [-]")
+        ax.plot(m.points[m.valley, 0], m.points[m.valley, 1], "o", mfc="none", mec=_NEIGHBOUR, ms=10, mew=1.6,
+                label=f"valley: f - f_min <= {m.level:.3g} ({int(m.valley.sum())} points)")
+        if multi_start is not None:
+            names = list(multi_start.names) if hasattr(multi_start, "names") else None
+            i, j = _pair_columns(m.names, names or m.names, multi_start.starts.shape[1])
+            for a, b in zip(multi_start.starts, multi_start.ends):
+                ax.annotate("", xy=(b[i], b[j]), xytext=(a[i], a[j]), arrowprops={"arrowstyle": "->", "color": _ESTIMATE})
+            ax.plot(multi_start.ends[:, i], multi_start.ends[:, j], "*", color=_ESTIMATE, ms=12, mec="k", mew=0.5,
+                    label="multi-start ends")
+        if truth is not None:
+            ax.plot([truth[0]], [truth[1]], "P", color="k", ms=10, label="truth")
+        _parameter_axis(ax, "x", m.points[:, 0])
+        _parameter_axis(ax, "y", m.points[:, 1])
+        ax.set_xlabel(parameter_label(m.names[0]))
+        ax.set_ylabel(parameter_label(m.names[1]))
+        title = f"valley correlation {m.correlation:+.2f}" if np.isfinite(m.correlation) else "valley"
+        ax.set_title(title, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="x-small", loc="best")
+    return fig
+
+
+def _pair_columns(pair, names, p):
+    names = list(names)
+    if len(names) == p and pair[0] in names and pair[1] in names:
+        return names.index(pair[0]), names.index(pair[1])
+    return 0, 1
+
+
+def stability_figure(stability, names, estimate=None, std=None):
+    """Estimates of the noisy replicates per parameter, with the estimate and its +-2 std band."""
+    ok = stability.ok
+    p = len(names)
+    fig = _new_figure(3.2 * p, 3.4)
+    axes = np.atleast_1d(fig.subplots(1, p))
+    for j, (ax, name) in enumerate(zip(axes, names)):
+        ax.plot(np.arange(1, ok.sum() + 1), stability.estimates[ok, j], "o", color=_MEASURED, label="replicates")
+        if estimate is not None:
+            ax.axhline(estimate[j], color=_ESTIMATE, label="estimate")
+            if std is not None:
+                ax.axhspan(estimate[j] - 2 * std[j], estimate[j] + 2 * std[j], color=_ESTIMATE, alpha=0.12,
+                           label="+- 2 std")
+        ax.set_xlabel("replicate")
+        ax.set_ylabel(parameter_label(name))
+        ax.set_title(f"scatter {stability.relative_scatter[j]:.1%} (noise {stability.noise_level:.1%})", fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize="x-small")
+    return fig
+
+
+def prediction_figure(predictions):
+    """Held-out data and their prediction at the estimate with a +-2 std band."""
+    shown = [p for p in predictions if p.status == "ok"]
+    if not shown:
+        return None
+    fig = _new_figure(4.6 * len(shown), 3.6)
+    axes = np.atleast_1d(fig.subplots(1, len(shown)))
+    for ax, p in zip(axes, shown):
+        ax.errorbar(p.control, p.y_exp, yerr=p.std_exp, fmt="o", ms=3, color=_MEASURED, label="measured")
+        ax.plot(p.control, p.y, "-", color=_ESTIMATE, label="predicted")
+        ax.fill_between(p.control, p.y - 2 * p.std, p.y + 2 * p.std, color=_ESTIMATE, alpha=0.15, label="+- 2 std")
+        ax.set_title(f"{p.name}: RMS {p.relative_rms:.1%}, chi2/point {p.chi2_per_point:.2f}", fontsize=9)
+        ax.set_xlabel("control [mm]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="x-small")
+    return fig
+
+
+def study_figures(study, control=None, truth=None, size_effect=None) -> dict:
+    """All figures of a study by name (None where there is nothing to draw)."""
+    figs = {"valley": valley_figure(study.maps, study.multi_start, truth),
+            "predictions": prediction_figure(study.predictions)}
+    if study.sensitivity is not None:
+        figs["sensitivity"] = sensitivity_figure(study.sensitivity, control)
+    if study.stability is not None and study.stability.ok.sum() >= 2:
+        ident = study.identification
+        figs["stability"] = stability_figure(study.stability, study.names, ident.x, ident.std)
+    if size_effect is not None:
+        figs["size_effect"] = size_effect_figure(**size_effect)
+    return figs
+
+
+def _verdict_section(study) -> str:
+    units = DamageParameters.units()
+    rows = [[v.name, v.status, f"{v.value:.5g}", f"{v.std:.3g}", f"{v.std / abs(v.value):.1%}",
+             f"{v.partner} ({v.correlation:+.3f})" if v.partner else "", f"{v.variance_removed:.0%}",
+             "; ".join(v.remarks + tuple(f"would help: {s}" for s in v.suggestions))] for v in study.verdict.parameters]
+    table = _table(["parameter", "verdict", "estimate", "std", "std/|x|", "most correlated with", "prior variance removed",
+                    "remarks"], rows, text_columns=(0, 1, 5, 7))
+    text = "<pre>" + _e(study.verdict.text(units)) + "</pre>"
+    return table + text
+
+
+def study_sections(study, figures: dict) -> list:
+    """(heading, HTML) sections of a study for :func:`~fracid.report.html.write_report`."""
+    sections = [("Verdict", _verdict_section(study))]
+    captions = {
+        "sensitivity": "Normalised sensitivities along the load history and the share of each parameter's prior "
+                       "(bounds) variance removed by the data up to each point.",
+        "valley": "Objective over the population; circled: the valley of sets the data cannot tell from the best "
+                  "(chi^2 95 % level); arrows: Kalman filters from distinct starting points.",
+        "stability": "Estimates from data with noise added (fixed seeds): the scatter against the estimate's +-2 std.",
+        "predictions": "Data not used for calibration, predicted at the estimate (+-2 std propagated from its "
+                       "covariance).",
+        "size_effect": "Nominal strength versus size with Bazant's size effect law fitted.",
+    }
+    for name, caption in captions.items():
+        fig = figures.get(name)
+        if fig is not None:
+            sections.append((name.replace("_", " ").capitalize(), _image(to_png(fig), name, caption)))
+    if study.multi_start is not None:
+        ms = study.multi_start
+        rows = [[i + 1, *np.round(a, 6).tolist(), *np.round(b, 6).tolist(), f"{f:.4g}"]
+                for i, (a, b, f) in enumerate(zip(ms.starts, ms.ends, ms.f))]
+        header = ["start"] + [f"start {n}" for n in study.names] + [f"end {n}" for n in study.names] + ["f at end"]
+        sections.append(("Multi-start check", _table(header, rows)))
+    return sections
+
+
+def write_study(directory, study, data, *, title="fracid study", truth=None, size_effect=None) -> list:
+    """Write the study's JSON/CSV tables, figures (PNG) and HTML report into ``directory``.
+
+    Returns the paths written.
+    """
+    directory = Path(directory)
+    study.save(directory)
+    figs = study_figures(study, data.control if data is not None else None, truth, size_effect)
+    (directory / "figures").mkdir(parents=True, exist_ok=True)
+    written = [directory / "study.json", directory / "verdict.txt"]
+    for name, fig in figs.items():
+        if fig is not None:
+            path = directory / "figures" / f"{name}.png"
+            path.write_bytes(to_png(fig))
+            written.append(path)
+    report = write_report(directory / "report.html", study.identification,
+                          control=None if data is None else data.control, title=title,
+                          data_notes=() if data is None else data.notes, extra_sections=study_sections(study, figs))
+    return written + [report]
