@@ -52,8 +52,10 @@ class ParameterSpace:
     def to_unit(self, x: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`from_unit`."""
         x = np.atleast_2d(x)
+        log = np.array(self.log)
         lo, hi = _safe_log(self.lower), _safe_log(self.upper)
-        return np.where(np.array(self.log), (_safe_log(x) - lo) / (hi - lo), (x - self.lower) / (self.upper - self.lower))
+        log_span = np.where(log, hi - lo, 1.0)  # the log branch is evaluated for linear entries too
+        return np.where(log, (_safe_log(x) - lo) / log_span, (x - self.lower) / (self.upper - self.lower))
 
 
 def _safe_log(v):

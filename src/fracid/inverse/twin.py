@@ -7,6 +7,8 @@ can be compared with the truth.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from fracid.data import ExperimentalData
@@ -58,3 +60,87 @@ def _block_std(std, name, values) -> float:
         return float(std[name])
     raise KeyError(f"no noise level for block {name!r}: give std[{name!r}] (absolute) or "
                    f"std['{name}:relative'] (fraction of its largest value)")
+
+
+@dataclass
+class TwinOutcome:
+    """Identification of one twin experiment.
+
+    Attributes
+    ----------
+    name : str
+    study : StudyResult
+    truth : ndarray
+    data : ExperimentalData
+    """
+
+    name: str
+    study: object
+    truth: np.ndarray
+    data: ExperimentalData
+
+    @property
+    def estimate(self) -> np.ndarray:
+        return self.study.identification.x
+
+    @property
+    def relative_error(self) -> np.ndarray:
+        """(estimate - truth) / truth per parameter."""
+        return (self.estimate - self.truth) / np.abs(self.truth)
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """Posterior standard deviation / |estimate|: the expected estimation error."""
+        ident = self.study.identification
+        return ident.std / np.abs(ident.x)
+
+    @property
+    def correlation(self) -> np.ndarray:
+        return self.study.identification.correlation
+
+    def row(self) -> dict:
+        names = self.study.names
+        out = {"case": self.name, "n_y": int(self.data.n_y)}
+        for j, n in enumerate(names):
+            out[f"{n}_estimate"] = float(self.estimate[j])
+            out[f"{n}_error"] = float(self.relative_error[j])
+            out[f"{n}_rel_std"] = float(self.relative_std[j])
+            out[f"{n}_verdict"] = self.study.verdict[n].status
+        for a in range(len(names)):
+            for b in range(a + 1, len(names)):
+                out[f"corr_{names[a]}_{names[b]}"] = float(self.correlation[a, b])
+        return out
+
+
+def twin_matrix(cases: dict, x_true, std, space, *, seed: int | None = 1, log=None, **settings) -> dict:
+    """Twin experiments over several data sets: synthetic data per case, then the study.
+
+    Parameters
+    ----------
+    cases : dict of str -> ForwardOperator
+        The data set of each case (e.g. one size; three sizes; global plus local).
+    x_true : array_like
+        Known parameters.
+    std : dict or float
+        Noise per block, see :func:`synthetic_data`.
+    space : ParameterSpace
+    seed : int or None
+        Noise seed, the same for every case.
+    settings
+        Keyword arguments of :func:`fracid.inverse.study.run_study`.
+
+    Returns
+    -------
+    dict of str -> TwinOutcome
+    """
+    from fracid.inverse.study import run_study
+
+    x_true = np.asarray(x_true, float)
+    outcomes = {}
+    for name, operator in cases.items():
+        if log is not None:
+            log(f"twin case {name!r}")
+        data = synthetic_data(operator, x_true, std, seed=seed)
+        study = run_study(operator, data, space, log=lambda text: None, **settings)
+        outcomes[name] = TwinOutcome(name, study, x_true, data)
+    return outcomes

@@ -469,7 +469,9 @@ def _plain_log_ticks(axis) -> None:
 
 def _size_effect_law(ax, fit, D) -> None:
     """The fitted law and its two asymptotes over a range wide enough to show where they meet."""
-    span = np.concatenate([D[np.isfinite(D) & (D > 0)], [fit.D0]])
+    data = D[np.isfinite(D) & (D > 0)]
+    # show the transition at D0 when it is near the data, never decades of empty axis
+    span = np.concatenate([data, [np.clip(fit.D0, data.min() / 10.0, data.max() * 10.0)]])
     grid = np.geomspace(span.min() / 2.0, span.max() * 2.0, 200)
     ax.plot(grid, fit.predict(grid), "-", color=_ESTIMATE, lw=1.6,
             label=f"size effect law: B f_t = {fit.B_ft:.3g} MPa, D0 = {fit.D0:.3g} mm")
