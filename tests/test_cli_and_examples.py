@@ -216,3 +216,10 @@ def test_sensitivity_and_size_effect_commands(bar_series, tmp_path):
     sizes = np.loadtxt(out / "size_effect.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(sizes[:, 0], [60, 100, 160, 240])
     assert (out / "size_effect.png").exists()
+
+
+def test_uniqueness_command_runs_only_its_stages(bar_series, tmp_path):
+    out = tmp_path / "u"
+    assert cli.main(["uniqueness", str(bar_series), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    study = json.loads((out / "study.json").read_text())
+    assert "multi_start" in study and "stability" not in study and study["predictions"] == []

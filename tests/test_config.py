@@ -387,6 +387,22 @@ BAD = [
                  ["specimen.n_elements", "12.5", "must be an integer"], id="float-for-integer"),
     pytest.param(BAR_SIMULATE.replace('type = "local-damage"', 'type = "nonlocal"'), "simulate",
                  ["model.type", "'nonlocal'", "one of 'gradient-damage', 'local-damage'"], id="unknown-model-type"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nweight = -1.0"), "identify",
+                 ["experiments[0].weight", "-1.0", "must be a number > 0"], id="negative-weight"),
+    pytest.param(variant("n_points = 40", "n_points = 40\ndamage_threshold = 0.5"), "identify",
+                 ["experiments[0].damage_threshold", "0.5", "local quantity only"], id="threshold-on-force"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\nrole = "validation"'), "identify",
+                 ["experiments[0].role", "'validation'", "'calibration', 'prediction'"], id="unknown-role"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\nrole = "prediction"'), "identify",
+                 ["experiments", "role = 'calibration'"], id="nothing-to-calibrate"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nspecimen = { depth = 20.0 }"), "identify",
+                 ["experiments[0].specimen.depth", "20.0", "notch"], id="override-breaks-specimen"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nspecimen = { size = 20.0 }"), "identify",
+                 ["experiments[0].specimen.size", "unknown key"], id="override-unknown-field"),
+    pytest.param(variant("vtk_steps = []", "vtk_steps = []\n[study]\nreplicates = 1"), "identify",
+                 ["study.replicates", "1", ">= 2"], id="one-replicate"),
+    pytest.param(variant("vtk_steps = []", "vtk_steps = []\n[study]\nprior = 'flat'"), "identify",
+                 ["study.prior", "'flat'", "'knn', 'bounds'"], id="unknown-prior"),
 ]
 
 

@@ -4,6 +4,8 @@
     fracid identify CONFIG    KNN + Kalman filter: result (JSON), fitted curves (CSV), figures, HTML report
     fracid study CONFIG       the whole strategy: KNN, sensitivity, uniqueness, Kalman filter, multi-start,
                               stability, prediction of held-out data, size effect; a verdict per parameter
+    fracid uniqueness CONFIG  KNN, objective maps and valley, Kalman filter, multi-start (no replicates)
+    fracid stability CONFIG   KNN, Kalman filter, identification on noisy replicates (no multi-start)
     fracid sensitivity CONFIG normalised sensitivities and information along the load history at the
                               configured parameter values
     fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
@@ -35,6 +37,8 @@ def _parser() -> argparse.ArgumentParser:
     for name, text in (("simulate", "forward analysis of the configured specimen"),
                        ("identify", "identify parameters from measured data (KNN + Kalman filter)"),
                        ("study", "identification with uniqueness, stability and prediction checks, and a verdict"),
+                       ("uniqueness", "the study's uniqueness stages only: objective maps, valley, multi-start"),
+                       ("stability", "the study's stability stage only: identification on noisy replicates"),
                        ("sensitivity", "sensitivities and information along the load history"),
                        ("size-effect", "nominal strength versus size and Bazant's size effect law")):
         p = sub.add_parser(name, parents=[common], help=text)
@@ -179,6 +183,10 @@ def _save_size_effect(out: Path, series, fits) -> None:
                                                       for k, v in fits.items()}, indent=1))
 
 
+#: subcommands that run part of the study: [study] settings they override
+_STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0}, "stability": {"starts": 0}}
+
+
 def run_study_command(args) -> int:
     from fracid.config import (build_data, build_held_out, build_operator, build_space, load_config,
                                study_settings)
@@ -189,13 +197,16 @@ def run_study_command(args) -> int:
 
     cfg = load_config(args.config, purpose="identify")
     data = build_data(cfg)
-    operator, space, settings = build_operator(cfg, data), build_space(cfg), study_settings(cfg)
-    held_out = build_held_out(cfg)
+    operator, space = build_operator(cfg, data), build_space(cfg)
+    settings = {**study_settings(cfg), **_STUDY_PARTS[args.command]}
+    held_out = build_held_out(cfg) if args.command == "study" else []
     out = _out_dir(args, cfg)
     with RunStore(out / "runs.sqlite") as store, make_executor(args.workers, args.scheduler) as executor:
         study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
                           progress=None if not args.quiet else False, log=lambda text: _say(args, text), **settings)
-        size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
+        size = None
+        if args.command == "study":
+            size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
     figure = None
     if size is not None:
         figure, series, fits = size
@@ -281,7 +292,7 @@ def main(argv=None) -> int:
             return run_simulate(args)
         if args.command == "identify":
             return run_identify(args)
-        if args.command == "study":
+        if args.command in _STUDY_PARTS:
             return run_study_command(args)
         if args.command == "sensitivity":
             return run_sensitivity_command(args)

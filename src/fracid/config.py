@@ -108,6 +108,8 @@ present they are always validated. Every other key is optional unless marked *re
     replicates = 5                      # identifications on data with noise added (0: none; else >= 2)
     seed = 0                            # seed of the replicates' noise, default 0
     tolerance = 0.1                     # largest relative std called "identified", default 0.1
+    prior = "knn"                       # Kalman prior covariance: "knn" (neighbours' spread, default)
+                                        #   | "bounds" (uniform over the bounds: the data's information only)
 
     [output]                            # optional
     directory = "results"               # default "results", relative to this file unless absolute
@@ -222,7 +224,7 @@ _KNN_KEYS = ("n", "method", "k", "seed")
 _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
-_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance")
+_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
 _ROLES = ("calibration", "prediction")
 
 
@@ -355,6 +357,7 @@ class StudyConfig:
     replicates: int = 5
     seed: int = 0
     tolerance: float = 0.1
+    prior: str = "knn"
 
 
 @dataclass(frozen=True)
@@ -835,6 +838,7 @@ def _study(ck: _Checker, raw) -> StudyConfig:
         tolerance=ck.number("study.tolerance", raw.get("tolerance", 0.1),
                             "must be a number with 0 < t < 1 (largest relative std called identified)",
                             lambda v: 0 < v < 1),
+        prior=ck.choice("study.prior", raw.get("prior", "knn"), ("knn", "bounds")),
     )
 
 
@@ -999,7 +1003,7 @@ def study_settings(cfg: Config) -> dict:
     """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``."""
     study = cfg.study
     return {**identify_settings(cfg), "starts": study.starts, "replicates": study.replicates,
-            "noise_seed": study.seed, "tolerance": study.tolerance}
+            "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior}
 
 
 def build_space(cfg: Config):

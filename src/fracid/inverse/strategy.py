@@ -117,11 +117,16 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
 
 
 def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0.01, restart="linearize",
-           executor=None, blocks=(), notes=(), method="", seed=0, started=None) -> IdentificationResult:
-    """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :func:`identify`."""
+           executor=None, blocks=(), notes=(), method="", seed=0, started=None, C0=None) -> IdentificationResult:
+    """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :func:`identify`.
+
+    ``C0`` replaces the KNN covariance as the prior's (e.g. the bounds' covariance, so that the
+    posterior holds the information of the data alone).
+    """
     start = time.perf_counter() if started is None else started
     bounds = DamageParameters.valid_bounds(knn.space.names)
-    kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, knn.C0, groups=groups, max_iterations=max_iterations,
+    C0 = knn.C0 if C0 is None else np.asarray(C0, float)
+    kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, C0, groups=groups, max_iterations=max_iterations,
                            tol=tol, restart=restart, executor=executor, bounds=bounds)
     knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
                    "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}

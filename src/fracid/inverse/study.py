@@ -153,7 +153,7 @@ class StudyResult:
 
 def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates: int = 5, noise_seed: int = 0,
               tolerance: float = 0.1, n=64, method="sobol", seed=0, k=5, groups=None, max_iterations=10, tol=0.01,
-              restart="linearize", executor=None, store=None, progress=None, log=print) -> StudyResult:
+              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=print) -> StudyResult:
     """Run the identification strategy with its checks and return the verdict.
 
     Parameters
@@ -175,8 +175,14 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         Seed of the replicates' noise.
     tolerance : float
         Largest relative standard deviation called identified.
+    prior : {"knn", "bounds"}
+        Covariance of the Kalman filter's prior (mean: the KNN estimate): the spread of the k
+        nearest neighbours (the thesis's cascade), or the bounds' uniform covariance. The
+        neighbours were ranked with the same data, so "bounds" keeps the posterior to what the
+        data say, which comparisons of data sets (twin matrices) need.
     n, method, seed, k, groups, max_iterations, tol, restart
-        KNN and Kalman settings, as in :func:`~fracid.inverse.strategy.identify`.
+        KNN and Kalman settings, as in :func:`~fracid.inverse.strategy.identify`; ``groups`` may also
+        be ``"blocks"`` (one filter step per data block) or ``"all"`` (one step: the batch filter).
     log : callable(str)
         Receives one line per stage.
     """
@@ -191,13 +197,18 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         clock = now
 
     y, C = data.y, data.covariance
+    if isinstance(groups, str):
+        groups = _named_groups(groups, data)
     kalman = {"groups": groups, "max_iterations": max_iterations, "tol": tol, "restart": restart}
     bounds = DamageParameters.valid_bounds(space.names)
     C_bounds = bounds_covariance(space)
+    if prior not in ("knn", "bounds"):
+        raise ValueError(f"prior = {prior!r}; choose 'knn' or 'bounds'")
     log(f"KNN: population of {n} ({method})")
     knn = knn_search(operator, y, C, space, n=n, method=method, seed=seed, k=k, executor=executor, store=store,
                      progress=progress)
     stage("knn")
+    C0 = knn.C0 if prior == "knn" else C_bounds
     log("sensitivity along the load history at the KNN estimate")
     history = sensitivity_history(operator, knn.x0, C, C_bounds, names=space.names, blocks=data.blocks,
                                   executor=executor)
@@ -205,7 +216,7 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     maps, extent = objective_maps(knn), valley_extent(knn)
     log("Kalman filter from the KNN prior")
     ident = refine(operator, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
-                   method=method, seed=seed, **kalman)
+                   method=method, seed=seed, C0=C0, **kalman)
     stage("kalman")
     ms = None
     if starts > 1:
@@ -217,7 +228,7 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     st = None
     if replicates:
         log(f"stability check: {replicates} noisy replicates")
-        st = stability_check(operator, y, C, knn.x0, knn.C0, replicates=replicates, seed=noise_seed, bounds=bounds,
+        st = stability_check(operator, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
                              executor=executor, **kalman)
         stage("stability")
     predictions = []
@@ -230,6 +241,14 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
                                  tolerance=tolerance, multi_start=ms, stability=st)
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings)
+
+
+def _named_groups(name, data):
+    if name == "all":
+        return [np.arange(data.n_y)]
+    if name == "blocks":
+        return [np.arange(start, stop) for _, start, stop in data.blocks]
+    raise ValueError(f"groups = {name!r}; give index arrays, None, 'blocks' or 'all'")
 
 
 __all__ = ["Prediction", "StudyResult", "describe_data", "predict", "run_study"]

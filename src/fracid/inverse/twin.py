@@ -144,3 +144,37 @@ def twin_matrix(cases: dict, x_true, std, space, *, seed: int | None = 1, log=No
         study = run_study(operator, data, space, log=lambda text: None, **settings)
         outcomes[name] = TwinOutcome(name, study, x_true, data)
     return outcomes
+
+
+def dogbone_cases(params, names=("c", "beta"), *, sizes=(50.0, 100.0, 200.0), reference=100.0, h_fine=2.5,
+                  n_points=15, damage_threshold=0.5, regularization="gradient") -> dict:
+    """The four data sets of the thesis's identifiability study on dog-bones (van Vliet & van Mier).
+
+    ``one size``: the force-elongation curve of the ``reference`` size; ``three sizes``: the curves
+    of all ``sizes``; ``local only``: the FPZ width (damage above ``damage_threshold``) of the
+    reference size; ``one size + local``: the reference curve and its FPZ width; ``all``: every
+    curve and the reference FPZ width.
+
+    Each curve is sampled at ``n_points`` elongations from 1/n_points of the range to where the
+    force at ``params`` has fallen to 20 % of its peak (or the specimen's default target).
+    """
+    from fracid.forward import simulate
+    from fracid.inverse.forward_operator import ForwardOperator, Observation
+    from fracid.specimens.dogbone import DogBone
+
+    if reference not in sizes:
+        raise ValueError(f"the reference size {reference} must be one of the sizes {sizes}")
+    curves, local = {}, {}
+    for D in sizes:
+        specimen = DogBone(size=float(D), h_fine=h_fine)
+        run = simulate(specimen, params, regularization=regularization, stop_force_fraction=0.2)
+        points = np.linspace(run.control[-1] / n_points, run.control[-1], n_points)
+        curves[D] = Observation(specimen, points, name=f"force D{D:g}")
+        local[D] = Observation(specimen, points, quantity="fpz_width", name=f"fpz D{D:g}",
+                               damage_threshold=damage_threshold)
+    sets = {"one size": [curves[reference]],
+            "three sizes": [curves[D] for D in sizes],
+            "local only": [local[reference]],
+            "one size + local": [curves[reference], local[reference]],
+            "all": [curves[D] for D in sizes] + [local[reference]]}
+    return {name: ForwardOperator(obs, params, names, regularization=regularization) for name, obs in sets.items()}
