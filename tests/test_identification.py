@@ -157,7 +157,7 @@ def test_global_and_local_blocks_from_experimental_data(bar_operator):
 
 
 def test_force_and_local_data_of_one_test_share_one_forward_run(monkeypatch):
-    import fracid.inverse.forward_operator as fo
+    import fracid.forward as fo
 
     both = ForwardOperator([Observation(BAR, POINTS, name="global"),
                             Observation(fracid.BarWithWeakZone(n_elements=100), POINTS[4:],

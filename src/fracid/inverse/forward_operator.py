@@ -15,8 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fracid.forward import simulate
-from fracid.model.parameters import DamageParameters
+from fracid.models import DamageModel
 from fracid.model.path_following import ConvergenceError, StepOptions
 
 
@@ -100,28 +99,37 @@ class ForwardOperator:
     Parameters
     ----------
     observations : sequence of Observation
-    base : DamageParameters
-        Values of the parameters that are not identified.
+    base : parameter object
+        Values of the parameters that are not identified (an instance of ``model.parameters``).
     names : sequence of str
         Identified parameters, in the order of x.
     regularization : str
-        ``"gradient"`` or ``"local"``.
+        ``"gradient"`` or ``"local"``: shorthand for ``model=DamageModel(regularization)``.
     steps : StepOptions or None
         Step rule (the specimen's default if None); the retry divides its increments by 4.
+    model : ForwardModel, optional
+        The forward model (see :mod:`fracid.models`); :class:`~fracid.models.DamageModel` by default.
     """
 
     observations: tuple
-    base: DamageParameters
+    base: object
     names: tuple
     regularization: str = "gradient"
     steps: StepOptions | None = None
+    model: object = None
 
     def __post_init__(self):
         object.__setattr__(self, "observations", tuple(self.observations))
         object.__setattr__(self, "names", tuple(self.names))
-        unknown = set(self.names) - set(DamageParameters.names())
+        if self.model is None:
+            object.__setattr__(self, "model", DamageModel(self.regularization))
+        if not isinstance(self.base, self.model.parameters):
+            raise TypeError(f"base is a {type(self.base).__name__}; the model {self.model.key!r} takes "
+                            f"{self.model.parameters.__name__}")
+        known = self.model.parameters.names()
+        unknown = set(self.names) - set(known)
         if unknown or not self.names:
-            raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {DamageParameters.names()}")
+            raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {known}")
         sizes = [o.control_points.size for o in self.observations]
         object.__setattr__(self, "_offsets", np.concatenate([[0], np.cumsum(sizes)]))
 
@@ -129,7 +137,17 @@ class ForwardOperator:
     def n_outputs(self) -> int:
         return int(self._offsets[-1])
 
-    def parameters(self, x) -> DamageParameters:
+    def valid_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Valid ranges of the identified parameters (the model's), for clipping estimates."""
+        return self.model.parameters.valid_bounds(self.names)
+
+    @property
+    def units(self) -> dict:
+        """Units of the identified parameters."""
+        units = self.model.parameters.units()
+        return {name: units.get(name, "") for name in self.names}
+
+    def parameters(self, x):
         """The full parameter set for the vector x (raises ValueError for invalid values)."""
         x = np.asarray(x, dtype=float)
         if x.shape != (len(self.names),):
@@ -194,9 +212,9 @@ class ForwardOperator:
         error = ""
         for attempt, steps in enumerate(self._step_rules(obs, target)):
             try:
-                result = simulate(obs.specimen, params, regularization=self.regularization, control=obs.control,
-                                  target=target, stop_force_fraction=None, steps=steps, field_steps=None,
-                                  checkpoints=checkpoints, damage_threshold=threshold)
+                result = self.model.simulate(obs.specimen, params, control=obs.control, target=target,
+                                             stop_force_fraction=None, steps=steps, field_steps=None,
+                                             checkpoints=checkpoints, damage_threshold=threshold)
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)

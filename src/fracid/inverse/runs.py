@@ -12,12 +12,13 @@ from fracid.store import key_for
 def run_key(operator, x) -> str:
     """Store key of the run of ``operator`` at ``x``: model, specimens, meshes, controls and parameters."""
     observations = [
-        {"specimen": o.specimen, "points": o.control_points.tolist(), "quantity": o.quantity, "control": o.control}
+        {"specimen": o.specimen, "points": o.control_points.tolist(), "quantity": o.quantity, "control": o.control,
+         "damage_threshold": o.damage_threshold}
         for o in operator.observations
     ]
     return key_for(
-        model="gradient-damage",
-        regularization=operator.regularization,
+        model=operator.model.key,
+        model_options=operator.model,
         observations=observations,
         parameters=operator.parameters(x) if _valid(operator, x) else {"names": list(operator.names), "x": list(map(float, x))},
         steps=repr(operator.steps),

@@ -49,6 +49,7 @@ class IdentificationResult:
     runs: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     converged: bool = False
+    units: dict = field(default_factory=dict)
 
     @property
     def std(self) -> np.ndarray:
@@ -59,7 +60,7 @@ class IdentificationResult:
         return self.C / np.outer(self.std, self.std)
 
     def summary(self) -> str:
-        units = DamageParameters.units()
+        units = self.units or DamageParameters.units()
         lines = [f"{n:>8} = {v:.6g} +- {s:.3g} {units.get(n, '')}" for n, v, s in zip(self.names, self.x, self.std)]
         lines.append("correlation:\n" + np.array2string(self.correlation, precision=3))
         return "\n".join(lines)
@@ -124,7 +125,7 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
     posterior holds the information of the data alone).
     """
     start = time.perf_counter() if started is None else started
-    bounds = DamageParameters.valid_bounds(knn.space.names)
+    bounds = operator.valid_bounds()
     C0 = knn.C0 if C0 is None else np.asarray(C0, float)
     kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, C0, groups=groups, max_iterations=max_iterations,
                            tol=tol, restart=restart, executor=executor, bounds=bounds)
@@ -138,7 +139,7 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
         std_exp=np.sqrt(np.diag(C_exp)), blocks=list(blocks), history=kalman.history, knn=knn_summary, runs=runs,
         notes=list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {knn.k}",
                              f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std"],
-        converged=kalman.converged,
+        converged=kalman.converged, units=dict(operator.units),
     )
 
 

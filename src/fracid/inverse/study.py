@@ -97,7 +97,7 @@ class StudyResult:
         return list(self.identification.names)
 
     def summary(self) -> str:
-        lines = ["Verdict:", self.verdict.text(DamageParameters.units())]
+        lines = ["Verdict:", self.verdict.text(self.identification.units or DamageParameters.units())]
         if self.predictions:
             lines.append("Predictions of data not used for calibration:")
             lines += [f"  {p.name}: RMS {p.relative_rms:.1%} of the peak, chi2/point {p.chi2_per_point:.2f}"
@@ -200,7 +200,7 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     if isinstance(groups, str):
         groups = _named_groups(groups, data)
     kalman = {"groups": groups, "max_iterations": max_iterations, "tol": tol, "restart": restart}
-    bounds = DamageParameters.valid_bounds(space.names)
+    bounds = operator.valid_bounds()
     C_bounds = bounds_covariance(space)
     if prior not in ("knn", "bounds"):
         raise ValueError(f"prior = {prior!r}; choose 'knn' or 'bounds'")
