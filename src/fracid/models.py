@@ -53,6 +53,39 @@ class DamageModel:
         return simulate(specimen, params, regularization=self.regularization, **options)
 
 
+@dataclass(frozen=True)
+class CohesiveCrackModel:
+    """Discrete cohesive crack with Hordijk's law along the ligament, elastic bulk (SPEC 5).
+
+    Specimens must offer ``build_cohesive_problem(params)`` (the notched beam does). Observable:
+    ``crack_length`` [mm], the length of the ligament whose faces have separated.
+    """
+
+    penalty_factor: float = 1000.0
+    key: ClassVar[str] = "cohesive-crack-hordijk"
+
+    @property
+    def parameters(self):
+        from fracid.model.cohesive import CohesiveParameters
+
+        return CohesiveParameters
+
+    def simulate(self, specimen, params, *, control=None, target=None, stop_force_fraction=0.1, steps=None,
+                 field_steps="last", checkpoints=None, damage_threshold=0.0, **options):
+        from fracid.model.path_following import StepOptions, follow_path
+
+        if not hasattr(specimen, "build_cohesive_problem"):
+            raise TypeError(f"{type(specimen).__name__} has no cohesive crack (build_cohesive_problem)")
+        problem = specimen.build_cohesive_problem(params, self.penalty_factor)
+        target = target if target is not None else specimen.default_target(params)
+        if steps is None:
+            steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
+        observers = {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
+        return follow_path(problem, control or specimen.default_control, target, steps=steps,
+                           stop_force_fraction=stop_force_fraction, observers=observers, field_steps=field_steps,
+                           checkpoints=checkpoints, **options)
+
+
 def parameter_units(model_or_params) -> dict:
     """Units of a model's parameters (from its parameter class or a parameter object)."""
     cls = getattr(model_or_params, "parameters", None) or type(model_or_params)

@@ -88,7 +88,8 @@ class NotchedBeam:
         in_notch = lambda s, t: (s < self.notch_width / 2) & (t < self.notch_depth)  # noqa: E731
         return structured_quad8(xs, ys, keep=lambda s, t: ~in_notch(s, t))
 
-    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
+    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None,
+                      crack_free: bool = False) -> DamageProblem:
         mesh = mesh or self.mesh()
         x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
@@ -97,16 +98,43 @@ class NotchedBeam:
         plate = np.flatnonzero((np.abs(y - self.depth) < 1e-9) & (x <= self.plate_width / 2 + 1e-9))
         mouth = mesh.closest_node((self.notch_width / 2, 0.0))
         master = int(plate[np.argmin(x[plate])])
+        if crack_free:
+            # a cohesive crack replaces the symmetry condition; the plate loads by an even pressure
+            # instead of a rigid tie, and the support is a point: rigid plates would clamp the halves'
+            # rotation and carry load by frame action once the crack has opened
+            symmetry, tied = [], []
+            support = np.array([mesh.closest_node((self.span / 2, 0.0))])
+            load = {2 * n + 1: -0.5 / plate.size for n in plate}
+            deflection = {2 * n + 1: -1.0 / plate.size for n in plate}
+        else:
+            symmetry, tied = [2 * ligament], [2 * plate + 1]
+            load = {2 * master + 1: -0.5}  # the half model carries half the force: lambda = total force [N]
+            deflection = {2 * master + 1: -1.0}
         return DamageProblem(
             disc,
             params,
             regularization=regularization,
-            fixed_dofs=np.concatenate([2 * ligament, 2 * support + 1]),
-            tied=[2 * plate + 1],
-            load={2 * master + 1: -0.5},  # the half model carries half the force: lambda = total force [N]
-            functionals={"cmod": {2 * mouth: 2.0}, "deflection": {2 * master + 1: -1.0}},
+            fixed_dofs=np.concatenate(symmetry + [2 * support + 1]),
+            tied=tied,
+            load=load,
+            functionals={"cmod": {2 * mouth: 2.0}, "deflection": deflection},
             symmetry_factor=2.0,
+            damageable=0.0 if crack_free else 1.0,
         )
+
+    def build_cohesive_problem(self, params, penalty_factor: float = 1000.0):
+        """Elastic half beam with a Hordijk cohesive crack along the ligament (SPEC 5, discrete crack).
+
+        ``params`` is a :class:`~fracid.model.cohesive.CohesiveParameters`; the faces are tied by a
+        penalty ``penalty_factor * E / h_fine`` [MPa/mm] until the traction reaches ft.
+        """
+        from fracid.model.cohesive_problem import CohesiveCrackProblem, ligament_edges
+        from fracid.model.parameters import DamageParameters
+
+        mesh = self.mesh()
+        bulk = self.build_problem(DamageParameters(E=params.E, nu=params.nu), "local", mesh, crack_free=True)
+        edges = ligament_edges(mesh.nodes, mesh.cells, bulk.disc.u_dofs, self.notch_depth)
+        return CohesiveCrackProblem(bulk, edges, params, self.thickness, penalty_factor * params.E / self.h_fine)
 
     def output_mesh(self):
         """Nodes, cells and VTK cell type of the (half) mesh, for :func:`fracid.report.write_result_vtk`."""

@@ -1,0 +1,56 @@
+"""Discrete cohesive crack (Hordijk) along the ligament of the notched beam ([6/6] item 3)."""
+
+import numpy as np
+import pytest
+
+from fracid.model.cohesive import CohesiveParameters, dissipated_energy_density
+from fracid.model.cohesive_problem import crack_traction
+from fracid.models import CohesiveCrackModel
+from fracid.specimens.beam import NotchedBeam
+
+PARAMS = CohesiveParameters(E=37000.0, nu=0.2, ft=3.0, Gf=0.1)
+
+
+def test_crack_traction_tangent_matches_finite_differences():
+    ft, wc, c1, c2 = PARAMS.law()
+    penalty = 1e6
+    w0 = ft / penalty
+    w = np.array([-1e-5, 0.5 * w0, 0.3 * wc, 0.6 * wc, 0.2 * wc, 1.2 * wc])
+    w_max = np.array([0.0, 0.0, 0.25 * wc, 0.7 * wc, 0.4 * wc, 0.0])  # closed, uncracked, loading, unloading ...
+    sigma, tangent, _ = crack_traction(w, w_max, ft, wc, c1, c2, penalty)
+    h = 1e-7 * wc
+    plus, _, _ = crack_traction(w + h, w_max, ft, wc, c1, c2, penalty)
+    minus, _, _ = crack_traction(w - h, w_max, ft, wc, c1, c2, penalty)
+    np.testing.assert_allclose(tangent, (plus - minus) / (2 * h), rtol=1e-5)
+    assert sigma[0] < 0 and sigma[1] == pytest.approx(0.5 * ft) and sigma[-1] == 0.0
+
+
+@pytest.fixture(scope="module")
+def separated():
+    beam = NotchedBeam(h_fine=2.0, h_coarse=6.0)
+    problem = beam.build_cohesive_problem(PARAMS)
+    result = CohesiveCrackModel().simulate(beam, PARAMS, target=7.0, stop_force_fraction=None, field_steps="last")
+    return beam, problem, result
+
+
+def test_dissipated_energy_at_separation_is_gf_times_the_ligament_area(separated):
+    beam, problem, result = separated
+    ligament = (beam.depth - beam.notch_depth) * beam.thickness
+    dissipated = result.observables["dissipated_energy"][-1]
+    assert result.force[-1] < 0.002 * result.force.max()  # separated: the force has gone
+    # the work still to come in the tail, F ~ 1 / delta^2: int_delta^inf F = F delta (about 1.5 %)
+    tail = result.force[-1] * result.observables["load_point_displacement"][-1]
+    assert dissipated + tail == pytest.approx(PARAMS.Gf * ligament, rel=0.02)
+    assert dissipated == pytest.approx(PARAMS.Gf * ligament, rel=0.03)
+    # the global energy balance equals the energy the crack dissipated, point by point
+    w_max = result.fields[max(result.fields)]["crack_opening_max"]
+    w0 = PARAMS.ft / problem.penalty
+    local = np.sum(dissipated_energy_density(np.maximum(w_max - w0, 0.0), *PARAMS.law()) * problem.dA)
+    assert dissipated == pytest.approx(local, rel=0.01)
+
+
+def test_cohesive_beam_curve_peaks_then_softens(separated):
+    _, _, result = separated
+    peak = int(np.argmax(result.force))
+    assert 0 < peak < len(result.force) - 10
+    assert np.all(np.diff(result.observables["crack_length"]) >= -1e-9)  # the crack only grows
