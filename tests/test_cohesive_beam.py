@@ -54,3 +54,21 @@ def test_cohesive_beam_curve_peaks_then_softens(separated):
     peak = int(np.argmax(result.force))
     assert 0 < peak < len(result.force) - 10
     assert np.all(np.diff(result.observables["crack_length"]) >= -1e-9)  # the crack only grows
+
+
+def test_twin_experiment_recovers_ft_and_gf_noise_free():
+    from fracid.inverse.forward_operator import Observation, ForwardOperator
+    from fracid.inverse.knn import ParameterSpace
+    from fracid.inverse.strategy import identify
+    from fracid.inverse.twin import synthetic_data
+    from fracid.parallel import make_executor
+
+    beam = NotchedBeam(h_fine=4.0, h_coarse=8.0)  # coarse: data and model share the mesh
+    op = ForwardOperator([Observation(beam, np.linspace(0.01, 0.3, 15), control="cmod")], PARAMS, ("ft", "Gf"),
+                         model=CohesiveCrackModel())
+    data = synthetic_data(op, [3.0, 0.1], {"global:relative": 0.01}, seed=None)
+    space = ParameterSpace(("ft", "Gf"), [1.5, 0.04], [5.0, 0.25])
+    with make_executor(2) as executor:
+        result = identify(op, data.y, data.covariance, space, n=12, k=3, groups=[np.arange(15)], executor=executor)
+    np.testing.assert_allclose(result.x, [3.0, 0.1], rtol=0.01)
+    assert result.units == {"ft": "MPa", "Gf": "N/mm"}
