@@ -105,7 +105,7 @@ def main(argv=None):
         rows.append(row)
         slug = name.replace(" ", "_").replace("+", "plus")
         (args.out / f"valley_{slug}.png").write_bytes(to_png(valley_figure(outcome.study.maps, outcome.study.multi_start,
-                                                                           TRUTH)))
+                                                                           TRUTH, outcome.study.names)))
         if outcome.study.stability is not None:
             ident = outcome.study.identification
             (args.out / f"stability_{slug}.png").write_bytes(

@@ -102,3 +102,18 @@ def test_multi_start_ends_agree_when_the_data_identify(executor):
     # noise-free data: each end is the truth within its posterior uncertainty (the prior pulls it a little)
     assert np.all(np.abs(ms.ends - TRUTH) <= 2 * ms.stds)
     assert np.all(ms.f < 1.0)  # and fits the data to well under one standard deviation per point
+
+
+def test_valley_figure_places_multi_start_ends_in_each_pairs_columns():
+    from fracid.inverse.uniqueness import MultiStart
+    from fracid.report.study import valley_figure
+
+    space = ParameterSpace(("a", "b", "c"), [0.0, 0.0, 0.0], [1.0, 2.0, 3.0])
+    points = space.from_unit(np.random.default_rng(0).random((30, 3)))
+    knn = knn_from_population(space, points, points, ["ok"] * 30, [""] * 30, [0.5, 1.0, 1.5], np.eye(3), k=3)
+    ends = np.array([[0.1, 1.1, 2.1], [0.2, 1.2, 2.2]])
+    ms = MultiStart(ends - 0.05, ends, np.ones((2, 3)), np.zeros(2), np.zeros(3))
+    fig = valley_figure(objective_maps(knn), ms, truth=[0.5, 1.0, 1.5], names=space.names)
+    for ax, (i, j) in zip(fig.axes[:3], [(0, 1), (0, 2), (1, 2)]):  # the pair axes come before the colour bars
+        [line] = [ln for ln in ax.get_lines() if ln.get_label() == "multi-start ends"]
+        np.testing.assert_allclose(np.column_stack(line.get_data()), ends[:, [i, j]])

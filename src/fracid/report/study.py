@@ -17,9 +17,12 @@ from fracid.report.figures import (_ESTIMATE, _MEASURED, _NEIGHBOUR, _new_figure
 from fracid.report.html import _e, _image, _table, write_report
 
 
-def valley_figure(maps, multi_start=None, truth=None):
+def valley_figure(maps, multi_start=None, truth=None, names=None):
     """Objective over each parameter pair (population coloured by log10(f - f_min + 1)), the valley
-    (points within the chi^2 level of the minimum) and the multi-start starts and ends."""
+    (points within the chi^2 level of the minimum) and the multi-start starts and ends.
+
+    ``names`` orders the columns of the multi-start points and of ``truth`` (the pair's own order
+    when omitted, which only fits two parameters)."""
     if not maps:
         return None
     fig = _new_figure(5.2 * len(maps), 4.4)
@@ -31,15 +34,14 @@ def valley_figure(maps, multi_start=None, truth=None):
         fig.colorbar(sc, ax=ax, label="log10(f - f_min + 1) [-]")
         ax.plot(m.points[m.valley, 0], m.points[m.valley, 1], "o", mfc="none", mec=_NEIGHBOUR, ms=10, mew=1.6,
                 label=f"valley: f - f_min <= {m.level:.3g} ({int(m.valley.sum())} points)")
+        i, j = (list(names).index(m.names[0]), list(names).index(m.names[1])) if names is not None else (0, 1)
         if multi_start is not None:
-            names = list(multi_start.names) if hasattr(multi_start, "names") else None
-            i, j = _pair_columns(m.names, names or m.names, multi_start.starts.shape[1])
             for a, b in zip(multi_start.starts, multi_start.ends):
                 ax.annotate("", xy=(b[i], b[j]), xytext=(a[i], a[j]), arrowprops={"arrowstyle": "->", "color": _ESTIMATE})
             ax.plot(multi_start.ends[:, i], multi_start.ends[:, j], "*", color=_ESTIMATE, ms=12, mec="k", mew=0.5,
                     label="multi-start ends")
         if truth is not None:
-            ax.plot([truth[0]], [truth[1]], "P", color="k", ms=10, label="truth")
+            ax.plot([truth[i]], [truth[j]], "P", color="k", ms=10, label="truth")
         _parameter_axis(ax, "x", m.points[:, 0])
         _parameter_axis(ax, "y", m.points[:, 1])
         ax.set_xlabel(parameter_label(m.names[0]))
@@ -49,13 +51,6 @@ def valley_figure(maps, multi_start=None, truth=None):
         ax.grid(alpha=0.3)
         ax.legend(fontsize="x-small", loc="best")
     return fig
-
-
-def _pair_columns(pair, names, p):
-    names = list(names)
-    if len(names) == p and pair[0] in names and pair[1] in names:
-        return names.index(pair[0]), names.index(pair[1])
-    return 0, 1
 
 
 def stability_figure(stability, names, estimate=None, std=None):
@@ -99,7 +94,7 @@ def prediction_figure(predictions):
 
 def study_figures(study, control=None, truth=None, size_effect=None) -> dict:
     """All figures of a study by name (None where there is nothing to draw)."""
-    figs = {"valley": valley_figure(study.maps, study.multi_start, truth),
+    figs = {"valley": valley_figure(study.maps, study.multi_start, truth, study.names),
             "predictions": prediction_figure(study.predictions)}
     if study.sensitivity is not None:
         figs["sensitivity"] = sensitivity_figure(study.sensitivity, control)
