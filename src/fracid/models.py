@@ -90,3 +90,19 @@ def parameter_units(model_or_params) -> dict:
     """Units of a model's parameters (from its parameter class or a parameter object)."""
     cls = getattr(model_or_params, "parameters", None) or type(model_or_params)
     return dict(cls.units())
+
+
+# ``[model] type`` of a configuration -> the forward model (one line per model)
+MODEL_TYPES = {
+    "gradient-damage": lambda: DamageModel("gradient"),
+    "local-damage": lambda: DamageModel("local"),
+    "cohesive-crack": lambda: CohesiveCrackModel(),
+}
+
+
+def model_from_type(name: str):
+    """The forward model named ``name`` in a configuration's ``[model] type`` (see :data:`MODEL_TYPES`)."""
+    try:
+        return MODEL_TYPES[name]()
+    except KeyError:
+        raise ValueError(f"model type = {name!r}; choose one of {sorted(MODEL_TYPES)}") from None
