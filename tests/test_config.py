@@ -417,3 +417,103 @@ def test_bad_config_is_named(tmp_path, text, purpose, words):
     assert message.startswith(str(path))
     for word in words:
         assert word in message, f"{word!r} not in: {message}"
+
+
+# ------------------------------------------------------------------------- other forward models
+
+COHESIVE = variant("""[model]
+type = "gradient-damage"
+[model.parameters]
+E = 37000.0
+kappa_i = 6.6e-5
+c = 9.0
+""", """[model]
+type = "cohesive-crack"
+[model.parameters]
+E = 37000.0
+ft = 3.0
+Gf = 0.1
+""", variant("""parameters = ["kappa_i", "beta", "c"]
+[identify.bounds]
+kappa_i = [4e-5, 1.2e-4]
+beta = [100.0, 2000.0]
+c = [1.0, 30.0]
+log = ["beta"]""", """parameters = ["ft", "Gf"]
+[identify.bounds]
+ft = [1.5, 6.0]
+Gf = [0.04, 0.3]
+log = ["Gf"]"""))
+
+
+def test_cohesive_model_config_builds_its_operator(tmp_path):
+    from fracid.model.cohesive import CohesiveParameters
+    from fracid.models import CohesiveCrackModel
+
+    cfg = load_config(write(tmp_path, COHESIVE))
+    assert build_parameters(cfg) == CohesiveParameters(E=37000.0, ft=3.0, Gf=0.1)
+    assert cfg.model.regularization is None and "regularization" not in simulate_settings(cfg)
+    operator = build_operator(cfg, build_data(cfg))
+    assert isinstance(operator.model, CohesiveCrackModel) and operator.names == ("ft", "Gf")
+    assert operator.units == {"ft": "MPa", "Gf": "N/mm"}
+    space = build_space(cfg)
+    assert space.names == ("ft", "Gf") and space.log == (False, True)
+
+
+def test_model_types_are_read_from_the_registry_when_loading(tmp_path, monkeypatch):
+    """A model registered in fracid.models.MODEL_TYPES is a valid [model] type with no change to the config code."""
+    import fracid.models
+    from fracid.config import build_model
+
+    text = COHESIVE.replace('type = "cohesive-crack"', 'type = "cohesive-crack-stiff"')
+    with pytest.raises(ConfigError, match="model.type = 'cohesive-crack-stiff'"):
+        load_config(write(tmp_path, text))
+    monkeypatch.setitem(fracid.models.MODEL_TYPES, "cohesive-crack-stiff",
+                        lambda: fracid.models.CohesiveCrackModel(penalty_factor=1e4))
+    cfg = load_config(write(tmp_path, text))
+    assert build_model(cfg).penalty_factor == 1e4
+    assert build_operator(cfg, build_data(cfg)).model == fracid.models.CohesiveCrackModel(penalty_factor=1e4)
+
+
+def test_simulate_cohesive_beam_from_its_config(tmp_path):
+    """`fracid simulate` with type = "cohesive-crack" on a coarse beam: a peaked, softening curve and its energy."""
+    from fracid.cli import main
+
+    assert main(["simulate", str(CONFIGS / "beam_cohesive_simulate.toml"), "--out", str(tmp_path), "--quiet"]) == 0
+    with open(tmp_path / "curve.csv") as handle:
+        names = handle.readline().strip().split(",")
+    curve = dict(zip(names, np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1).T))
+    assert {"cmod", "force_N", "crack_length", "dissipated_energy"} <= set(curve)
+    peak = int(np.argmax(curve["force_N"]))
+    assert 0 < peak < curve["cmod"].size - 10  # softening after the peak
+    assert 800.0 < curve["force_N"][peak] < 1100.0  # N; ft 3 MPa on the Gregoire beam (about 930 N)
+    assert curve["cmod"][-1] == pytest.approx(0.3)  # target reached: the force stays above 10 % of the peak
+    # the crack dissipates less than Gf times the ligament area before it has separated
+    assert 0.0 < curve["dissipated_energy"][-1] < 0.1 * 25.0 * 50.0
+    assert (tmp_path / "curve.png").stat().st_size > 0
+
+
+from fracid.models import MODEL_TYPES  # noqa: E402  (every registered model is a valid type)
+
+BAD_MODELS = [
+    pytest.param(variant('type = "gradient-damage"', 'type = "crack-bands"'), "identify",
+                 ["model.type", "'crack-bands'", "must be one of " + ", ".join(map(repr, MODEL_TYPES))],
+                 id="unknown-model-type-lists-registry"),
+    pytest.param(COHESIVE.replace("Gf = 0.1\n", "Gf = 0.1\nkappa_i = 6.6e-5\n", 1), "identify",
+                 ["model.parameters.kappa_i", "6.6e-05", "not a parameter of model.type = 'cohesive-crack'",
+                  "CohesiveParameters", "E, nu, ft, Gf, c1, c2"], id="damage-parameter-for-cohesive-model"),
+    pytest.param(COHESIVE.replace("ft = 3.0\n", "ft = -3.0\n", 1), "identify",
+                 ["model.parameters.ft", "-3.0", "valid range 0 < ft [MPa]"], id="cohesive-ft-negative"),
+    pytest.param(COHESIVE.replace("Gf = 0.1\n", "Gf = 0.1\nc1 = 10.0\nc2 = 2.0\n", 1), "identify",
+                 ["model.parameters", "c1", "c2", "CohesiveParameters", "area"], id="cohesive-law-without-area"),
+    pytest.param(COHESIVE.replace('parameters = ["ft", "Gf"]', 'parameters = ["ft", "beta"]'), "identify",
+                 ["identify.parameters", "'beta'", "not a model parameter of model.type = 'cohesive-crack'"],
+                 id="damage-parameter-identified-with-cohesive-model"),
+    pytest.param(COHESIVE.replace("Gf = [0.04, 0.3]", "Gf = [0.0, 0.3]"), "identify",
+                 ["identify.bounds.Gf", "[0.0, 0.3]", "lower bound 0 is outside the valid range 0 < Gf [N/mm]"],
+                 id="cohesive-bound-outside-valid-range"),
+]
+
+
+@pytest.mark.parametrize("text, purpose, words", BAD_MODELS)
+def test_bad_model_config_is_named(tmp_path, text, purpose, words):
+    test_bad_config_is_named(tmp_path, text, purpose, words)

@@ -66,19 +66,20 @@ def _out_dir(args, cfg) -> Path:
 
 
 def run_simulate(args) -> int:
-    from fracid.config import build_parameters, build_specimen, load_config, simulate_settings
-    from fracid.forward import simulate
+    from fracid.config import build_model, build_parameters, build_specimen, load_config, simulate_settings
     from fracid.progress import progress_bar
     from fracid.report.figures import curve_figure, to_png
 
     cfg = load_config(args.config, purpose="simulate")
-    specimen, params = build_specimen(cfg), build_parameters(cfg)
+    model, specimen, params = build_model(cfg), build_specimen(cfg), build_parameters(cfg)
     settings = simulate_settings(cfg)
+    settings.pop("regularization", None)  # the model carries its own
     if settings.get("target") is None:
         settings["target"] = specimen.default_target(params)
     out = _out_dir(args, cfg)
     with progress_bar(settings["target"], "forward analysis", False if args.quiet else None, unit="mm") as bar:
-        result = simulate(specimen, params, callback=lambda step, tau, force: bar.update(tau - bar.n), **settings)
+        result = model.simulate(specimen, params, callback=lambda step, tau, force: bar.update(tau - bar.n),
+                                **settings)
     columns = {result.control_name: result.control, "force_N": result.force, **result.observables}
     names = list(dict.fromkeys(columns))
     np.savetxt(out / "curve.csv", np.column_stack([columns[n] for n in names]), delimiter=",", header=",".join(names),
@@ -131,17 +132,30 @@ def run_identify(args, config_path=None) -> int:
     return 0
 
 
+def _no_size_effect(cfg) -> str:
+    return (f"{cfg.path}: model.type = {cfg.model.type!r}: the size-effect series is available for the damage "
+            "models only (fracid.inverse.size_effect.size_effect_series runs fracid.forward.simulate, which takes "
+            "a regularization, not a forward model)")
+
+
 def _size_effect(cfg, params, executor, sizes=(), quiet=True):
     """Nominal strength at ``params`` over the sizes of the force experiments (and ``sizes``), the
     measured nominal strength of those experiments, and Bazant fits of both.
 
     Returns (figure arguments, series, fits) or None when fewer than three sizes are involved.
+
+    Raises
+    ------
+    ConfigError
+        For a model without a ``regularization`` (the size-effect series runs the damage models only).
     """
     from dataclasses import replace
 
-    from fracid.config import build_experiment_data, build_specimen
+    from fracid.config import ConfigError, build_experiment_data, build_specimen
     from fracid.inverse.size_effect import fit_size_effect, nominal_strength, size_effect_series, specimen_size
 
+    if cfg.model.regularization is None:
+        raise ConfigError(_no_size_effect(cfg))
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
         if exp.quantity != "force":
@@ -205,7 +219,9 @@ def run_study_command(args) -> int:
         study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
                           progress=None if not args.quiet else False, log=lambda text: _say(args, text), **settings)
         size = None
-        if args.command == "study":
+        if args.command == "study" and cfg.model.regularization is None:
+            _say(args, "size effect skipped: " + _no_size_effect(cfg))
+        elif args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
     figure = None
     if size is not None:

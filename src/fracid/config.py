@@ -23,10 +23,14 @@ present they are always validated. Every other key is optional unless marked *re
 .. code-block:: toml
 
     [model]                             # optional; defaults: gradient damage, DamageParameters()
-    type = "gradient-damage"            # "gradient-damage" | "local-damage" (mesh-dependent)
-    [model.parameters]                  # any subset of E nu kappa_i alpha beta c eta; the rest take
-                                        # the defaults of DamageParameters (E 20000, nu 0.2,
-                                        # kappa_i 1e-4, alpha 0.99, beta 300, c 1, eta 10)
+    type = "gradient-damage"            # any name of fracid.models.MODEL_TYPES, read when the file is
+                                        #   validated: "gradient-damage" | "local-damage" (mesh-
+                                        #   dependent) | "cohesive-crack" (Hordijk crack on the beam's
+                                        #   ligament; parameters E nu ft Gf c1 c2) | models added later
+    [model.parameters]                  # any subset of the model's parameters (its parameter class's
+                                        # names(); checked by its own validation); the rest take the
+                                        # class's defaults. Gradient and local damage (DamageParameters):
+                                        # E 20000, nu 0.2, kappa_i 1e-4, alpha 0.99, beta 300, c 1, eta 10
     E = 37000.0                         # MPa, E > 0
     nu = 0.2                            # -, -1 < nu < 0.5
     kappa_i = 6.6e-5                    # -, kappa_i > 0
@@ -83,7 +87,8 @@ present they are always validated. Every other key is optional unless marked *re
                                         #   estimate by `fracid study`, not calibrated on
 
     [identify]                          # required for identification
-    parameters = ["kappa_i", "beta", "c"]   # required: model parameters to identify, no duplicates
+    parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
+                                            #   no duplicates
     [identify.bounds]                   # required: [lower, upper] for every identified parameter,
                                         #   lower < upper, both inside the parameter's valid range
     kappa_i = [4e-5, 1.2e-4]
@@ -144,7 +149,6 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.model.parameters import DamageParameters, _range_text
 
 __all__ = [
     "Config",
@@ -158,6 +162,7 @@ __all__ = [
     "SimulateConfig",
     "SpecimenConfig",
     "build_data",
+    "build_model",
     "build_operator",
     "build_parameters",
     "build_space",
@@ -178,7 +183,20 @@ class ConfigError(ValueError):
 
 # ------------------------------------------------------------------------------------ vocabularies
 
-_MODEL_TYPES = {"gradient-damage": "gradient", "local-damage": "local"}
+def _model_types() -> tuple:
+    """The ``[model] type`` names: those of :data:`fracid.models.MODEL_TYPES` at the time of the call,
+    so that a model registered there needs no change here."""
+    from fracid.models import MODEL_TYPES
+
+    return tuple(MODEL_TYPES)
+
+
+def _model_of(kind: str):
+    from fracid.models import model_from_type
+
+    return model_from_type(kind)
+
+
 _CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
 _FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 _LOCAL_UNITS = dict(_CONTROL_UNITS)
@@ -239,9 +257,10 @@ class ModelConfig:
     parameters: tuple = ()  # ((name, value), ...) as given
 
     @property
-    def regularization(self) -> str:
-        """``"gradient"`` or ``"local"`` (the ``regularization`` argument of the forward model)."""
-        return _MODEL_TYPES[self.type]
+    def regularization(self) -> str | None:
+        """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
+        (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
+        return getattr(_model_of(self.type), "regularization", None)
 
 
 @dataclass(frozen=True)
@@ -486,33 +505,59 @@ def _read_toml(path: Path) -> dict:
         raise ConfigError(f"{path}: not valid TOML: {err}") from None
 
 
-def _parameter_allowed(name: str) -> str:
-    return f"must be a number in the valid range {_range_text(name)} [{DamageParameters.units()[name]}]"
+def _range_text(cls, name: str) -> str:
+    """The valid range of parameter ``name`` of the parameter class ``cls`` as its own validation
+    words it (e.g. ``"0 < c"``, ``"-1 < nu < 0.5"``).
 
-
-def _valid_parameter(name: str, value: float) -> bool:
+    The parameter classes state their ranges only in their error messages ("... valid range: 0 < c"),
+    so an invalid value (nan) is offered to ``replace`` and the range read from the message; a class
+    that words it otherwise gets the limits of ``valid_bounds``.
+    """
     try:
-        DamageParameters(**{name: value})
-    except ValueError:
-        return False
-    return True
+        cls().replace(**{name: math.nan})
+    except ValueError as err:
+        text = str(err)
+        if "valid range: " in text:
+            return text.split("valid range: ", 1)[1].strip()
+    lower, upper = cls.valid_bounds([name])
+    return f"{lower[0]:g} <= {name} <= {upper[0]:g}"
+
+
+def _parameter_allowed(cls, name: str) -> str:
+    return f"must be a number in the valid range {_range_text(cls, name)} [{cls.units().get(name, '-')}]"
+
+
+def _valid_parameter(cls, name: str, value: float) -> bool:
+    """Whether ``value`` lies in the valid range of ``name`` (the class's ``valid_bounds``, whose open
+    ends are moved inside, so a value on an open end is refused). Conditions joining several
+    parameters are left to the class (see :func:`_model`)."""
+    lower, upper = cls.valid_bounds([name])
+    return bool(lower[0] <= value <= upper[0])
 
 
 def _model(ck: _Checker, raw) -> ModelConfig:
     if raw is None:
         return ModelConfig()
     ck.table("model", raw, _MODEL_KEYS)
-    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), tuple(_MODEL_TYPES))
-    params = ck.table("model.parameters", raw.get("parameters", {}), DamageParameters.names())
-    values = []
+    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), _model_types())
+    cls = _model_of(kind).parameters
+    names = cls.names()
+    params = raw.get("parameters", {})
+    if not isinstance(params, dict):
+        ck.fail("model.parameters", params, f"must be a table (section) with keys among {', '.join(names)}")
+    values = {}
     for name, value in params.items():
         key = f"model.parameters.{name}"
-        allowed = _parameter_allowed(name)
-        v = ck.number(key, value, allowed)
-        if not _valid_parameter(name, v):
-            ck.fail(key, value, allowed)
-        values.append((name, v))
-    return ModelConfig(type=kind, parameters=tuple(values))
+        if name not in names:
+            ck.fail(key, value, f"not a parameter of model.type = {kind!r} ({cls.__name__}); "
+                                f"allowed keys here: {', '.join(names)}")
+        values[name] = ck.number(key, value, _parameter_allowed(cls, name),
+                                 lambda v, name=name: _valid_parameter(cls, name, v))
+    try:  # conditions joining several parameters, e.g. the area of the cohesive law over c1, c2
+        cls(**values)
+    except ValueError as err:
+        ck.fail("model.parameters", params, f"rejected together by {cls.__name__} (model.type = {kind!r}): {err}")
+    return ModelConfig(type=kind, parameters=tuple(values.items()))
 
 
 def _field_kind(field: dataclasses.Field) -> str:
@@ -713,13 +758,14 @@ def _experiments(ck: _Checker, raw, base: Path, specimen: SpecimenConfig, needed
     return tuple(_experiment(ck, i, block, base, specimen) for i, block in enumerate(raw))
 
 
-def _identify(ck: _Checker, raw, n_y: int | None, needed: bool) -> IdentifyConfig | None:
+def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:
     if raw is None:
         if needed:
             ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
         return None
     ck.table("identify", raw, _IDENTIFY_KEYS)
-    names_all = DamageParameters.names()
+    cls = _model_of(model.type).parameters
+    names_all = cls.names()
     if "parameters" not in raw:
         ck.missing("identify.parameters", "a list of model parameters among " + ", ".join(names_all))
     value = raw["parameters"]
@@ -727,7 +773,8 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool) -> IdentifyConfi
         ck.fail("identify.parameters", value, "must be a non-empty list of model parameters among " + ", ".join(names_all))
     for name in value:
         if name not in names_all:
-            ck.fail("identify.parameters", value, f"{name!r} is not a model parameter; allowed: {', '.join(names_all)}")
+            ck.fail("identify.parameters", value, f"{name!r} is not a model parameter of model.type = {model.type!r} "
+                                                  f"({cls.__name__}); allowed: {', '.join(names_all)}")
     duplicates = sorted({v for v in value if value.count(v) > 1})
     if duplicates:
         ck.fail("identify.parameters", value, f"duplicate parameter {', '.join(map(repr, duplicates))}; list each once")
@@ -739,8 +786,8 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool) -> IdentifyConfi
     lower, upper = [], []
     for name in names:
         key = f"identify.bounds.{name}"
-        unit = DamageParameters.units()[name]
-        allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(name)} [{unit}]"
+        unit = cls.units().get(name, "-")
+        allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(cls, name)} [{unit}]"
         if name not in bounds:
             ck.missing(key, f"[lower, upper] bounds of the identified parameter {name} [{unit}]")
         pair = bounds[name]
@@ -748,8 +795,8 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool) -> IdentifyConfi
         if not lo < hi:
             ck.fail(key, pair, f"lower = {lo:g} must be below upper = {hi:g} ({allowed})")
         for which, v in (("lower", lo), ("upper", hi)):
-            if not _valid_parameter(name, v):
-                ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(name)} [{unit}]")
+            if not _valid_parameter(cls, name, v):
+                ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(cls, name)} [{unit}]")
         lower.append(lo)
         upper.append(hi)
     log = ()
@@ -875,7 +922,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
     if experiments and not n_y and purpose == "identify":
         ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
-    identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify")
+    identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
     output = _output(ck, raw.get("output"), base)
     simulate = _simulate(ck, raw.get("simulate"))
     study = _study(ck, raw.get("study"))
@@ -894,9 +941,16 @@ def _require(cfg: Config, section: str):
     return value
 
 
-def build_parameters(cfg: Config) -> DamageParameters:
-    """The model parameters: those given in ``[model.parameters]``, the rest the defaults."""
-    return DamageParameters(**dict(cfg.model.parameters))
+def build_model(cfg: Config):
+    """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
+    return _model_of(cfg.model.type)
+
+
+def build_parameters(cfg: Config):
+    """The model parameters, an instance of the model's parameter class (``DamageParameters`` for
+    the damage models, ``CohesiveParameters`` for the cohesive crack): those given in
+    ``[model.parameters]``, the rest the class's defaults."""
+    return build_model(cfg).parameters(**dict(cfg.model.parameters))
 
 
 def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
@@ -975,8 +1029,7 @@ def _operator(cfg: Config, experiments, data):
         except ValueError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
                               f"{_show(exp.control_range and list(exp.control_range))}: {err}") from None
-    return ForwardOperator(observations, build_parameters(cfg), identify.parameters,
-                           regularization=cfg.model.regularization)
+    return ForwardOperator(observations, build_parameters(cfg), identify.parameters, model=build_model(cfg))
 
 
 def build_operator(cfg: Config, data):
@@ -1041,10 +1094,14 @@ def identify_settings(cfg: Config) -> dict:
 
 
 def simulate_settings(cfg: Config) -> dict:
-    """Keyword arguments of :func:`fracid.forward.simulate` besides the specimen and parameters:
-    ``regularization``, ``control``, ``target``, ``stop_force_fraction``, ``damage_threshold`` and
-    ``field_steps`` (the VTK steps, or ``"last"`` when none are listed)."""
+    """Keyword arguments of a forward run besides the specimen and parameters: ``control``,
+    ``target``, ``stop_force_fraction``, ``damage_threshold`` and ``field_steps`` (the VTK steps, or
+    ``"last"`` when none are listed), as taken by ``build_model(cfg).simulate``; for the damage
+    models also ``regularization``, so that they are those of :func:`fracid.forward.simulate` too
+    (drop it when calling the model's ``simulate``, which sets it itself)."""
     sim = cfg.simulate
-    return {"regularization": cfg.model.regularization, "control": cfg.specimen.control, "target": sim.target,
-            "stop_force_fraction": sim.stop_force_fraction, "damage_threshold": sim.damage_threshold,
-            "field_steps": list(cfg.output.vtk_steps) if cfg.output.vtk_steps else "last"}
+    settings = {"control": cfg.specimen.control, "target": sim.target,
+                "stop_force_fraction": sim.stop_force_fraction, "damage_threshold": sim.damage_threshold,
+                "field_steps": list(cfg.output.vtk_steps) if cfg.output.vtk_steps else "last"}
+    regularization = cfg.model.regularization
+    return settings if regularization is None else {"regularization": regularization, **settings}

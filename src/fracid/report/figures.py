@@ -51,9 +51,22 @@ def _new_figure(width: float, height: float) -> Figure:
     return fig
 
 
+def parameter_units() -> dict:
+    """Unit of every parameter name of the registered forward models (:data:`fracid.models.MODEL_TYPES`),
+    those of :class:`DamageParameters` first: a result holds only names, and the figures label
+    the parameters of any model (e.g. ``ft [MPa]`` of the cohesive crack)."""
+    from fracid.models import MODEL_TYPES
+
+    units = {}
+    for make in MODEL_TYPES.values():
+        for name, unit in make().parameters.units().items():
+            units.setdefault(name, unit)
+    return {**units, **DamageParameters.units()}
+
+
 def parameter_label(name: str) -> str:
-    """Axis label of a parameter with its unit, e.g. ``"c [mm^2]"``, ``"beta [-]"``."""
-    unit = DamageParameters.units().get(name)
+    """Axis label of a parameter with its unit, e.g. ``"c [mm^2]"``, ``"beta [-]"``, ``"ft [MPa]"``."""
+    unit = parameter_units().get(name)
     return f"{name} [{unit}]" if unit else str(name)
 
 

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.model.parameters import DamageParameters
 
 _CSS = """
 body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 2em auto; max-width: 1100px;
@@ -155,7 +154,9 @@ def fit_metrics(result) -> list[dict]:
 
 
 def _parameter_section(result) -> str:
-    units = DamageParameters.units()
+    from fracid.report.figures import parameter_units
+
+    units = {**parameter_units(), **(getattr(result, "units", None) or {})}
     x = np.asarray(result.x, float)
     std = np.asarray(result.std, float)
     rows = []

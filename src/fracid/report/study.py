@@ -11,9 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.model.parameters import DamageParameters
 from fracid.report.figures import (_ESTIMATE, _MEASURED, _NEIGHBOUR, _new_figure, _parameter_axis, parameter_label,
-                                   sensitivity_figure, size_effect_figure, to_png)
+                                   parameter_units, sensitivity_figure, size_effect_figure, to_png)
 from fracid.report.html import _e, _image, _table, write_report
 
 
@@ -107,7 +106,7 @@ def study_figures(study, control=None, truth=None, size_effect=None) -> dict:
 
 
 def _verdict_section(study) -> str:
-    units = DamageParameters.units()
+    units = {**parameter_units(), **(study.identification.units or {})}
     rows = [[v.name, v.status, f"{v.value:.5g}", f"{v.std:.3g}", f"{v.std / abs(v.value):.1%}",
              f"{v.partner} ({v.correlation:+.3f})" if v.partner else "", f"{v.variance_removed:.0%}",
              "; ".join(v.remarks + tuple(f"would help: {s}" for s in v.suggestions))] for v in study.verdict.parameters]
