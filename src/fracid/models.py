@@ -13,7 +13,8 @@ damage_threshold)``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
     :class:`~fracid.model.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
 
-:class:`DamageModel` wraps the implicit gradient-enhanced damage model and its local variant.
+:class:`DamageModel` wraps the implicit gradient-enhanced damage model, its local variant and the
+integral-type nonlocal model.
 """
 
 from __future__ import annotations
@@ -34,14 +35,16 @@ class ForwardModel(Protocol):
 @dataclass(frozen=True)
 class DamageModel:
     """Continuum damage with exponential softening (SPEC 1): ``"gradient"`` (implicit gradient
-    enhancement) or ``"local"`` (no regularisation; mesh-dependent, for comparison)."""
+    enhancement), ``"local"`` (no regularisation; mesh-dependent, for comparison) or ``"integral"``
+    (Gaussian average of the equivalent strain, internal length l = sqrt(2 c): same parameters as
+    the gradient model)."""
 
     regularization: str = "gradient"
     parameters: ClassVar[type] = DamageParameters
 
     def __post_init__(self):
-        if self.regularization not in ("gradient", "local"):
-            raise ValueError(f"regularization = {self.regularization!r}; choose 'gradient' or 'local'")
+        if self.regularization not in ("gradient", "local", "integral"):
+            raise ValueError(f"regularization = {self.regularization!r}; choose 'gradient', 'local' or 'integral'")
 
     @property
     def key(self) -> str:
@@ -70,20 +73,48 @@ class CohesiveCrackModel:
 
         return CohesiveParameters
 
-    def simulate(self, specimen, params, *, control=None, target=None, stop_force_fraction=0.1, steps=None,
-                 field_steps="last", checkpoints=None, damage_threshold=0.0, **options):
-        from fracid.model.path_following import StepOptions, follow_path
-
+    def simulate(self, specimen, params, **options):
         if not hasattr(specimen, "build_cohesive_problem"):
             raise TypeError(f"{type(specimen).__name__} has no cohesive crack (build_cohesive_problem)")
         problem = specimen.build_cohesive_problem(params, self.penalty_factor)
-        target = target if target is not None else specimen.default_target(params)
-        if steps is None:
-            steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
         observers = {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
-        return follow_path(problem, control or specimen.default_control, target, steps=steps,
-                           stop_force_fraction=stop_force_fraction, observers=observers, field_steps=field_steps,
-                           checkpoints=checkpoints, **options)
+        return _follow(problem, specimen, params, observers, **options)
+
+
+@dataclass(frozen=True)
+class CrackBandModel:
+    """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width (SPEC 5).
+
+    Same parameters as the cohesive crack (:class:`~fracid.model.cohesive.CohesiveParameters`), so the
+    two are directly comparable. Specimens must offer ``build_crack_band_problem(params)`` (the notched
+    beam and the tension strip do).
+    """
+
+    key: ClassVar[str] = "crack-band-hordijk"
+
+    @property
+    def parameters(self):
+        from fracid.model.cohesive import CohesiveParameters
+
+        return CohesiveParameters
+
+    def simulate(self, specimen, params, **options):
+        if not hasattr(specimen, "build_crack_band_problem"):
+            raise TypeError(f"{type(specimen).__name__} has no crack band model (build_crack_band_problem)")
+        return _follow(specimen.build_crack_band_problem(params), specimen, params, {}, **options)
+
+
+def _follow(problem, specimen, params, observers, *, control=None, target=None, stop_force_fraction=0.1,
+            steps=None, damage_threshold=0.0, **options):
+    """Path following of a specimen's problem with the specimen's default control, target and steps
+    (``damage_threshold`` concerns the damage models' FPZ width only)."""
+    from fracid.model.path_following import StepOptions, follow_path
+
+    target = target if target is not None else specimen.default_target(params)
+    if steps is None:
+        steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
+    return follow_path(problem, control or specimen.default_control, target, steps=steps,
+                       stop_force_fraction=stop_force_fraction, observers=observers, **options)
 
 
 def parameter_units(model_or_params) -> dict:
@@ -96,7 +127,9 @@ def parameter_units(model_or_params) -> dict:
 MODEL_TYPES = {
     "gradient-damage": lambda: DamageModel("gradient"),
     "local-damage": lambda: DamageModel("local"),
+    "integral-damage": lambda: DamageModel("integral"),
     "cohesive-crack": lambda: CohesiveCrackModel(),
+    "crack-band": lambda: CrackBandModel(),
 }
 
 

@@ -91,35 +91,42 @@ class NotchedBeam:
     def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None,
                       crack_free: bool = False) -> DamageProblem:
         mesh = mesh or self.mesh()
-        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        return DamageProblem(disc, params, regularization=regularization, damageable=0.0 if crack_free else 1.0,
+                             symmetry_planes=[] if crack_free else [(0, 0.0)],
+                             **self._conditions(mesh, crack_free, rigid_plates=not crack_free))
+
+    def _conditions(self, mesh: QuadMesh, crack_free: bool = False, rigid_plates: bool = True) -> dict:
+        """Supports, load pattern and functionals of the half beam (keyword arguments of the problems).
+
+        ``crack_free``: no symmetry condition on the ligament (a discrete crack lies there);
+        ``rigid_plates``: the loading plate moves as one and the support holds its nodes, else an
+        even pressure loads the beam and the support is a point.
+        """
+        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
         ligament = np.flatnonzero((np.abs(x) < 1e-9) & (y >= self.notch_depth - 1e-9))
         support = np.flatnonzero((np.abs(y) < 1e-9) & (np.abs(x - self.span / 2) <= self.plate_width / 2 + 1e-9))
         plate = np.flatnonzero((np.abs(y - self.depth) < 1e-9) & (x <= self.plate_width / 2 + 1e-9))
         mouth = mesh.closest_node((self.notch_width / 2, 0.0))
         master = int(plate[np.argmin(x[plate])])
-        if crack_free:
-            # a cohesive crack replaces the symmetry condition; the plate loads by an even pressure
-            # instead of a rigid tie, and the support is a point: rigid plates would clamp the halves'
-            # rotation and carry load by frame action once the crack has opened
-            symmetry, tied = [], []
+        symmetry = [] if crack_free else [2 * ligament]
+        if rigid_plates:
+            tied = [2 * plate + 1]
+            load = {2 * master + 1: -0.5}  # the half model carries half the force: lambda = total force [N]
+            deflection = {2 * master + 1: -1.0}
+        else:
+            # an even pressure under the plate and a point support: once a crack has opened, rigid
+            # plates would clamp the halves' rotation and carry load by frame action
+            tied = []
             support = np.array([mesh.closest_node((self.span / 2, 0.0))])
             load = {2 * n + 1: -0.5 / plate.size for n in plate}
             deflection = {2 * n + 1: -1.0 / plate.size for n in plate}
-        else:
-            symmetry, tied = [2 * ligament], [2 * plate + 1]
-            load = {2 * master + 1: -0.5}  # the half model carries half the force: lambda = total force [N]
-            deflection = {2 * master + 1: -1.0}
-        return DamageProblem(
-            disc,
-            params,
-            regularization=regularization,
+        return dict(
             fixed_dofs=np.concatenate(symmetry + [2 * support + 1]),
             tied=tied,
             load=load,
             functionals={"cmod": {2 * mouth: 2.0}, "deflection": deflection},
             symmetry_factor=2.0,
-            damageable=0.0 if crack_free else 1.0,
         )
 
     def build_cohesive_problem(self, params, penalty_factor: float = 1000.0):
@@ -135,6 +142,24 @@ class NotchedBeam:
         bulk = self.build_problem(DamageParameters(E=params.E, nu=params.nu), "local", mesh, crack_free=True)
         edges = ligament_edges(mesh.nodes, mesh.cells, bulk.disc.u_dofs, self.notch_depth)
         return CohesiveCrackProblem(bulk, edges, params, self.thickness, penalty_factor * params.E / self.h_fine)
+
+    def build_crack_band_problem(self, params):
+        """Half beam with a rotating crack band (Hordijk, :class:`~fracid.model.cohesive.CohesiveParameters`)
+        in the element column on the symmetry line above the notch (SPEC 5, smeared crack).
+
+        The crack is confined to that column, as the cohesive crack is to the ligament: in a half model
+        a band anywhere else would be mirrored into two cracks. The column is half of a band centred on
+        the symmetry line, so its band width is twice its width.
+        """
+        from fracid.model.crack_band_problem import CrackBandProblem, element_extent
+
+        mesh = self.mesh()
+        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        corners = mesh.nodes[mesh.cells[:, :4]]
+        on_ligament = (corners[..., 0].min(axis=1) < 1e-9) & (corners[..., 1].min(axis=1) >= self.notch_depth - 1e-9)
+        return CrackBandProblem(disc, params, 2.0 * element_extent(mesh.nodes, mesh.cells, (1.0, 0.0)),
+                                crackable=np.repeat(on_ligament[:, None], disc.weights.shape[1], axis=1).astype(float),
+                                **self._conditions(mesh, rigid_plates=False))
 
     def output_mesh(self):
         """Nodes, cells and VTK cell type of the (half) mesh, for :func:`fracid.report.write_result_vtk`."""

@@ -1,0 +1,184 @@
+"""Smeared crack band with Hordijk softening: a rotating crack in plane stress (SPEC 5).
+
+**Choice: rotating crack.** The crack normal follows the major principal direction of the
+(effective) stress, which is that of the strain for an isotropic bulk: the crack is coaxial. A fixed
+crack keeps the normal of crack initiation and needs a shear-retention factor, an extra parameter
+that no force-CMOD curve identifies, and it locks stress when the principal directions turn after
+cracking (spurious stress transfer across the band); the rotating crack has neither, and in mode I
+(the notched beam, the tension test) the two coincide.
+
+**The law.** With s = D eps the effective stress per unit E (D the unit plane-stress matrix), its
+major principal value lambda_1 and the projectors P_1, P_2 on its principal directions, the crack
+strain e_c n (x) n (n the major direction) takes the stress normal to the crack down to
+(1 - omega) E lambda_1 and leaves the rest of the elastic response alone:
+
+    sigma = E (s - omega <lambda_1> (P_1 + nu P_2))        (P_1 + nu P_2 = D (n (x) n) / D_nnnn),
+
+so a crack transmits no Poisson stress across the band and a closed crack (lambda_1 <= 0) carries
+compression. The history kappa is the largest lambda_1 reached (Rankine, in strain units). In
+uniaxial tension the crack strain is e_c = (1 - nu^2) omega kappa, and omega(kappa) is set so that
+the stress follows Hordijk's law of the crack opening w = h e_c, h the crack band width:
+
+    E (kappa - w / h') = sigma_H(w),   h' = (1 - nu^2) h,
+
+the stress of the band equal to the cohesive traction of its crack. The energy dissipated per unit
+band volume is then Gf / h, per unit crack area Gf, whatever the element size. The equation has one
+root in w when the band is narrower than the snap-back limit h' < E / max|d sigma_H / dw|
+(:func:`snap_back_limit`); wider elements are refused.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fracid.model.cohesive import _normalised_law, hordijk_stress, hordijk_tangent
+from fracid.model.damage import update_history
+
+
+def principal_tension(s):
+    """Major principal value of plane stress-like tensors, its tensile part on its projector, and
+    their derivatives.
+
+    Parameters
+    ----------
+    s : ndarray, shape (..., 3)
+        Voigt components (sxx, syy, sxy).
+
+    Returns
+    -------
+    lam : ndarray, shape (...)
+        Major principal value lambda_1.
+    F : ndarray, shape (..., 3)
+        <lambda_1> P_1 in Voigt components (zero where lambda_1 <= 0).
+    dF : ndarray, shape (..., 3, 3)
+        dF_i / ds_j.
+    dlam : ndarray, shape (..., 3)
+        d lambda_1 / ds_j.
+
+    Notes
+    -----
+    In 2D, P_1 = (s - lambda_2 I) / (lambda_1 - lambda_2), so with m = (sxx + syy) / 2,
+    a = (sxx - syy) / 2, r = sqrt(a^2 + sxy^2) (lambda_1,2 = m +- r):
+    lambda_1 P_1 = (m + r) / 2 (1, 1, 0) + (m / r + 1) / 2 (a, -a, sxy), a closed form with a
+    closed-form derivative. At equal principal values (r = 0) the direction is undefined; r is kept
+    above 1e-12 |m| + 1e-30 there (the damage term then acts along an arbitrary but fixed axis).
+    """
+    s = np.asarray(s, dtype=float)
+    m = 0.5 * (s[..., 0] + s[..., 1])
+    a = 0.5 * (s[..., 0] - s[..., 1])
+    t = s[..., 2]
+    r = np.maximum(np.hypot(a, t), 1e-12 * np.abs(m) + 1e-30)
+    lam = m + r
+    ones = np.array([1.0, 1.0, 0.0])
+    u = np.stack([a, -a, t], axis=-1)
+    g = 0.5 * (m / r + 1.0)
+    dm = np.broadcast_to(0.5 * ones, s.shape)
+    dr = np.stack([0.5 * a, -0.5 * a, t], axis=-1) / r[..., None]
+    dg = 0.5 * (dm / r[..., None] - (m / r**2)[..., None] * dr)
+    du = np.array([[0.5, -0.5, 0.0], [-0.5, 0.5, 0.0], [0.0, 0.0, 1.0]])
+    dlam = dm + dr
+    F = 0.5 * lam[..., None] * ones + g[..., None] * u
+    dF = 0.5 * ones[:, None] * dlam[..., None, :] + u[..., :, None] * dg[..., None, :] + g[..., None, None] * du
+    tensile = (lam > 0.0)[..., None]
+    return lam, np.where(tensile, F, 0.0), np.where(tensile[..., None], dF, 0.0), dlam
+
+
+def crack_direction_stress(s, nu):
+    """The stress a fully open crack removes, <lambda_1> (P_1 + nu P_2), with lambda_1 and the
+    derivatives d/ds of both (see :func:`principal_tension` for the arguments and shapes)."""
+    lam, F1, dF1, dlam = principal_tension(s)
+    tensile = (lam > 0.0)[..., None]
+    ones = np.array([1.0, 1.0, 0.0])  # P_1 + P_2 = I
+    F = (1.0 - nu) * F1 + nu * np.where(tensile, lam[..., None] * ones, 0.0)
+    dF = (1.0 - nu) * dF1 + nu * np.where(tensile[..., None], ones[:, None] * dlam[..., None, :], 0.0)
+    return lam, F, dF, dlam
+
+
+def snap_back_limit(E, ft, wc, c1, c2, samples: int = 2001) -> float:
+    """Widest crack band [mm] for which the band's stress-strain law has no snap-back:
+    h_max = E / max_w |d sigma_H / dw| (the softening slope of the band, -1 / (1/E - h / |sigma_H'|),
+    must stay negative)."""
+    x = np.linspace(0.0, 1.0, samples)
+    steepest = np.max(np.abs(_normalised_law(x, c1, c2)[1])) * ft / wc
+    return float(E / steepest)
+
+
+def band_damage(kappa, band_width, E, ft, wc, c1, c2, tol=1e-13, max_iterations=60):
+    """Damage omega(kappa) of the crack band and d omega / d kappa.
+
+    Solves E (kappa - w / h) = sigma_H(w) for the opening w in [0, h kappa] by Newton steps kept in
+    a shrinking bracket (bisection when a step leaves it), all points at once; omega = w / (h kappa).
+
+    Parameters
+    ----------
+    kappa : ndarray
+        Largest major principal effective stress / E reached [-].
+    band_width : ndarray
+        Crack band width h at each point [mm], below :func:`snap_back_limit`.
+    E, ft : float or ndarray
+        Young's modulus [MPa] and tensile strength [MPa] at each point.
+    wc, c1, c2 : float
+        Hordijk's critical opening [mm] and shape constants [-].
+
+    Returns
+    -------
+    omega, d_omega : ndarray
+        Damage [-] (0 below kappa_0 = ft / E) and its derivative.
+    """
+    kappa, h, E, ft = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (kappa, band_width, E, ft)))
+    cracked = kappa > ft / E
+    k = np.where(cracked, kappa, ft / E)
+    lo, hi = np.zeros_like(k), h * k
+    w = np.zeros_like(k)
+    for _ in range(max_iterations):
+        g = E * (k - w / h) - hordijk_stress(w, ft, wc, c1, c2)
+        slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)  # < 0 below the snap-back limit
+        lo, hi = np.where(g > 0.0, w, lo), np.where(g > 0.0, hi, w)
+        step = np.where(cracked, -g / slope, 0.0)
+        trial = w + step
+        w = np.where((trial >= lo) & (trial <= hi), trial, 0.5 * (lo + hi))
+        if np.all(np.abs(step) <= tol * wc):
+            break
+    slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)
+    dw = -E / slope
+    omega = np.where(cracked, w / (h * k), 0.0)
+    d_omega = np.where(cracked, dw / (h * k) - w / (h * k * k), 0.0)
+    return omega, d_omega
+
+
+def crack_band_stress(s, kappa_old, band_width, E, nu, ft, law, crackable=1.0):
+    """Stress, material tangent and history of the rotating crack band at all points.
+
+    Parameters
+    ----------
+    s : ndarray, shape (n_el, n_q, 3)
+        Effective stress per unit E, D eps [-].
+    kappa_old : ndarray, shape (n_el, n_q)
+        History of the last converged step [-].
+    band_width : ndarray, broadcastable to (n_el, n_q)
+        [mm].
+    E, ft : ndarray, shape (n_el, n_q)
+        Young's modulus [MPa] and tensile strength [MPa].
+    nu : float
+        Poisson's ratio [-].
+    law : tuple
+        (wc, c1, c2) of Hordijk's law; wc [mm] may vary over the points.
+    crackable : float or ndarray, shape (n_el, n_q)
+        1 where a crack may form, 0 where the material stays elastic.
+
+    Returns
+    -------
+    sigma : ndarray, shape (n_el, n_q, 3)
+        Stress [MPa].
+    dsigma_ds : ndarray, shape (n_el, n_q, 3, 3)
+        d sigma / d s [MPa] (multiply by D for d sigma / d eps).
+    kappa, omega : ndarray, shape (n_el, n_q)
+    """
+    lam, F, dF, dlam = crack_direction_stress(s, nu)
+    kappa, loading = update_history(kappa_old, lam)
+    h = (1.0 - nu * nu) * np.asarray(band_width)
+    omega, d_omega = (crackable * v for v in band_damage(kappa, h, E, ft, *law))
+    sigma = E[..., None] * (s - omega[..., None] * F)
+    softening = (d_omega * loading)[..., None, None] * F[..., :, None] * dlam[..., None, :]
+    dsigma = E[..., None, None] * (np.eye(3) - omega[..., None, None] * dF - softening)
+    return sigma, dsigma, kappa, omega
