@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from fracid.model.damage import exponential_damage, update_history
+from fracid.model.nonlocal_average import NonlocalAveraging, softening_coupling
 
 
 class ElementArrays(NamedTuple):
@@ -19,7 +20,9 @@ class ElementArrays(NamedTuple):
 
     ``residual`` is (n_el, n_dof_el) with the displacement dofs first; ``tangent`` is
     (n_el, n_dof_el, n_dof_el); ``reference`` holds per field the element vectors whose assembled
-    norm scales that field's residual (internal forces for u, the equivalent-strain source for ebar).
+    norm scales that field's residual (internal forces for u, the equivalent-strain source for ebar);
+    ``coupling`` holds the tangent entries between points of different elements that the integral
+    model adds (None for the element-local models) [N/mm].
     """
 
     residual: np.ndarray
@@ -27,6 +30,7 @@ class ElementArrays(NamedTuple):
     reference: dict
     kappa: np.ndarray
     omega: np.ndarray
+    coupling: object = None  # scipy.sparse matrix over the free dofs, added to the assembled tangent
 
 
 class ModelConstants(NamedTuple):
@@ -113,6 +117,42 @@ def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent
     softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1), _bt(d_eq, B))
     out_tangent[:] = secant - softening
     return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)
+
+
+def integral_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
+    """Integral-type nonlocal damage: kappa follows the Gaussian average ebar = A eps_eq of the
+    local equivalent strain (see :mod:`fracid.model.nonlocal_average`).
+
+    Parameters
+    ----------
+    ue : ndarray, shape (n_el, n_u)
+        Element displacements [mm].
+    kappa_old : ndarray, shape (n_el, n_q)
+        History variable at the end of the last converged step [-].
+    out_tangent : ndarray, shape (n_el, n_u, n_u)
+        Buffer for the element tangents.
+    averaging : NonlocalAveraging
+        The averaging matrix of the mesh and the map of the points to the free dofs.
+
+    Returns
+    -------
+    ElementArrays
+        The element tangent is the secant stiffness minus the softening of each point driven by its
+        own strain (A_ii); ``coupling`` is the rest of the consistent tangent, - G A_offdiag H over
+        the free dofs, which couples points of different elements (None while nothing softens).
+    """
+    B, w = disc.strain_operator, disc.weights
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
+    kappa, loading = update_history(kappa_old, ebar)
+    omega, d_omega = _damage(params, const, kappa)
+    bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
+    g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
+    h = _bt(d_eq, B)  # d eps_eq / d u at each point
+    out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
+    coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega, coupling)
 
 
 def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:

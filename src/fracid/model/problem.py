@@ -8,10 +8,11 @@ import numpy as np
 
 from fracid.model.assembly import assemble_vector, norm2
 from fracid.model.discretization import MixedDiscretization
-from fracid.model.forms import elastic_energy, gradient_damage, local_damage, model_constants
+from fracid.model.forms import elastic_energy, gradient_damage, integral_damage, local_damage, model_constants
+from fracid.model.nonlocal_average import internal_length, nonlocal_averaging
 from fracid.model.parameters import DamageParameters
 
-REGULARIZATIONS = ("gradient", "local")
+REGULARIZATIONS = ("gradient", "local", "integral")
 
 
 class DamageProblem:
@@ -26,8 +27,10 @@ class DamageProblem:
     ----------
     disc : MixedDiscretization
     params : DamageParameters
-    regularization : {"gradient", "local"}
-        Implicit gradient-enhanced damage, or the local damage model (no ebar dofs) for comparison.
+    regularization : {"gradient", "local", "integral"}
+        Implicit gradient-enhanced damage; the local damage model (no ebar dofs) for comparison; or
+        integral-type nonlocal damage (no ebar dofs, Gaussian average of internal length
+        l = sqrt(2 c) over the integration points, built once here).
     stiffness_factor : float or ndarray, shape (n_el, n_q)
         Young's modulus at each integration point relative to ``params.E`` (weak zones) [-].
     fixed_dofs : sequence of int
@@ -43,6 +46,11 @@ class DamageProblem:
         energies are reported for the whole specimen.
     damageable : float or ndarray, shape (n_el, n_q)
         1 where the material damages, 0 where it stays elastic (loading platens) [-].
+    symmetry_planes : sequence of (axis, coordinate)
+        Symmetry planes x[axis] = coordinate [mm] of a half or quarter model. Only the integral model
+        needs them (the nonlocal average reaches across the plane, see
+        :func:`~fracid.model.nonlocal_average.averaging_matrix`); the gradient model's natural
+        boundary condition already is the symmetry condition.
     """
 
     def __init__(
@@ -58,6 +66,7 @@ class DamageProblem:
         tied=(),
         symmetry_factor: float = 1.0,
         damageable=1.0,
+        symmetry_planes=(),
     ):
         if regularization not in REGULARIZATIONS:
             raise ValueError(f"regularization = {regularization!r}; choose one of {REGULARIZATIONS}")
@@ -87,6 +96,10 @@ class DamageProblem:
         self._tangent = np.zeros((disc.n_elements,) + (self.element_dofs.shape[1],) * 2)
         if gradient:
             self._tangent[:, n_u:, n_u:] = self.const.ebar_matrix
+        self.averaging = None
+        if regularization == "integral":
+            length = internal_length(params.c)
+            self.averaging = nonlocal_averaging(disc, length, self.element_dofs, self.n_free, mirror=symmetry_planes)
 
     def _number_unknowns(self, n_active, fixed, tied) -> np.ndarray:
         """Unknown index of every dof: -1 if fixed or absent, shared within a tied group."""
@@ -137,7 +150,7 @@ class DamageProblem:
         residual : ndarray, shape (n_free,)
             Internal forces minus the equivalent-strain source (no external load).
         arrays : ElementArrays
-            Element tangents, trial history and damage.
+            Element tangents, trial history and damage (and the nonlocal coupling of the integral model).
         references : dict {field: float}
             Norms that make the residual of each field relative.
         """
@@ -145,6 +158,8 @@ class DamageProblem:
         n_u = self.disc.u_dofs.shape[1]
         if self.regularization == "gradient":
             arrays = gradient_damage(self.disc, self.params, self.const, qe[:, :n_u], qe[:, n_u:], kappa_old, self._tangent)
+        elif self.regularization == "integral":
+            arrays = integral_damage(self.disc, self.params, self.const, qe, kappa_old, self._tangent, self.averaging)
         else:
             arrays = local_damage(self.disc, self.params, self.const, qe, kappa_old, self._tangent)
         residual = assemble_vector(self.element_dofs, arrays.residual, self.n_free)

@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from fracid.model.assembly import SparsePattern, dot, norm2
 from fracid.model.linear_solvers import SingularMatrixError
@@ -107,7 +108,8 @@ class ControlledSystem:
         return residual, arrays, errors, (internal, arrays, references)
 
     def matrix(self, arrays):
-        return self.pattern.matrix(arrays.tangent, self.border_values)
+        """The bordered tangent (CSC), with the nonlocal coupling of the integral model if any."""
+        return _add_coupling(self.pattern.matrix(arrays.tangent, self.border_values), _coupling(arrays))
 
     def scaled_matrix(self, arrays):
         """The bordered matrix equilibrated as S M S, and the diagonal of S.
@@ -116,14 +118,36 @@ class ControlledSystem:
         border). The rows of equilibrium (order E t) and of the diffusion equation (order mm^2)
         differ by six orders of magnitude; equilibrated, SuperLU reaches 1e-15 relative residuals
         instead of 1e-7 and PARDISO no longer perturbs pivots of the virgin state.
+
+        A nonlocal coupling (integral model) has a pattern of its own that changes with the
+        loading points, so it is scaled entry by entry with the same S and added: the sum has a
+        new pattern, and PARDISO then redoes its symbolic analysis (correct, only slower).
         """
-        matrix = self.matrix(arrays)
+        matrix = self.pattern.matrix(arrays.tangent, self.border_values)
         if self._scale is None:
             diagonal = np.abs(matrix.diagonal())
             self._scale = np.where(diagonal > 0.0, 1.0 / np.sqrt(np.where(diagonal > 0.0, diagonal, 1.0)), 1.0)
             self._entry_scale = self._scale[matrix.indices] * np.repeat(self._scale, np.diff(matrix.indptr))
         matrix.data *= self._entry_scale
-        return matrix, self._scale
+        coupling = _coupling(arrays)
+        if coupling is not None:
+            coupling = sp.csc_matrix(coupling, copy=True)
+            coupling.data *= self._scale[coupling.indices] * np.repeat(self._scale[:-1], np.diff(coupling.indptr))
+        return _add_coupling(matrix, coupling), self._scale
+
+
+def _coupling(arrays):
+    # element arrays of other models (a NamedTuple without the field) have no coupling
+    return getattr(arrays, "coupling", None)
+
+
+def _add_coupling(matrix, coupling):
+    """``matrix`` (n + 1, n + 1) plus ``coupling`` (n, n) padded with the border row and column, as CSC."""
+    if coupling is None:
+        return matrix
+    coupling = sp.csc_matrix(coupling)
+    padded = sp.csc_matrix((coupling.data, coupling.indices, np.append(coupling.indptr, coupling.indptr[-1])), shape=matrix.shape)
+    return (matrix + padded).tocsc()
 
 
 def solve_increment(
