@@ -30,7 +30,7 @@ def simulate(
     specimen
         A specimen object (e.g. :class:`~fracid.specimens.bar.BarWithWeakZone`).
     params : DamageParameters
-    regularization : {"gradient", "local"}
+    regularization : {"gradient", "local", "integral"}
     control : str, optional
         Prescribed quantity; the specimen's default (plain displacement control) if None.
     target : float, optional

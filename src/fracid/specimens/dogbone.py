@@ -147,6 +147,7 @@ class DogBone:
             load={2 * master + 1: 0.5},  # the quarter carries half the force: lambda = total force [N]
             functionals={"elongation": {2 * gauge + 1: 2.0}, "platen_displacement": {2 * master + 1: 2.0}},
             symmetry_factor=4.0,
+            symmetry_planes=[(0, 0.0), (1, 0.0)],
         )
 
     def _hinged_problem(self, params, regularization, mesh, disc) -> DamageProblem:
@@ -172,6 +173,7 @@ class DogBone:
                 "platen_tilt": {2 * corners[0] + 1: 1.0, 2 * corners[1] + 1: -1.0},
             },
             symmetry_factor=2.0,
+            symmetry_planes=[(1, 0.0)],
         )
 
     def output_mesh(self):
