@@ -146,23 +146,37 @@ def band_damage(kappa, band_width, E, ft, wc, c1, c2, tol=1e-13, max_iterations=
     return omega, d_omega
 
 
-def crack_band_stress(s, kappa_old, band_width, E, nu, ft, law, crackable=1.0):
+def element_mean(values, weights):
+    """Weighted mean over the integration points of each element, broadcast back to the points."""
+    values = np.broadcast_to(values, weights.shape)
+    return np.broadcast_to((np.sum(values * weights, axis=1) / np.sum(weights, axis=1))[:, None], weights.shape)
+
+
+def crack_band_stress(s, kappa_old, weights, band_width, E, nu, ft, law, crackable=1.0):
     """Stress, material tangent and history of the rotating crack band at all points.
+
+    Each element cracks as one band: its history kappa is the largest weighted mean over its points
+    of the major principal effective stress / E, and one damage omega acts at all its points (each
+    along its own principal direction). Point-wise damage would let the crack localise in one row
+    of integration points, narrower than the band width the law is scaled by, and makes Newton's
+    method stall on the alternating loading and unloading of neighbouring points.
 
     Parameters
     ----------
     s : ndarray, shape (n_el, n_q, 3)
         Effective stress per unit E, D eps [-].
     kappa_old : ndarray, shape (n_el, n_q)
-        History of the last converged step [-].
-    band_width : ndarray, broadcastable to (n_el, n_q)
+        History of the last converged step (equal at the points of an element) [-].
+    weights : ndarray, shape (n_el, n_q)
+        Integration weights [mm^3].
+    band_width : ndarray, shape (n_el, 1) or (n_el, n_q)
         [mm].
     E, ft : ndarray, shape (n_el, n_q)
-        Young's modulus [MPa] and tensile strength [MPa].
+        Young's modulus [MPa] and tensile strength [MPa] (element means are used).
     nu : float
         Poisson's ratio [-].
     law : tuple
-        (wc, c1, c2) of Hordijk's law; wc [mm] may vary over the points.
+        (wc, c1, c2) of Hordijk's law; wc [mm] may vary over the elements.
     crackable : float or ndarray, shape (n_el, n_q)
         1 where a crack may form, 0 where the material stays elastic.
 
@@ -171,14 +185,20 @@ def crack_band_stress(s, kappa_old, band_width, E, nu, ft, law, crackable=1.0):
     sigma : ndarray, shape (n_el, n_q, 3)
         Stress [MPa].
     dsigma_ds : ndarray, shape (n_el, n_q, 3, 3)
-        d sigma / d s [MPa] (multiply by D for d sigma / d eps).
+        d sigma_q / d s_q [MPa], the point-wise part of the tangent.
+    coupling : tuple of two ndarrays, shape (n_el, n_q, 3)
+        (a, b) with d sigma_q / d s_p = dsigma_ds_q delta_qp - a_q (x) b_p within an element: the
+        softening of the element's common damage.
     kappa, omega : ndarray, shape (n_el, n_q)
     """
     lam, F, dF, dlam = crack_direction_stress(s, nu)
-    kappa, loading = update_history(kappa_old, lam)
-    h = (1.0 - nu * nu) * np.asarray(band_width)
-    omega, d_omega = (crackable * v for v in band_damage(kappa, h, E, ft, *law))
+    share = weights / np.sum(weights, axis=1, keepdims=True)
+    kappa, loading = update_history(kappa_old, element_mean(lam, weights))
+    h = (1.0 - nu * nu) * np.broadcast_to(band_width, weights.shape)
+    wc, c1, c2 = law
+    mean = lambda v: element_mean(v, weights)  # noqa: E731
+    omega, d_omega = (mean(crackable) * v for v in band_damage(kappa, h, mean(E), mean(ft), mean(wc), c1, c2))
     sigma = E[..., None] * (s - omega[..., None] * F)
-    softening = (d_omega * loading)[..., None, None] * F[..., :, None] * dlam[..., None, :]
-    dsigma = E[..., None, None] * (np.eye(3) - omega[..., None, None] * dF - softening)
-    return sigma, dsigma, kappa, omega
+    dsigma = E[..., None, None] * (np.eye(3) - omega[..., None, None] * dF)
+    coupling = (E[..., None] * F, (d_omega * loading * share)[..., None] * dlam)
+    return sigma, dsigma, coupling, kappa, omega

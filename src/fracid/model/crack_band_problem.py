@@ -71,14 +71,18 @@ class CrackBandProblem(DamageProblem):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
         _, wc, c1, c2 = self.params.law()
         law = (wc / self.strength, c1, c2)
-        return crack_band_stress(s, kappa_old, self.band_width, self.const.E, self.params.nu, self.ft, law, self.crackable)
+        return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu, self.ft,
+                                 law, self.crackable)
 
     def evaluate(self, q, kappa_old):
         ue = self.gather(q)
         B, w = self.disc.strain_operator, self.disc.weights
-        sigma, dsigma, kappa, omega = self._stress(ue, kappa_old)
+        sigma, dsigma, (a, b), kappa, omega = self._stress(ue, kappa_old)
         forces = np.einsum("eqsi,eqs->ei", B, sigma * w[..., None])
         self._tangent[:] = _btdb(B * w[..., None, None], np.matmul(dsigma, self.const.DB))
+        # the element's common damage couples its points: a rank-one term per element
+        self._tangent -= np.einsum("ei,ej->eij", np.einsum("eqsi,eqs->ei", B, a * w[..., None]),
+                                   np.einsum("eqs,eqsj->ej", b, self.const.DB))
         residual = assemble_vector(self.element_dofs, forces, self.n_free)
         arrays = ElementArrays(forces, self._tangent, {"u": forces}, kappa, omega)
         return residual, arrays, {"u": norm2(residual)}
