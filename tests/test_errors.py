@@ -62,7 +62,7 @@ def test_invalid_bar_is_named(changes, word):
         ({"target": float("inf")}, "target"),
         ({"control": "cmod"}, "unknown control 'cmod'"),
         ({"stop_force_fraction": 1.5}, "stop_force_fraction"),
-        ({"regularization": "integral"}, "regularization"),
+        ({"regularization": "nonlocal"}, "regularization"),
         ({"steps": fracid.StepOptions(initial=1.0), "target": 0.01}, "step initial"),
         ({"steps": fracid.StepOptions(grow=0.5)}, "grow"),
         ({"max_steps": 0}, "max_steps"),

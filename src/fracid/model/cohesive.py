@@ -17,62 +17,26 @@ positive area are accepted by :class:`CohesiveParameters`.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import ClassVar
 
 import numpy as np
 from scipy.special import gammainc
 
 from fracid.model.damage import update_history
+from fracid.model.ranges import ParameterRange, ParameterSet
 
 
-class _Range(NamedTuple):
-    """Valid range of one parameter; None = unbounded on that side."""
-
-    lo: float | None
-    lo_incl: bool
-    hi: float | None
-    hi_incl: bool
-    unit: str
-
-    def describe(self, name: str) -> str:
-        text = name if self.lo is None else f"{self.lo:g} {'<=' if self.lo_incl else '<'} {name}"
-        return text if self.hi is None else f"{text} {'<=' if self.hi_incl else '<'} {self.hi:g}"
-
-    def admits(self, v: float) -> bool:
-        above = self.lo is None or (v >= self.lo if self.lo_incl else v > self.lo)
-        below = self.hi is None or (v <= self.hi if self.hi_incl else v < self.hi)
-        return math.isfinite(v) and above and below
-
-    def inner_limits(self) -> tuple[float, float]:
-        # open ends moved inside by the same relative margins as DamageParameters.valid_bounds,
-        # so that a value clipped to these limits passes validation
-        lower = -np.inf if self.lo is None else self.lo if self.lo_incl else self.lo + 1e-9 * max(abs(self.lo), 1e-9)
-        upper = np.inf if self.hi is None else self.hi if self.hi_incl else self.hi - 1e-9 * max(abs(self.hi), 1.0)
-        return lower, upper
-
-
+_R = ParameterRange
 _RANGES = {
-    "E": _Range(0.0, False, None, False, "MPa"),
-    "nu": _Range(-1.0, False, 0.5, False, "-"),
-    "ft": _Range(0.0, False, None, False, "MPa"),
-    "Gf": _Range(0.0, False, None, False, "N/mm"),
-    "c1": _Range(0.0, True, None, False, "-"),
-    "c2": _Range(0.0, False, None, False, "-"),
+    "E": _R(0.0, False, None, False, "MPa"),
+    "nu": _R(-1.0, False, 0.5, False, "-"),
+    "ft": _R(0.0, False, None, False, "MPa"),
+    "Gf": _R(0.0, False, None, False, "N/mm"),
+    "c1": _R(0.0, True, None, False, "-"),
+    "c2": _R(0.0, False, None, False, "-"),
 }
-
-
-def _validated(name: str, value) -> float:
-    rng = _RANGES[name]
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter {name!r} = {value!r} is not a number; valid range: {rng.describe(name)}") from None
-    if not rng.admits(v):
-        raise ValueError(f"parameter {name!r} = {value!r} is out of range; valid range: {rng.describe(name)}")
-    return v
 
 
 def _incomplete_moment(n, c, x):
@@ -241,7 +205,7 @@ def dissipated_energy_density(w_max, ft, wc, c1, c2):
 
 
 @dataclass(frozen=True)
-class CohesiveParameters:
+class CohesiveParameters(ParameterSet):
     """Parameters x = (E, nu, ft, Gf, c1, c2) of a bulk with Hordijk cohesive cracks.
 
     Parameters
@@ -278,9 +242,10 @@ class CohesiveParameters:
     c1: float = 3.0
     c2: float = 6.93
 
+    ranges: ClassVar[dict] = _RANGES
+
     def __post_init__(self):
-        for name in self.names():
-            object.__setattr__(self, name, _validated(name, getattr(self, name)))
+        super().__post_init__()
         if not self.area_factor > 0.0:
             raise ValueError(
                 f"parameters 'c1' = {self.c1!r}, 'c2' = {self.c2!r} give a cohesive law of area "
@@ -300,44 +265,6 @@ class CohesiveParameters:
         """Critical opening [mm] at which the traction vanishes, wc = Gf / (ft I(c1, c2)), so that
         the area under the law is exactly Gf (about 5.136 Gf / ft for Hordijk's constants)."""
         return self.Gf / (self.ft * self.area_factor)
-
-    @classmethod
-    def names(cls) -> tuple[str, ...]:
-        """Names of the parameters in the order of the vector x (the order of the fields)."""
-        return tuple(field.name for field in dataclasses.fields(cls))
-
-    @classmethod
-    def units(cls) -> dict[str, str]:
-        """Unit of each parameter."""
-        return {name: rng.unit for name, rng in _RANGES.items()}
-
-    @classmethod
-    def valid_bounds(cls, names) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper limits of the valid ranges of ``names``, open ends moved inside by 1e-9
-        (relative) so that clipped values stay valid; +-inf where unbounded. The joint condition
-        on (c1, c2) (positive area) is not a box and is not reflected here."""
-        limits = np.array([_RANGES[name].inner_limits() for name in names], dtype=float).reshape(-1, 2)
-        return limits[:, 0].copy(), limits[:, 1].copy()
-
-    def replace(self, **changes) -> "CohesiveParameters":
-        """A copy with some parameters changed (validated)."""
-        unknown = sorted(set(changes).difference(self.names()))
-        if unknown:
-            raise ValueError(f"unknown parameter(s) {unknown}; known: {list(self.names())}")
-        return dataclasses.replace(self, **changes)
-
-    def as_array(self) -> np.ndarray:
-        """The vector x in the order of :meth:`names`."""
-        return np.array(dataclasses.astuple(self), dtype=float)
-
-    @classmethod
-    def from_array(cls, x) -> "CohesiveParameters":
-        """Build from a vector x in the order of :meth:`names`."""
-        x = np.asarray(x, dtype=float)
-        names = cls.names()
-        if x.shape != (len(names),):
-            raise ValueError(f"expected a vector of {len(names)} parameters {list(names)}, got shape {x.shape}")
-        return cls(*x)
 
     def law(self) -> tuple[float, float, float, float]:
         """(ft, wc, c1, c2), the trailing arguments of the law functions of this module."""

@@ -2,53 +2,25 @@
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-import numpy as np
+from fracid.model.ranges import ParameterRange, ParameterSet
 
-# name -> (lower, lower inclusive, upper, upper inclusive, unit); None = unbounded
+_R = ParameterRange
 _RANGES = {
-    "E": (0.0, False, None, False, "MPa"),
-    "nu": (-1.0, False, 0.5, False, "-"),
-    "kappa_i": (0.0, False, None, False, "-"),
-    "alpha": (0.0, True, 1.0, True, "-"),
-    "beta": (0.0, True, None, False, "-"),
-    "c": (0.0, False, None, False, "mm^2"),
-    "eta": (1.0, True, None, False, "-"),
+    "E": _R(0.0, False, None, False, "MPa"),
+    "nu": _R(-1.0, False, 0.5, False, "-"),
+    "kappa_i": _R(0.0, False, None, False, "-"),
+    "alpha": _R(0.0, True, 1.0, True, "-"),
+    "beta": _R(0.0, True, None, False, "-"),
+    "c": _R(0.0, False, None, False, "mm^2"),
+    "eta": _R(1.0, True, None, False, "-"),
 }
 
 
-def _range_text(name: str) -> str:
-    lo, lo_incl, hi, hi_incl, _ = _RANGES[name]
-    parts = []
-    if lo is not None:
-        parts.append(f"{lo:g} {'<=' if lo_incl else '<'} {name}")
-    text = parts[0] if parts else name
-    if hi is not None:
-        text += f" {'<=' if hi_incl else '<'} {hi:g}"
-    return text
-
-
-def _check(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter {name!r} = {value!r} is not a number; valid range: {_range_text(name)}") from None
-    lo, lo_incl, hi, hi_incl, _ = _RANGES[name]
-    bad = not math.isfinite(v)
-    if lo is not None:
-        bad |= v < lo if lo_incl else v <= lo
-    if hi is not None:
-        bad |= v > hi if hi_incl else v >= hi
-    if bad:
-        raise ValueError(f"parameter {name!r} = {value!r} is out of range; valid range: {_range_text(name)}")
-    return v
-
-
 @dataclass(frozen=True)
-class DamageParameters:
+class DamageParameters(ParameterSet):
     """Parameters x = (E, nu, kappa_i, alpha, beta, c, eta) of the gradient-enhanced damage model.
 
     Parameters
@@ -84,46 +56,4 @@ class DamageParameters:
     c: float = 1.0
     eta: float = 10.0
 
-    def __post_init__(self):
-        for name in _RANGES:
-            object.__setattr__(self, name, _check(name, getattr(self, name)))
-
-    @classmethod
-    def names(cls) -> tuple[str, ...]:
-        """Names of the parameters in the order of the vector x."""
-        return tuple(_RANGES)
-
-    @classmethod
-    def units(cls) -> dict[str, str]:
-        """Unit of each parameter."""
-        return {name: r[4] for name, r in _RANGES.items()}
-
-    @classmethod
-    def valid_bounds(cls, names) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper limits of the valid ranges of ``names``, open ends moved inside by 1e-9
-        (relative) so that clipped values stay valid; +-inf where unbounded."""
-        lower, upper = [], []
-        for name in names:
-            lo, lo_incl, hi, hi_incl, _ = _RANGES[name]
-            lower.append(-np.inf if lo is None else lo if lo_incl else lo + 1e-9 * max(abs(lo), 1e-9))
-            upper.append(np.inf if hi is None else hi if hi_incl else hi - 1e-9 * max(abs(hi), 1.0))
-        return np.array(lower), np.array(upper)
-
-    def replace(self, **changes) -> "DamageParameters":
-        """A copy with some parameters changed (validated)."""
-        unknown = set(changes) - set(_RANGES)
-        if unknown:
-            raise ValueError(f"unknown parameter(s) {sorted(unknown)}; known: {list(_RANGES)}")
-        return dataclasses.replace(self, **changes)
-
-    def as_array(self) -> np.ndarray:
-        """The vector x in the order of :meth:`names`."""
-        return np.array([getattr(self, n) for n in _RANGES])
-
-    @classmethod
-    def from_array(cls, x) -> "DamageParameters":
-        """Build from a vector x in the order of :meth:`names`."""
-        x = np.asarray(x, dtype=float)
-        if x.shape != (len(_RANGES),):
-            raise ValueError(f"expected a vector of {len(_RANGES)} parameters {list(_RANGES)}, got shape {x.shape}")
-        return cls(**dict(zip(_RANGES, x)))
+    ranges: ClassVar[dict] = _RANGES
