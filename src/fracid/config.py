@@ -506,19 +506,12 @@ def _read_toml(path: Path) -> dict:
 
 
 def _range_text(cls, name: str) -> str:
-    """The valid range of parameter ``name`` of the parameter class ``cls`` as its own validation
-    words it (e.g. ``"0 < c"``, ``"-1 < nu < 0.5"``).
-
-    The parameter classes state their ranges only in their error messages ("... valid range: 0 < c"),
-    so an invalid value (nan) is offered to ``replace`` and the range read from the message; a class
-    that words it otherwise gets the limits of ``valid_bounds``.
-    """
-    try:
-        cls().replace(**{name: math.nan})
-    except ValueError as err:
-        text = str(err)
-        if "valid range: " in text:
-            return text.split("valid range: ", 1)[1].strip()
+    """The valid range of parameter ``name`` of the parameter class ``cls`` in words (e.g. ``"0 < c"``,
+    ``"-1 < nu < 0.5"``): from its :class:`~fracid.model.ranges.ParameterRange` when it declares
+    ``ranges``, else the limits of ``valid_bounds`` (the interface every model's class has)."""
+    rng = getattr(cls, "ranges", {}).get(name)
+    if rng is not None:
+        return rng.describe(name)
     lower, upper = cls.valid_bounds([name])
     return f"{lower[0]:g} <= {name} <= {upper[0]:g}"
 
@@ -528,9 +521,12 @@ def _parameter_allowed(cls, name: str) -> str:
 
 
 def _valid_parameter(cls, name: str, value: float) -> bool:
-    """Whether ``value`` lies in the valid range of ``name`` (the class's ``valid_bounds``, whose open
-    ends are moved inside, so a value on an open end is refused). Conditions joining several
-    parameters are left to the class (see :func:`_model`)."""
+    """Whether ``value`` lies in the valid range of ``name`` (its ``ParameterRange``, else the class's
+    ``valid_bounds``, whose open ends are moved inside). Conditions joining several parameters are
+    left to the class (see :func:`_model`)."""
+    rng = getattr(cls, "ranges", {}).get(name)
+    if rng is not None:
+        return rng.admits(value)
     lower, upper = cls.valid_bounds([name])
     return bool(lower[0] <= value <= upper[0])
 
