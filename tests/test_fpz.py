@@ -39,3 +39,23 @@ def test_no_damage_gives_zero_width_and_a_half_model_is_doubled():
     assert fpz_width(sampler, _kappa(pts, 6.0), 5.0, mirror=True) == 0.0
     half = fpz_width(sampler, _kappa(pts, 6.0), 1.0, mirror=False)
     assert fpz_width(sampler, _kappa(pts, 6.0), 1.0, mirror=True) == pytest.approx(2 * half)
+
+
+def test_superlevel_length_of_many_lines_at_once_equals_line_by_line():
+    from fracid.specimens.observables import superlevel_length
+
+    x = np.linspace(0.0, 10.0, 41)
+    lines = np.sin(x[None, :] + np.arange(5)[:, None]) + 0.2
+    together = superlevel_length(x, lines, 0.5, -1.0, 12.0)
+    assert together.shape == (5,)
+    np.testing.assert_allclose(together, [superlevel_length(x, line, 0.5, -1.0, 12.0) for line in lines])
+
+
+def test_observers_are_attached_only_when_asked_for():
+    import fracid
+
+    bar, params = fracid.BarWithWeakZone(n_elements=20), fracid.DamageParameters()
+    everything = fracid.simulate(bar, params, target=0.005, stop_force_fraction=None)
+    nothing = fracid.simulate(bar, params, target=0.005, stop_force_fraction=None, observables=())
+    assert "damaged_zone_width" in everything.observables and "damaged_zone_width" not in nothing.observables
+    np.testing.assert_array_equal(everything.force, nothing.force)

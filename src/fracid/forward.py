@@ -6,6 +6,14 @@ from fracid.model.path_following import PathResult, StepOptions, follow_path
 from fracid.model.solver import NewtonOptions
 
 
+def select_observers(observers: dict, names=None) -> dict:
+    """The observers named in ``names`` (all if None). Other names are left out: the energies and
+    the problem's functionals are recorded at every step anyway."""
+    if names is None:
+        return observers
+    return {name: fn for name, fn in observers.items() if name in set(names)}
+
+
 def simulate(
     specimen,
     params,
@@ -15,6 +23,7 @@ def simulate(
     target: float | None = None,
     stop_force_fraction: float | None = 0.1,
     damage_threshold: float = 0.0,
+    observables=None,
     steps: StepOptions | None = None,
     newton: NewtonOptions = NewtonOptions(),
     linear_solver=None,
@@ -39,6 +48,9 @@ def simulate(
         Stop when the force falls below this fraction of its peak (None: run to ``target``).
     damage_threshold : float
         Damage above which a point counts in the damaged-zone width [-].
+    observables : iterable of str, optional
+        The specimen's observables to record along the path (e.g. ``["fpz_width"]``); all of them if
+        None. Energies and functionals are always recorded.
     steps : StepOptions, optional
         Step-size rule; the specimen's default (``specimen.default_steps(target)``) if None.
 
@@ -57,7 +69,7 @@ def simulate(
         max_steps=max_steps,
         newton=newton,
         linear_solver=linear_solver,
-        observers=specimen.observers(params, damage_threshold),
+        observers=select_observers(specimen.observers(params, damage_threshold), observables),
         field_steps=field_steps,
         callback=callback,
         checkpoints=checkpoints,

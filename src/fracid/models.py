@@ -8,7 +8,7 @@ A forward model is any object with
     Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods and
     ``replace(**changes)`` on instances, returning a validated copy (ValueError for bad values).
 ``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints,
-damage_threshold)``
+damage_threshold, observables)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
     :class:`~fracid.model.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
@@ -105,16 +105,18 @@ class CrackBandModel:
 
 
 def _follow(problem, specimen, params, observers, *, control=None, target=None, stop_force_fraction=0.1,
-            steps=None, damage_threshold=0.0, **options):
+            steps=None, damage_threshold=0.0, observables=None, **options):
     """Path following of a specimen's problem with the specimen's default control, target and steps
     (``damage_threshold`` concerns the damage models' FPZ width only)."""
+    from fracid.forward import select_observers
     from fracid.model.path_following import StepOptions, follow_path
 
     target = target if target is not None else specimen.default_target(params)
     if steps is None:
         steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
     return follow_path(problem, control or specimen.default_control, target, steps=steps,
-                       stop_force_fraction=stop_force_fraction, observers=observers, **options)
+                       stop_force_fraction=stop_force_fraction,
+                       observers=select_observers(observers, observables), **options)
 
 
 def parameter_units(model_or_params) -> dict:

@@ -195,7 +195,8 @@ class ForwardOperator:
         """Run one group's analysis to its largest needed control value and sample its blocks."""
         wanted = [obs.control_points[: min(part.stop, limit) - part.start] for obs, part in group]
         checkpoints = np.unique(np.concatenate(wanted))
-        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold)
+        local = sorted({obs.quantity for obs, _ in group} - {"force"})  # observers cost time at every step
+        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold, local)
         record.retried |= retried
         if run is None:
             record.status, record.error = "failed", error
@@ -207,14 +208,15 @@ class ForwardOperator:
             record.y[part.start : part.start + points.size] = np.interp(points, run.control, values)
         return True
 
-    def _run(self, obs, params, target, checkpoints, threshold):
+    def _run(self, obs, params, target, checkpoints, threshold, observables):
         """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
         error = ""
         for attempt, steps in enumerate(self._step_rules(obs, target)):
             try:
                 result = self.model.simulate(obs.specimen, params, control=obs.control, target=target,
                                              stop_force_fraction=None, steps=steps, field_steps=None,
-                                             checkpoints=checkpoints, damage_threshold=threshold)
+                                             checkpoints=checkpoints, damage_threshold=threshold,
+                                             observables=observables)
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)

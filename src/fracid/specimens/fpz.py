@@ -79,25 +79,38 @@ def fpz_width(sampler: AcrossSampler, kappa, kappa_threshold, mirror: bool) -> f
     (``mirror``).
     """
     values = sampler(np.asarray(kappa, float))
-    width = 0.0
-    for line in values:
-        inside = np.isfinite(line)
-        if inside.sum() < 2 or np.nanmax(line) <= kappa_threshold:
-            continue
-        s = sampler.across[inside]
-        width = max(width, superlevel_length(s, line[inside], kappa_threshold, 0.0, s[-1]))
+    inside = np.isfinite(values)
+    # a line holds its first inner value from the path on (the first points lie off the path) and
+    # ends at its last inner sample: later samples outside the mesh count as below the threshold
+    first = np.argmax(inside, axis=1)
+    before = np.arange(values.shape[1])[None, :] < first[:, None]
+    values = np.where(before, values[np.arange(values.shape[0]), first][:, None], values)
+    below = kappa_threshold - 1.0 - abs(kappa_threshold)
+    lengths = superlevel_length(sampler.across, np.where(np.isfinite(values), values, below), kappa_threshold,
+                                sampler.across[0], sampler.across[-1])
+    width = float(np.max(lengths, initial=0.0))
     return 2.0 * width if mirror else width
+
+
+_SAMPLERS: dict = {}  # a few meshes' samplers, so the runs of a study triangulate each mesh once
+
+
+def cached_sampler(points, axis: int, along_range) -> AcrossSampler:
+    """:func:`across_sampler` of ``points``, kept for the next run on the same mesh."""
+    key = (hash(points.tobytes()), points.shape, axis, tuple(along_range))
+    if key not in _SAMPLERS:
+        if len(_SAMPLERS) >= 8:
+            _SAMPLERS.pop(next(iter(_SAMPLERS)))
+        _SAMPLERS[key] = across_sampler(points, axis, along_range)
+    return _SAMPLERS[key]
 
 
 def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool, along_range=(-np.inf, np.inf)):
     """Observer f(problem, q, arrays) -> FPZ width [mm] for :func:`~fracid.model.path_following.follow_path`."""
     kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
 
-    cache = {}  # per problem: the sampler, built once (the points do not move during an analysis)
-
     def observe(problem, q, arrays):
-        if cache.get("problem") is not problem:
-            cache.update(problem=problem, sampler=across_sampler(problem.disc.points.reshape(-1, 2), axis, along_range))
-        return fpz_width(cache["sampler"], arrays.kappa.ravel(), kappa_t, mirror)
+        sampler = cached_sampler(problem.disc.points.reshape(-1, 2), axis, along_range)
+        return fpz_width(sampler, arrays.kappa.ravel(), kappa_t, mirror)
 
     return observe
