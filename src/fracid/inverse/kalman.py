@@ -38,8 +38,21 @@ def kalman_update(x, C, S, innovation, R):
     return x + K @ innovation, 0.5 * (C_new + C_new.T), K
 
 
+class GaussianEstimate:
+    """Mixin of the results that hold an estimate's covariance ``C``: its standard deviations and
+    correlation matrix."""
+
+    @property
+    def std(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.C))
+
+    @property
+    def correlation(self) -> np.ndarray:
+        return self.C / np.outer(self.std, self.std)
+
+
 @dataclass
-class KalmanResult:
+class KalmanResult(GaussianEstimate):
     """Estimates of a Kalman-filter identification.
 
     Attributes
@@ -64,15 +77,6 @@ class KalmanResult:
     y: np.ndarray | None = None
     runs: int = 0
     run_equivalents: float = 0.0
-
-    @property
-    def std(self) -> np.ndarray:
-        return np.sqrt(np.diag(self.C))
-
-    @property
-    def correlation(self) -> np.ndarray:
-        s = self.std
-        return self.C / np.outer(s, s)
 
 
 def _observation_groups(n, groups):

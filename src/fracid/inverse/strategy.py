@@ -9,13 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.kalman import kalman_filter
+from fracid.inverse.kalman import GaussianEstimate, kalman_filter
 from fracid.inverse.knn import ParameterSpace, knn_search
-from fracid.model.parameters import DamageParameters
 
 
 @dataclass
-class IdentificationResult:
+class IdentificationResult(GaussianEstimate):
     """Identified parameters with their uncertainty, the fit and how it was obtained.
 
     Attributes
@@ -51,16 +50,8 @@ class IdentificationResult:
     converged: bool = False
     units: dict = field(default_factory=dict)
 
-    @property
-    def std(self) -> np.ndarray:
-        return np.sqrt(np.diag(self.C))
-
-    @property
-    def correlation(self) -> np.ndarray:
-        return self.C / np.outer(self.std, self.std)
-
     def summary(self) -> str:
-        units = self.units or DamageParameters.units()
+        units = self.units
         lines = [f"{n:>8} = {v:.6g} +- {s:.3g} {units.get(n, '')}" for n, v, s in zip(self.names, self.x, self.std)]
         lines.append("correlation:\n" + np.array2string(self.correlation, precision=3))
         return "\n".join(lines)

@@ -23,7 +23,6 @@ from fracid.inverse.stability import stability as stability_check
 from fracid.inverse.strategy import refine
 from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
 from fracid.inverse.verdict import DataDescription, parameter_verdicts
-from fracid.model.parameters import DamageParameters
 
 
 @dataclass
@@ -97,7 +96,7 @@ class StudyResult:
         return list(self.identification.names)
 
     def summary(self) -> str:
-        lines = ["Verdict:", self.verdict.text(self.identification.units or DamageParameters.units())]
+        lines = ["Verdict:", self.verdict.text(self.identification.units)]
         if self.predictions:
             lines.append("Predictions of data not used for calibration:")
             lines += [f"  {p.name}: RMS {p.relative_rms:.1%} of the peak, chi2/point {p.chi2_per_point:.2f}"
