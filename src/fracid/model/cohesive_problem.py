@@ -16,6 +16,8 @@ import numpy as np
 from fracid.model.assembly import assemble_vector
 from fracid.model.cohesive import cohesive_traction
 from fracid.model.elements import gauss_line, line_quadratic
+from fracid.model.parameters import DamageParameters
+from fracid.model.problem import DamageProblem
 
 _GAUSS = 3
 
@@ -52,36 +54,37 @@ def crack_traction(w, w_max, ft, wc, c1, c2, penalty):
     return sigma, tangent, np.maximum(w_max, w)
 
 
-class CohesiveCrackProblem:
-    """An elastic bulk problem (a :class:`~fracid.model.problem.DamageProblem` that cannot damage)
-    with a cohesive crack on its symmetry line x = 0.
+class CohesiveCrackProblem(DamageProblem):
+    """An elastic plane-stress problem (a :class:`~fracid.model.problem.DamageProblem` that cannot
+    damage) with a cohesive crack on the line x = 0.
 
     Parameters
     ----------
-    bulk : DamageProblem
-        Elastic (``damageable=0``), local regularisation, crack-line x-dofs free.
+    disc : MixedDiscretization
+    params : CohesiveParameters
     edges : tuple
         Output of :func:`ligament_edges`.
-    params : CohesiveParameters
     thickness : float
         [mm].
     penalty : float
         Stiffness tying the uncracked faces [MPa/mm].
+    **conditions
+        ``fixed_dofs`` (not the crack line's x-dofs), ``load``, ``functionals``, ``tied``,
+        ``symmetry_factor`` as for :class:`~fracid.model.problem.DamageProblem`.
     """
 
-    def __init__(self, bulk, edges, params, thickness, penalty):
-        self.bulk, self.params, self.penalty = bulk, params, float(penalty)
+    def __init__(self, disc, params, edges, thickness, penalty, **conditions):
+        super().__init__(disc, DamageParameters(E=params.E, nu=params.nu), regularization="local", damageable=0.0,
+                         **conditions)
+        self.crack, self.penalty = params, float(penalty)  # self.params: the elastic bulk
         self.owners, self.slots, heights = edges
         s, weights = gauss_line(_GAUSS)
         self.N = line_quadratic(s)[0]  # (n_g, 3), nodes ordered by height
         jac = 0.5 * (heights[:, 2] - heights[:, 0])
         self.dA = thickness * jac[:, None] * weights[None, :]  # crack area per edge Gauss point [mm^2]
         self.y = heights[:, [0]] + (1.0 + s[None, :]) * jac[:, None]  # heights of the Gauss points [mm]
-        self._bulk_history = bulk.initial_history()
+        self._bulk_history = super().initial_history()
         self._w_max = self.initial_history()  # history of the last evaluation (the converged state when energies are asked)
-        for name in ("n_free", "load_vector", "functionals", "element_dofs", "symmetry_factor", "blocks", "gather",
-                     "full_vector", "restrict", "disc"):
-            setattr(self, name, getattr(bulk, name))
 
     def initial_history(self):
         """Largest opening reached at each crack Gauss point [mm], shape (n_edges, n_g)."""
@@ -92,12 +95,12 @@ class CohesiveCrackProblem:
         return 2.0 * ux @ self.N.T  # (n_edges, n_g)
 
     def onset_ratio(self, w_max):
-        return float(w_max.max()) * self.penalty / self.params.ft
+        return float(w_max.max()) * self.penalty / self.crack.ft
 
     def evaluate(self, q, w_max_old):
-        residual, arrays, references = self.bulk.evaluate(q, self._bulk_history)
+        residual, arrays, references = super().evaluate(q, self._bulk_history)
         w = self.openings(q)
-        sigma, dsigma, w_max = crack_traction(w, w_max_old, *self.params.law(), self.penalty)
+        sigma, dsigma, w_max = crack_traction(w, w_max_old, *self.crack.law(), self.penalty)
         # nodal forces on the half: int N_a sigma dA; d/d u_b: int N_a N_b dsigma/dw * 2 dA
         force = np.einsum("eg,ga->ea", sigma * self.dA, self.N)
         stiffness = 2.0 * np.einsum("eg,ga,gb->eab", dsigma * self.dA, self.N, self.N)
@@ -117,16 +120,16 @@ class CohesiveCrackProblem:
 
         order = np.argsort(self.y.ravel())
         y, w = self.y.ravel()[order], w_max.ravel()[order]
-        return superlevel_length(y, w, self.params.ft / self.penalty, y[0], y[-1])
+        return superlevel_length(y, w, self.crack.ft / self.penalty, y[0], y[-1])
 
     def fields(self, q, w_max, omega):
-        out = self.bulk.fields(q, self._bulk_history, omega)
+        out = super().fields(q, self._bulk_history, omega)
         out.update(crack_opening_max=w_max.copy())
         return out
 
     def elastic_energy(self, q, omega):
         """Bulk strain energy plus the energy the crack gives back on unloading (penalty and secant) [N mm]."""
         w = self.openings(q)
-        sigma, _, _ = crack_traction(w, self._w_max, *self.params.law(), self.penalty)
+        sigma, _, _ = crack_traction(w, self._w_max, *self.crack.law(), self.penalty)
         crack = 0.5 * np.sum(sigma * w * self.dA)  # w is the full opening: the crack of the whole specimen
-        return self.bulk.elastic_energy(q, omega) + crack
+        return super().elastic_energy(q, omega) + crack

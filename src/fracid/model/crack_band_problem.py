@@ -47,7 +47,7 @@ class CrackBandProblem(DamageProblem):
         if disc.strain_state.n_components != 3:
             raise ValueError("the crack band model is written for plane stress (3 strain components)")
         super().__init__(disc, DamageParameters(E=params.E, nu=params.nu), regularization="local", **conditions)
-        self.params = params
+        self.crack = params  # self.params: the elastic bulk
         h = np.asarray(band_width, dtype=float)
         if h.shape != (disc.n_elements,) or not np.all(h > 0):
             raise ValueError(f"band_width must be {disc.n_elements} positive element widths [mm]")
@@ -69,7 +69,7 @@ class CrackBandProblem(DamageProblem):
 
     def _stress(self, ue, kappa_old):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
-        _, wc, c1, c2 = self.params.law()
+        _, wc, c1, c2 = self.crack.law()
         law = (wc / self.strength, c1, c2)
         return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu, self.ft,
                                  law, self.crackable)

@@ -88,13 +88,11 @@ class NotchedBeam:
         in_notch = lambda s, t: (s < self.notch_width / 2) & (t < self.notch_depth)  # noqa: E731
         return structured_quad8(xs, ys, keep=lambda s, t: ~in_notch(s, t))
 
-    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None,
-                      crack_free: bool = False) -> DamageProblem:
+    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
         mesh = mesh or self.mesh()
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        return DamageProblem(disc, params, regularization=regularization, damageable=0.0 if crack_free else 1.0,
-                             symmetry_planes=[] if crack_free else [(0, 0.0)],
-                             **self._conditions(mesh, crack_free, rigid_plates=not crack_free))
+        return DamageProblem(disc, params, regularization=regularization, symmetry_planes=[(0, 0.0)],
+                             **self._conditions(mesh))
 
     def _conditions(self, mesh: QuadMesh, crack_free: bool = False, rigid_plates: bool = True) -> dict:
         """Supports, load pattern and functionals of the half beam (keyword arguments of the problems).
@@ -136,12 +134,12 @@ class NotchedBeam:
         penalty ``penalty_factor * E / h_fine`` [MPa/mm] until the traction reaches ft.
         """
         from fracid.model.cohesive_problem import CohesiveCrackProblem, ligament_edges
-        from fracid.model.parameters import DamageParameters
 
         mesh = self.mesh()
-        bulk = self.build_problem(DamageParameters(E=params.E, nu=params.nu), "local", mesh, crack_free=True)
-        edges = ligament_edges(mesh.nodes, mesh.cells, bulk.disc.u_dofs, self.notch_depth)
-        return CohesiveCrackProblem(bulk, edges, params, self.thickness, penalty_factor * params.E / self.h_fine)
+        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
+        edges = ligament_edges(mesh.nodes, mesh.cells, disc.u_dofs, self.notch_depth)
+        return CohesiveCrackProblem(disc, params, edges, self.thickness, penalty_factor * params.E / self.h_fine,
+                                    **self._conditions(mesh, crack_free=True, rigid_plates=False))
 
     def build_crack_band_problem(self, params):
         """Half beam with a rotating crack band (Hordijk, :class:`~fracid.model.cohesive.CohesiveParameters`)
