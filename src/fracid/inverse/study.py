@@ -152,7 +152,7 @@ class StudyResult:
 
 def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates: int = 5, noise_seed: int = 0,
               tolerance: float = 0.1, n=64, method="sobol", seed=0, k=5, groups=None, max_iterations=10, tol=0.01,
-              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=print) -> StudyResult:
+              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=None) -> StudyResult:
     """Run the identification strategy with its checks and return the verdict.
 
     Parameters
@@ -182,12 +182,13 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     n, method, seed, k, groups, max_iterations, tol, restart
         KNN and Kalman settings, as in :func:`~fracid.inverse.strategy.identify`; ``groups`` may also
         be ``"blocks"`` (one filter step per data block) or ``"all"`` (one step: the batch filter).
-    log : callable(str)
-        Receives one line per stage.
+    log : callable(str), optional
+        Receives one line per stage (the command line prints them); silent if None.
     """
     if data.y.size != operator.n_outputs:
         raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
     timings, clock = {}, time.perf_counter()
+    log = log or (lambda text: None)
 
     def stage(name):
         nonlocal clock

@@ -141,7 +141,7 @@ def twin_matrix(cases: dict, x_true, std, space, *, seed: int | None = 1, log=No
         if log is not None:
             log(f"twin case {name!r}")
         data = synthetic_data(operator, x_true, std, seed=seed)
-        study = run_study(operator, data, space, log=lambda text: None, **settings)
+        study = run_study(operator, data, space, **settings)
         outcomes[name] = TwinOutcome(name, study, x_true, data)
     return outcomes
 
