@@ -85,10 +85,9 @@ def test_gradient_curve_is_fitted_by_cohesive_crack(gradient_to_cohesive):
     assert gradient_to_cohesive.energy_ratio == pytest.approx(1.0, abs=0.08)  # measured 1.018
 
 
-def test_comparison_table_on_one_data_set(cohesive_to_gradient, executor):
-    """Both models on the cohesive beam's curve: the cohesive model finds its own parameters back, the
-    gradient model (c fixed) fits it too, and the two dissipate about the same energy."""
-    data = cohesive_to_gradient.data
+@pytest.fixture(scope="module")
+def comparison(cohesive_to_gradient, executor):
+    """Both models fitted to the cohesive beam's curve (the gradient model with c fixed at 20 mm^2)."""
     candidates = [
         Candidate("cohesive crack", CohesiveCrackModel(), CohesiveParameters(E=COHESIVE.E, nu=0.2), COHESIVE_SPACE.names,
                   COHESIVE_SPACE),
@@ -96,7 +95,14 @@ def test_comparison_table_on_one_data_set(cohesive_to_gradient, executor):
          ("kappa_i", "beta"), ParameterSpace(("kappa_i", "beta"), [3e-5, 200.0], [1.2e-4, 3000.0], log=(False, True))),
     ]
     lines = []
-    table = compare_models(data, BEAM, candidates, executor=executor, log=lines.append, **SETTINGS)
+    table = compare_models(cohesive_to_gradient.data, BEAM, candidates, executor=executor, log=lines.append, **SETTINGS)
+    return table, lines
+
+
+def test_comparison_table_on_one_data_set(comparison, cohesive_to_gradient):
+    """The cohesive model finds its own parameters back, the gradient model fits the curve too, and
+    the two dissipate about the same energy."""
+    table, lines = comparison
     print("\n" + "\n".join(lines))
     rows = table.rows()
     assert [r["label"] for r in rows] == ["cohesive crack", "gradient damage"]
@@ -114,3 +120,24 @@ def test_comparison_table_on_one_data_set(cohesive_to_gradient, executor):
     assert cohesive.dissipated_energy == pytest.approx(cohesive_to_gradient.source_energy, rel=0.01)
     with pytest.raises(KeyError, match="no model labelled 'crack band'"):
         table.fit("crack band")
+
+
+def test_tables_figure_and_report(tmp_path, cohesive_to_gradient, gradient_to_cohesive, comparison):
+    """The report module reads the results above (no new runs): tables, figure and one HTML page."""
+    from fracid.report.cross_model import (CurvePanel, comparison_rows, cross_rows, curves_figure, markdown_table,
+                                           write_cross_model_report)
+
+    crosses = [("(a)", cohesive_to_gradient), ("(b)", gradient_to_cohesive)]
+    header, rows = cross_rows(crosses)
+    assert len(rows) == 2 and all(len(r) == len(header) for r in rows)
+    assert "Gf = " in rows[1][3] and "N/mm" in rows[1][3]  # the cohesive fit, with its units
+    text = markdown_table(*comparison_rows(comparison[0]))
+    assert text.count("\n") == 3 and text.startswith("| model |")  # header, rule, two models
+    fig = curves_figure([CurvePanel.of_cross("(a)", cohesive_to_gradient),
+                         CurvePanel.of_comparison("one data set", comparison[0])])
+    assert len(fig.axes) == 2 and len(fig.axes[1].lines) == 3  # data and the two fitted runs
+    path = write_cross_model_report(tmp_path / "report.html", crosses=crosses,
+                                    comparisons=[("one data set", comparison[0])], notes=["a note"])
+    html = path.read_text()
+    assert html.count("<img") == 1 + 2 * 4  # the curves, then the fit and Kalman figures of four fits
+    assert html.count("<details>") == 4 and "a note" in html and "cohesive crack" in html

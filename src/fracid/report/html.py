@@ -300,8 +300,7 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
     """
     from fracid.report import figures  # matplotlib is imported only when a report is written
 
-    path = Path(path)
-    date = datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
+    date = generated_now()
     names = ", ".join(str(n) for n in result.names)
     body = [
         f"<h1>{_e(title)}</h1>",
@@ -317,6 +316,32 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
     ]
     for heading, fragment in extra_sections:
         body.append(f"<h2>{_e(heading)}</h2>\n{fragment}")
+    return write_document(path, title, body)
+
+
+def generated_now() -> str:
+    """The local date and time for a report's "Generated ..." line."""
+    return datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
+
+
+def write_document(path, title: str, body) -> Path:
+    """Write a self-contained HTML page: the report's style and image check around ``body``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The HTML file to write (parent directories are created).
+    title : str
+        Page title (escaped here).
+    body : sequence of str
+        HTML fragments, in order (not escaped).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    path = Path(path)
     document = "\n".join([
         "<!DOCTYPE html>",
         '<html lang="en">',
