@@ -494,6 +494,17 @@ def test_simulate_cohesive_beam_from_its_config(tmp_path):
 
 from fracid.models import MODEL_TYPES  # noqa: E402  (every registered model is a valid type)
 
+def test_size_effect_refuses_a_model_without_regularization(tmp_path, capsys):
+    """The size-effect series runs fracid.forward.simulate (damage models): a clear refusal before any run."""
+    from fracid.cli import main
+
+    config = str(CONFIGS / "beam_cohesive_simulate.toml")
+    assert main(["size-effect", config, "--sizes", "50", "100", "200", "--out", str(tmp_path), "--quiet"]) == 2
+    message = capsys.readouterr().err
+    assert "model.type = 'cohesive-crack'" in message and "damage models only" in message
+    assert "Traceback" not in message and message.count("\n") == 1
+
+
 BAD_MODELS = [
     pytest.param(variant('type = "gradient-damage"', 'type = "crack-bands"'), "identify",
                  ["model.type", "'crack-bands'", "must be one of " + ", ".join(map(repr, MODEL_TYPES))],
