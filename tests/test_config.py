@@ -494,15 +494,16 @@ def test_simulate_cohesive_beam_from_its_config(tmp_path):
 
 from fracid.models import MODEL_TYPES  # noqa: E402  (every registered model is a valid type)
 
-def test_size_effect_refuses_a_model_without_regularization(tmp_path, capsys):
-    """The size-effect series runs fracid.forward.simulate (damage models): a clear refusal before any run."""
+def test_size_effect_runs_any_model(tmp_path):
+    """The size-effect series takes the config's forward model: here the cohesive crack, three depths."""
     from fracid.cli import main
 
     config = str(CONFIGS / "beam_cohesive_simulate.toml")
-    assert main(["size-effect", config, "--sizes", "50", "100", "200", "--out", str(tmp_path), "--quiet"]) == 2
-    message = capsys.readouterr().err
-    assert "model.type = 'cohesive-crack'" in message and "damage models only" in message
-    assert "Traceback" not in message and message.count("\n") == 1
+    assert main(["size-effect", config, "--sizes", "40", "50", "60", "--out", str(tmp_path), "--quiet"]) == 0
+    table = np.loadtxt(tmp_path / "size_effect.csv", delimiter=",", skiprows=1)
+    assert table.shape == (3, 3) and np.all(np.isfinite(table))
+    assert np.all(np.diff(table[:, 1]) > 0)  # deeper beams carry more
+    assert (tmp_path / "size_effect.png").stat().st_size > 0
 
 
 BAD_MODELS = [

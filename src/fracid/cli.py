@@ -132,30 +132,14 @@ def run_identify(args, config_path=None) -> int:
     return 0
 
 
-def _no_size_effect(cfg) -> str:
-    return (f"{cfg.path}: model.type = {cfg.model.type!r}: the size-effect series is available for the damage "
-            "models only (fracid.inverse.size_effect.size_effect_series runs fracid.forward.simulate, which takes "
-            "a regularization, not a forward model)")
-
-
 def _size_effect(cfg, params, executor, sizes=(), quiet=True):
-    """Nominal strength at ``params`` over the sizes of the force experiments (and ``sizes``), the
-    measured nominal strength of those experiments, and Bazant fits of both.
-
-    Returns (figure arguments, series, fits) or None when fewer than three sizes are involved.
-
-    Raises
-    ------
-    ConfigError
-        For a model without a ``regularization`` (the size-effect series runs the damage models only).
-    """
+    """:func:`~fracid.inverse.size_effect.compare_size_effect` over the sizes of the force experiments
+    (and ``sizes``) with the measured nominal strength of those experiments; None below three sizes."""
     from dataclasses import replace
 
-    from fracid.config import ConfigError, build_experiment_data, build_specimen
-    from fracid.inverse.size_effect import fit_size_effect, nominal_strength, size_effect_series, specimen_size
+    from fracid.config import build_experiment_data, build_model, build_specimen
+    from fracid.inverse.size_effect import compare_size_effect, nominal_strength, specimen_size
 
-    if cfg.model.regularization is None:
-        raise ConfigError(_no_size_effect(cfg))
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
         if exp.quantity != "force":
@@ -163,38 +147,15 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
         specimen = build_specimen(cfg, exp)
         D = specimen_size(specimen)
         specimens[D] = specimen
-        peak = float(np.max(build_experiment_data(cfg, exp).y))
-        measured.setdefault(D, []).append(nominal_strength(specimen, peak))
+        measured.setdefault(D, []).append(nominal_strength(specimen, float(np.max(build_experiment_data(cfg, exp).y))))
         if exp.role == "calibration":
             calibrated.add(D)
     base = next(iter(specimens.values()), None) or build_specimen(cfg)
     size_field = "size" if hasattr(base, "size") else "depth" if hasattr(base, "depth") else "length"
     for D in sizes or ():
         specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
-    if len(specimens) < 3:
-        return None
-    order = sorted(specimens)
-    series = size_effect_series(params, [specimens[D] for D in order], regularization=cfg.model.regularization,
-                                executor=executor, progress=False if quiet else None)
-    fits = {"computed": fit_size_effect(series.sizes[series.ok], series.sigma_N[series.ok])
-            if series.ok.sum() >= 3 else None}
-    sigma_measured = np.array([np.mean(measured[D]) if D in measured else np.nan for D in order])
-    if np.isfinite(sigma_measured).sum() >= 3:
-        have = np.isfinite(sigma_measured)
-        fits["measured"] = fit_size_effect(np.array(order)[have], sigma_measured[have])
-    figure = {"sizes": series.sizes, "sigma_computed": series.sigma_N, "fit": fits["computed"],
-              "sigma_measured": sigma_measured if np.isfinite(sigma_measured).any() else None,
-              "calibrated": np.array([D in calibrated for D in order])}
-    return figure, series, fits
-
-
-def _save_size_effect(out: Path, series, fits) -> None:
-    import json
-
-    np.savetxt(out / "size_effect.csv", np.column_stack([series.sizes, series.peak_force, series.sigma_N]),
-               delimiter=",", header="D_mm,peak_force_N,nominal_strength_MPa", comments="")
-    (out / "size_effect.json").write_text(json.dumps({k: (v.as_dict() if v is not None else None)
-                                                      for k, v in fits.items()}, indent=1))
+    return compare_size_effect(params, specimens, measured, calibrated, model=build_model(cfg), executor=executor,
+                               progress=False if quiet else None)
 
 
 #: subcommands that run part of the study: [study] settings they override
@@ -219,15 +180,12 @@ def run_study_command(args) -> int:
         study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
                           progress=None if not args.quiet else False, log=lambda text: _say(args, text), **settings)
         size = None
-        if args.command == "study" and cfg.model.regularization is None:
-            _say(args, "size effect skipped: " + _no_size_effect(cfg))
-        elif args.command == "study":
+        if args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
-    figure = None
     if size is not None:
-        figure, series, fits = size
-        _save_size_effect(out, series, fits)
-    written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}", size_effect=figure)
+        size.save(out)
+    written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
+                          size_effect=size.figure_arguments() if size is not None else None)
     _say(args, study.summary())
     _say(args, f"wrote in {out}: " + ", ".join(str(Path(p).relative_to(out)) for p in written))
     return 0
@@ -273,10 +231,9 @@ def run_size_effect_command(args) -> int:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
               "[experiments.specimen] sizes", file=sys.stderr)
         return 2
-    figure, series, fits = size
-    _save_size_effect(out, series, fits)
-    (out / "size_effect.png").write_bytes(to_png(size_effect_figure(**figure)))
-    fit = fits["computed"]
+    size.save(out)
+    (out / "size_effect.png").write_bytes(to_png(size_effect_figure(**size.figure_arguments())))
+    fit, series = size.computed, size.series
     text = "" if fit is None else f"; Bazant fit B f_t = {fit.B_ft:.4g} MPa, D0 = {fit.D0:.4g} mm"
     _say(args, "nominal strength [MPa]: " + ", ".join(f"D {D:g}: {s:.4g}" for D, s in zip(series.sizes, series.sigma_N))
          + text + f"\nwrote in {out}: size_effect.csv, size_effect.json, size_effect.png")

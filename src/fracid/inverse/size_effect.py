@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from fracid.forward import simulate
 from fracid.model.path_following import ConvergenceError
 from fracid.parallel import run_batch
 from fracid.specimens.bar import BarWithWeakZone
@@ -27,9 +26,11 @@ from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 
 __all__ = [
+    "SizeEffectComparison",
     "SizeEffectFit",
     "SizeEffectSeries",
     "bazant_law",
+    "compare_size_effect",
     "fit_size_effect",
     "nominal_strength",
     "size_effect_series",
@@ -327,16 +328,17 @@ class SizeEffectSeries:
         return np.array([s == "ok" for s in self.status], dtype=bool)
 
 
-def size_effect_series(params, specimens, *, regularization: str = "gradient", executor=None,
-                       progress=None) -> SizeEffectSeries:
-    """Run :func:`~fracid.forward.simulate` for every specimen; peaks and nominal strengths by size.
+def size_effect_series(params, specimens, *, model=None, executor=None, progress=None) -> SizeEffectSeries:
+    """One forward run per specimen; peaks and nominal strengths by size.
 
     Parameters
     ----------
-    params : DamageParameters
+    params
+        Parameters of ``model`` (e.g. :class:`~fracid.model.parameters.DamageParameters`).
     specimens : sequence
         DogBone, NotchedBeam or BarWithWeakZone objects (any order; results keep it).
-    regularization : {"gradient", "local"}
+    model : forward model, optional
+        Any model of :mod:`fracid.models`; gradient damage if None.
     executor : Executor, optional
         From :func:`fracid.parallel.make_executor`; the runs go to it together. None: one after
         the other in this process.
@@ -354,9 +356,12 @@ def size_effect_series(params, specimens, *, regularization: str = "gradient", e
     TypeError
         For a specimen without a defined nominal strength (checked before any run).
     """
+    from fracid.models import DamageModel
+
+    model = model if model is not None else DamageModel("gradient")
     specimens = list(specimens)
     geometry = [_size_and_section(s) for s in specimens]  # fail before hours of runs, not after
-    tasks = [(specimen, params, regularization) for specimen in specimens]
+    tasks = [(specimen, params, model) for specimen in specimens]
     records = run_batch(_run_one_size, tasks, executor=executor if executor is not None else "serial",
                         progress=progress)
     peaks = np.array([r.get("peak_force", np.nan) for r in records], dtype=float)
@@ -372,9 +377,9 @@ def size_effect_series(params, specimens, *, regularization: str = "gradient", e
 
 def _run_one_size(task) -> dict:
     """Worker side (module level, so process pools can pickle it): one run as a record."""
-    specimen, params, regularization = task
+    specimen, params, model = task
     try:
-        result = simulate(specimen, params, regularization=regularization, field_steps=None)
+        result = model.simulate(specimen, params, field_steps=None)
     except ConvergenceError as err:
         partial = err.partial
         return {"status": "failed", "error": f"ConvergenceError: {err}", "control": partial.control,
@@ -382,3 +387,83 @@ def _run_one_size(task) -> dict:
     except ValueError as err:
         return {"status": "failed", "error": f"ValueError: {err}"}
     return {"status": "ok", "peak_force": result.peak_force, "control": result.control, "force": result.force}
+
+
+@dataclass
+class SizeEffectComparison:
+    """Computed and measured nominal strengths over a size series, with Bazant's law fitted to each.
+
+    Attributes
+    ----------
+    series : SizeEffectSeries
+        The forward runs, one per size (sorted).
+    computed : SizeEffectFit or None
+        Fit of the computed strengths (None with fewer than three successful runs).
+    sigma_measured : ndarray
+        Mean measured nominal strength per size [MPa] (nan where no test).
+    measured : SizeEffectFit or None
+        Fit of the measured strengths (None with fewer than three sizes tested).
+    calibrated : ndarray of bool
+        Sizes whose tests were used for calibration.
+    """
+
+    series: SizeEffectSeries
+    computed: object
+    sigma_measured: np.ndarray
+    measured: object
+    calibrated: np.ndarray
+
+    def figure_arguments(self) -> dict:
+        """Keyword arguments of :func:`fracid.report.figures.size_effect_figure`."""
+        have = np.isfinite(self.sigma_measured).any()
+        return {"sizes": self.series.sizes, "sigma_computed": self.series.sigma_N, "fit": self.computed,
+                "sigma_measured": self.sigma_measured if have else None, "calibrated": self.calibrated}
+
+    def save(self, directory) -> list:
+        """size_effect.csv (size, peak, strength) and size_effect.json (the fits) in ``directory``."""
+        import json
+        from pathlib import Path
+
+        directory = Path(directory)
+        s = self.series
+        np.savetxt(directory / "size_effect.csv", np.column_stack([s.sizes, s.peak_force, s.sigma_N]),
+                   delimiter=",", header="D_mm,peak_force_N,nominal_strength_MPa", comments="")
+        fits = {"computed": self.computed, "measured": self.measured}
+        (directory / "size_effect.json").write_text(
+            json.dumps({k: (v.as_dict() if v is not None else None) for k, v in fits.items()}, indent=1))
+        return [directory / "size_effect.csv", directory / "size_effect.json"]
+
+
+def compare_size_effect(params, specimens: dict, measured=None, calibrated=(), *, model=None, executor=None,
+                        progress=None) -> SizeEffectComparison | None:
+    """Nominal strength at ``params`` over a size series, against the measured one, with Bazant fits.
+
+    Parameters
+    ----------
+    params
+        Model parameters (e.g. the identified ones).
+    specimens : dict {D: specimen}
+        One specimen per size D [mm].
+    measured : dict {D: list of float}, optional
+        Measured nominal strengths per size [MPa] (several tests per size are averaged).
+    calibrated : collection of float
+        Sizes whose tests were used for calibration (marked in the figure).
+    model, executor, progress
+        As in :func:`size_effect_series`.
+
+    Returns
+    -------
+    SizeEffectComparison or None
+        None when fewer than three sizes are given.
+    """
+    if len(specimens) < 3:
+        return None
+    measured = measured or {}
+    order = sorted(specimens)
+    series = size_effect_series(params, [specimens[D] for D in order], model=model, executor=executor,
+                                progress=progress)
+    computed = fit_size_effect(series.sizes[series.ok], series.sigma_N[series.ok]) if series.ok.sum() >= 3 else None
+    sigma = np.array([np.mean(measured[D]) if D in measured else np.nan for D in order])
+    have = np.isfinite(sigma)
+    fit_measured = fit_size_effect(np.array(order)[have], sigma[have]) if have.sum() >= 3 else None
+    return SizeEffectComparison(series, computed, sigma, fit_measured, np.array([D in calibrated for D in order]))
