@@ -103,8 +103,10 @@ class ForwardOperator:
         Values of the parameters that are not identified (an instance of ``model.parameters``).
     names : sequence of str
         Identified parameters, in the order of x.
-    regularization : str
-        ``"gradient"`` or ``"local"``: shorthand for ``model=DamageModel(regularization)``.
+    regularization : str, optional
+        ``"gradient"``, ``"local"`` or ``"integral"``: shorthand for ``model=DamageModel(regularization)``
+        (not with ``model``). After construction it is the model's regularization (None for models
+        without one).
     steps : StepOptions or None
         Step rule (the specimen's default if None); the retry divides its increments by 4.
     model : ForwardModel, optional
@@ -114,7 +116,7 @@ class ForwardOperator:
     observations: tuple
     base: object
     names: tuple
-    regularization: str = "gradient"
+    regularization: str | None = None
     steps: StepOptions | None = None
     model: object = None
 
@@ -122,7 +124,11 @@ class ForwardOperator:
         object.__setattr__(self, "observations", tuple(self.observations))
         object.__setattr__(self, "names", tuple(self.names))
         if self.model is None:
-            object.__setattr__(self, "model", DamageModel(self.regularization))
+            object.__setattr__(self, "model", DamageModel(self.regularization or "gradient"))
+        elif self.regularization is not None and self.regularization != getattr(self.model, "regularization", None):
+            raise ValueError(f"regularization = {self.regularization!r} contradicts the model {self.model.key!r}; "
+                             "give one of them")
+        object.__setattr__(self, "regularization", getattr(self.model, "regularization", None))
         if not isinstance(self.base, self.model.parameters):
             raise TypeError(f"base is a {type(self.base).__name__}; the model {self.model.key!r} takes "
                             f"{self.model.parameters.__name__}")
