@@ -103,3 +103,33 @@ def test_damage_model_is_the_default_and_keys_differ_between_models():
     assert run_key(gradient, np.array([2.0])) != run_key(local, np.array([2.0]))
     with pytest.raises(ValueError, match="'nonlocal'"):
         DamageModel("nonlocal")
+
+
+@dataclass(frozen=True)
+class FailingBar(LinearCohesiveBar):
+    """Converges only while Gf >= 0.09 N/mm: the Kalman filter's estimate runs may fail."""
+
+    key: ClassVar[str] = "test-failing-bar"
+
+    def simulate(self, specimen, p, **options):
+        from fracid.model.path_following import ConvergenceError
+
+        result = super().simulate(specimen, p, **options)
+        if p.Gf < 0.09:
+            raise ConvergenceError("no convergence (test model)", SimpleNamespace(control=result.control[:3],
+                                   force=result.force[:3], observables={}, n_steps=3))
+        return result
+
+
+def test_model_comparison_records_a_failed_fit_and_keeps_the_others():
+    from fracid.inverse.cross_model import Candidate, compare_models
+
+    op = ForwardOperator([Observation(Bar(), POINTS)], SofteningBarParameters(), ("ft", "Gf"), model=LinearCohesiveBar())
+    data = synthetic_data(op, [3.0, 0.05], {"global:relative": 0.01}, seed=None)
+    space = ParameterSpace(("ft", "Gf"), [1.0, 0.02], [6.0, 0.4])
+    candidates = [Candidate("failing", FailingBar(), SofteningBarParameters(), ("ft", "Gf"), space),
+                  Candidate("closed form", LinearCohesiveBar(), SofteningBarParameters(), ("ft", "Gf"), space)]
+    comparison = compare_models(data, Bar(), candidates, control="end", n=32, k=4, groups=[np.arange(20)])
+    assert [fit.label for fit in comparison.fits] == ["closed form"]
+    assert "failing" in comparison.failures and "Error" in comparison.failures["failing"]
+    np.testing.assert_allclose(comparison.fits[0].x, [3.0, 0.05], rtol=0.01)

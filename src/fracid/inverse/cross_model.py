@@ -33,6 +33,7 @@ import numpy as np
 from fracid.data import ExperimentalData
 from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.knn import ParameterSpace
+from fracid.inverse.sensitivity import ForwardRunError
 from fracid.inverse.strategy import IdentificationResult, identify_data
 from fracid.model.path_following import ConvergenceError
 
@@ -166,6 +167,7 @@ class ModelComparison:
 
     data: ExperimentalData
     fits: list
+    failures: dict = field(default_factory=dict)  # label -> why the fit failed (the other fits are kept)
 
     def rows(self) -> list[dict]:
         """:meth:`ModelFit.row` of every model, with the data's peak force (``peak_force_data_N``)."""
@@ -246,7 +248,8 @@ def run_to_end(model, specimen, params, control_points, *, control="cmod", steps
     run : PathResult
         The run (the partial run if it stopped on a ConvergenceError).
     dissipated_energy : float
-        ``observables["dissipated_energy"]`` at the last control point [N mm]; NaN if not reached.
+        ``observables["dissipated_energy"]`` at the last control point [N mm]; NaN if not reached or
+        if the model does not report it.
     """
     points = np.asarray(control_points, float)
     target = float(points[-1])
@@ -256,7 +259,8 @@ def run_to_end(model, specimen, params, control_points, *, control="cmod", steps
     except ConvergenceError as err:
         run = err.partial
     reached = run.control.size > 0 and run.control[-1] >= target * (1.0 - 1e-9)
-    energy = float(np.interp(target, run.control, run.observables["dissipated_energy"])) if reached else float("nan")
+    dissipated = run.observables.get("dissipated_energy")
+    energy = float(np.interp(target, run.control, dissipated)) if reached and dissipated is not None else float("nan")
     return run, energy
 
 
@@ -328,21 +332,29 @@ def compare_models(data: ExperimentalData, specimen, candidates, *, control="cmo
     Returns
     -------
     ModelComparison
-        One :class:`ModelFit` per candidate, in order; :meth:`ModelComparison.rows` gives the
-        table: fitted parameters +- std, relative RMS fit error, peak force, dissipated energy
-        to the last data control value [N mm], number of forward runs.
+        One :class:`ModelFit` per candidate that could be fitted, in order; :meth:`ModelComparison.rows`
+        gives the table: fitted parameters +- std, relative RMS fit error, peak force, dissipated
+        energy to the last data control value [N mm], number of forward runs. A candidate whose fit
+        stops on a failed forward run (e.g. at the Kalman filter's estimate) is recorded in
+        ``failures`` with the reason, and the comparison goes on.
     """
-    fits = []
+    fits, failures = [], {}
     candidates = [c if isinstance(c, Candidate) else Candidate(*c) for c in candidates]
     for i, candidate in enumerate(candidates, start=1):
         if log is not None:
             log(f"[{i}/{len(candidates)}] fitting {candidate.label} ({candidate.model.key}): "
                 f"{', '.join(candidate.names)}")
-        fit = fit_model(data, candidate, specimen, control=control, steps=steps, **settings)
+        try:
+            fit = fit_model(data, candidate, specimen, control=control, steps=steps, **settings)
+        except (ForwardRunError, ConvergenceError) as err:
+            failures[candidate.label] = f"{type(err).__name__}: {err}"
+            if log is not None:
+                log(f"[{i}/{len(candidates)}] {candidate.label}: failed ({failures[candidate.label]})")
+            continue
         if log is not None:
             log(f"[{i}/{len(candidates)}] {candidate.label}: " + _fit_line(fit))
         fits.append(fit)
-    return ModelComparison(data=data, fits=fits)
+    return ModelComparison(data=data, fits=fits, failures=failures)
 
 
 def _fit_line(fit: ModelFit) -> str:

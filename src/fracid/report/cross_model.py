@@ -210,6 +210,8 @@ def write_cross_model_report(path, *, crosses=(), comparisons=(), title="fracid:
         body.append(f"<p>{comparison.data.y.size} data points from {comparison.data.control[0]:.4g} to "
                     f"{comparison.data.control[-1]:.4g} mm; measured peak {peak:.1f} N (the RMS is relative to it). "
                     "Dissipated energy of each model's run at its estimate to the last data point.</p>")
+        for failed, reason in getattr(comparison, "failures", {}).items():
+            body.append(f"<p><strong>{_e(failed)}: not fitted.</strong> {_e(reason)}</p>")
     body.append("<h2>Identification details</h2>")
     for case, cross in crosses:
         body.append(f"<h3>{_e(case)}</h3>\n" + _fit_details(cross.fit, cross.data.control))
