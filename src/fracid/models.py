@@ -56,8 +56,18 @@ class DamageModel:
         return simulate(specimen, params, regularization=self.regularization, **options)
 
 
+class _HordijkModel:
+    """Models whose parameters are those of Hordijk's law and an elastic bulk."""
+
+    @property
+    def parameters(self):
+        from fracid.model.cohesive import CohesiveParameters
+
+        return CohesiveParameters
+
+
 @dataclass(frozen=True)
-class CohesiveCrackModel:
+class CohesiveCrackModel(_HordijkModel):
     """Discrete cohesive crack with Hordijk's law along the ligament, elastic bulk (SPEC 5).
 
     Specimens must offer ``build_cohesive_problem(params)`` (the notched beam does). Observable:
@@ -66,12 +76,6 @@ class CohesiveCrackModel:
 
     penalty_factor: float = 1000.0
     key: ClassVar[str] = "cohesive-crack-hordijk"
-
-    @property
-    def parameters(self):
-        from fracid.model.cohesive import CohesiveParameters
-
-        return CohesiveParameters
 
     def simulate(self, specimen, params, **options):
         if not hasattr(specimen, "build_cohesive_problem"):
@@ -82,7 +86,7 @@ class CohesiveCrackModel:
 
 
 @dataclass(frozen=True)
-class CrackBandModel:
+class CrackBandModel(_HordijkModel):
     """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width (SPEC 5).
 
     Same parameters as the cohesive crack (:class:`~fracid.model.cohesive.CohesiveParameters`), so the
@@ -91,12 +95,6 @@ class CrackBandModel:
     """
 
     key: ClassVar[str] = "crack-band-hordijk"
-
-    @property
-    def parameters(self):
-        from fracid.model.cohesive import CohesiveParameters
-
-        return CohesiveParameters
 
     def simulate(self, specimen, params, **options):
         if not hasattr(specimen, "build_crack_band_problem"):

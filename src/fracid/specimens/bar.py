@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,6 +9,7 @@ import numpy as np
 from fracid.model.damage import kappa_at_damage
 from fracid.model.discretization import bar_discretization
 from fracid.model.problem import DamageProblem
+from fracid.specimens.checks import require_positive
 from fracid.specimens.observables import superlevel_length
 
 _WEAKENINGS = ("modulus", "area")
@@ -56,10 +56,7 @@ class BarWithWeakZone:
     default_control = "end_displacement"
 
     def __post_init__(self):
-        for name in ("length", "area", "weak_zone_width"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"BarWithWeakZone.{name} = {value!r}; it must be a positive number [mm or mm^2]")
+        require_positive(self, ("length", "area", "weak_zone_width"), " [mm or mm^2]")
         if self.weak_zone_width >= self.length:
             raise ValueError(f"weak_zone_width = {self.weak_zone_width} must be smaller than length = {self.length}")
         if not 0.0 < self.weak_zone_factor <= 1.0:

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from fracid.model.discretization import plane_stress_discretization
 from fracid.model.problem import DamageProblem
+from fracid.specimens.checks import require_positive
 from fracid.specimens.fpz import fpz_width_observer
 from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
 
@@ -56,11 +56,8 @@ class NotchedBeam:
     default_control = "cmod"
 
     def __post_init__(self):
-        for name in ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
-                     "h_fine", "h_coarse", "fine_width"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"NotchedBeam.{name} = {value!r}; it must be a positive number [mm]")
+        require_positive(self, ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
+                                "h_fine", "h_coarse", "fine_width"), " [mm]")
         if not self.span < self.length:
             raise ValueError(f"span = {self.span} must be smaller than length = {self.length}")
         if not self.notch_depth < self.depth:

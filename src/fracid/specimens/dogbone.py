@@ -9,6 +9,7 @@ import numpy as np
 
 from fracid.model.discretization import plane_stress_discretization
 from fracid.model.problem import DamageProblem
+from fracid.specimens.checks import require_positive
 from fracid.specimens.fpz import fpz_width_observer
 from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
 
@@ -71,12 +72,10 @@ class DogBone:
     default_control = "elongation"
 
     def __post_init__(self):
-        for name in ("size", "thickness", "gauge_length", "h_fine", "fine_height", "h_coarse", "notch_radius", "notch_width"):
-            value = getattr(self, name)
-            if value is None and name in ("gauge_length", "fine_height", "h_coarse"):
-                continue
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"DogBone.{name} = {value!r}; it must be a positive number")
+        optional = ("gauge_length", "fine_height", "h_coarse")  # None: derived from the size
+        require_positive(self, [n for n in ("size", "thickness", "gauge_length", "h_fine", "fine_height", "h_coarse",
+                                            "notch_radius", "notch_width")
+                                if not (n in optional and getattr(self, n) is None)])
         if not self.notch_width < 1.0 or (1.0 - self.notch_width) / 2 > self.notch_radius:
             raise ValueError(f"notch_width = {self.notch_width} and notch_radius = {self.notch_radius}: "
                              "the notch must narrow the width (notch_width < 1) and fit its radius")

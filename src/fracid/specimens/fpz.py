@@ -109,8 +109,11 @@ def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool,
     """Observer f(problem, q, arrays) -> FPZ width [mm] for :func:`~fracid.model.path_following.follow_path`."""
     kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
 
+    current = {}  # the problem of this run and its sampler: the mesh is looked up once per run, not per step
+
     def observe(problem, q, arrays):
-        sampler = cached_sampler(problem.disc.points.reshape(-1, 2), axis, along_range)
-        return fpz_width(sampler, arrays.kappa.ravel(), kappa_t, mirror)
+        if current.get("problem") is not problem:
+            current.update(problem=problem, sampler=cached_sampler(problem.disc.points.reshape(-1, 2), axis, along_range))
+        return fpz_width(current["sampler"], arrays.kappa.ravel(), kappa_t, mirror)
 
     return observe

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from fracid.model.discretization import plane_stress_discretization
+from fracid.specimens.checks import require_positive
 from fracid.specimens.meshing import structured_quad8
 
 
@@ -41,10 +41,7 @@ class TensionStrip:
     default_control = "band_opening"
 
     def __post_init__(self):
-        for name in ("length", "height", "thickness"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"TensionStrip.{name} = {value!r}; it must be a positive number [mm]")
+        require_positive(self, ("length", "height", "thickness"), " [mm]")
         if not (isinstance(self.n_elements, int) and self.n_elements >= 3 and self.n_elements % 2 == 1):
             raise ValueError(f"TensionStrip.n_elements = {self.n_elements!r}; it must be an odd integer >= 3 "
                              "(the weak column sits in the middle)")
@@ -67,7 +64,6 @@ class TensionStrip:
         from fracid.model.crack_band_problem import CrackBandProblem, element_extent
 
         mesh = self.mesh()
-        x = mesh.nodes[:, 0]
         disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
         left, right = mesh.nodes_near(x=0.0), mesh.nodes_near(x=self.length)
         h = self.element_size
