@@ -9,7 +9,6 @@ import fracid
 from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.knn import ParameterSpace, design, knn_from_population, knn_search, objective
-from fracid.inverse.sensitivity import ForwardRunError
 from fracid.inverse.strategy import identify
 
 BAR = fracid.BarWithWeakZone(n_elements=100)
@@ -70,9 +69,10 @@ def test_failed_forward_runs_are_recorded_and_do_not_stop_the_study(bar_operator
     failed = [i for i, s in enumerate(res.status) if s != "ok"]
     assert all("forward run failed" in res.errors[i] for i in failed)
     assert np.all(np.isinf(res.f[failed])) and set(res.order[-len(failed):]) == set(failed)
-    # the Kalman filter cannot do without its own point: a clear error
-    with pytest.raises(ForwardRunError, match="failed"):
-        kalman_filter(bar_operator, y, np.eye(y.size) * std**2, np.array([0.02, 20000.0]), np.diag([0.01, 1e6]))
+    # the Kalman filter cannot do without its own point: it stops, says why and never raises
+    result = kalman_filter(bar_operator, y, np.eye(y.size) * std**2, np.array([0.02, 20000.0]), np.diag([0.01, 1e6]))
+    assert result.failed and result.status.startswith("stopped:") and "forward run failed" in result.status
+    assert result.failures and result.failures[0]["x"] == [0.02, 20000.0]
 
 
 def test_twin_noise_free_bar(bar_operator, bar_data):

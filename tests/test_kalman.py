@@ -69,3 +69,73 @@ def test_bad_inputs_are_refused():
         kalman_filter(h, y, R, x0, C0, groups=[[0, 1], [1, 2]])
     with pytest.raises(ValueError, match="restart"):
         kalman_filter(h, y, R, x0, C0, restart="again")
+
+
+# --- bounds and failed runs ----------------------------------------------------------------------------
+
+
+def recording(h, fails=lambda x: False):
+    """h that records every point it is asked for, and fails (a failed RunRecord) where ``fails``."""
+    from fracid.inverse.forward_operator import RunRecord
+
+    asked = []
+
+    def evaluate(x, needed=None):
+        asked.append(np.array(x, float))
+        if fails(x):
+            return RunRecord(np.array(x, float), np.full(12, np.nan), status="failed", error="diverged")
+        return RunRecord(np.array(x, float), h(x))
+
+    return evaluate, asked
+
+
+@pytest.mark.parametrize("groups", [None, "all"])
+def test_estimates_stay_inside_the_bounds_and_are_flagged(groups):
+    h, y, R, x0, C0, (x_post, _) = linear_problem()
+    lower, upper = np.array([0.0, -1.5, -1.0]), np.array([2.0, 0.0, 1.0])
+    assert x_post[1] < lower[1]  # the unconstrained posterior leaves the box
+    evaluate, asked = recording(h)
+    groups = [np.arange(12)] if groups == "all" else None
+    result = kalman_filter(evaluate, y, R, x0, C0, groups=groups, bounds=(lower, upper))
+    asked = np.array(asked)
+    reach = 0.0101 * np.abs(asked) + 1e-12  # the sensitivities' +-1 % perturbations around points of the box
+    assert np.all(asked >= lower - reach) and np.all(asked <= upper + reach)
+    assert np.all(result.x >= lower) and np.all(result.x <= upper)
+    assert result.at_bound.tolist() == [False, True, False] and result.x[1] == lower[1]
+    assert not result.failed and result.status in ("converged",) or result.status.startswith("not converged")
+    for entry in result.history:
+        assert np.all(entry["x"] >= lower) and np.all(entry["x"] <= upper)
+
+
+def test_projection_is_the_most_probable_point_in_the_box():
+    from fracid.inverse.kalman import project_to_box
+
+    C = np.array([[1.0, 0.95], [0.95, 1.0]])
+    x = np.array([2.0, 1.8])
+    lower, upper = np.array([-1.0, -1.0]), np.array([1.0, 3.0])
+    z = project_to_box(x, C, lower, upper)
+    grid = np.stack(np.meshgrid(np.linspace(-1, 1, 401), np.linspace(-1, 3, 801)), -1).reshape(-1, 2)
+    d = grid - x
+    best = grid[np.argmin(np.einsum("ij,jk,ik->i", d, np.linalg.inv(C), d))]
+    np.testing.assert_allclose(z, best, atol=0.01)
+    assert z[0] == 1.0 and z[1] < 1.8  # slides along the valley; clipping would keep 1.8
+    np.testing.assert_array_equal(project_to_box(np.array([0.5, 0.5]), C, lower, upper), [0.5, 0.5])
+
+
+def test_failed_runs_are_backtracked_towards_the_last_good_point():
+    """The model fails beyond x0 > 1.2: the steps into that region are shortened, never raised."""
+    h, y, R, x0, C0, (x_post, _) = linear_problem()
+    y = y + 5.0 * (h(np.array([1.6, -2.0, 0.5])) - h(np.array([1.0, -2.0, 0.5])))  # pulls x[0] to ~3.4
+    evaluate, asked = recording(h, fails=lambda x: x[0] > 1.2)
+    result = kalman_filter(evaluate, y, R, x0, C0, max_iterations=6)
+    assert result.failures and all(f["error"] == "diverged" for f in result.failures)
+    assert not result.failed and np.all(np.isfinite(result.y)) and result.x[0] <= 1.2
+    assert result.status  # converged, not converged or stopped: always said
+
+
+def test_a_filter_that_cannot_run_anywhere_stops_with_a_status():
+    h, y, R, x0, C0, _ = linear_problem()
+    evaluate, _ = recording(h, fails=lambda x: True)
+    result = kalman_filter(evaluate, y, R, x0, C0)
+    assert result.failed and result.status.startswith("stopped:") and "diverged" in result.status
+    np.testing.assert_array_equal(result.x, x0)

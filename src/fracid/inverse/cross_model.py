@@ -149,7 +149,7 @@ class ModelFit:
     def row(self) -> dict:
         """A plain dict for tables and JSON: ``label``, ``model``, ``parameters`` ({name: {value, std,
         unit}}), ``rms_percent``, ``peak_force_N``, ``dissipated_energy_Nmm``, ``forward_runs``,
-        ``converged``, ``seconds``."""
+        ``converged``, ``status`` (of the Kalman filter), ``seconds``."""
         units = self.units
         return {
             "label": self.label, "model": self.model_key,
@@ -157,7 +157,8 @@ class ModelFit:
                            for n, v, s in zip(self.names, self.x, self.std)},
             "rms_percent": 100.0 * self.rms_relative, "peak_force_N": self.peak_force,
             "dissipated_energy_Nmm": self.dissipated_energy, "forward_runs": self.forward_runs,
-            "converged": bool(self.identification.converged), "seconds": self.seconds,
+            "converged": bool(self.identification.converged), "status": self.identification.status,
+            "seconds": self.seconds,
         }
 
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
-from fracid.inverse.sensitivity import CentralDifferences, evaluate_points
+from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError, evaluate_points, memoized
 
 
 def kalman_update(x, C, S, innovation, R):
@@ -64,9 +65,16 @@ class KalmanResult(GaussianEstimate):
     iterations : int
         Global iterations done; ``converged`` says whether the estimate stopped changing.
     y : ndarray
-        Computed observations at the final estimate.
+        Computed observations at the final estimate (NaN where the run at it failed).
     runs : int
-        Forward runs made; ``run_equivalents`` weights each by the share of the curve it computed.
+        Forward runs asked for; ``run_equivalents`` weights each by the share of the curve it computed.
+    status : str
+        ``"converged"``, ``"not converged: ..."`` or ``"stopped: ..."`` (forward runs failed at and
+        around the filter's point, or the objective no longer decreased along the step).
+    failures : list of dict
+        Failed forward runs at points the filter wanted: ``{"iteration", "step", "x", "error"}``.
+    at_bound : ndarray of bool
+        Parameters whose estimate lies on a bound of the box (see :func:`kalman_filter`, Notes).
     """
 
     x: np.ndarray
@@ -77,6 +85,38 @@ class KalmanResult(GaussianEstimate):
     y: np.ndarray | None = None
     runs: int = 0
     run_equivalents: float = 0.0
+    status: str = ""
+    failures: list = field(default_factory=list)
+    at_bound: np.ndarray | None = None
+
+    @property
+    def failed(self) -> bool:
+        """No forward run succeeded at the final estimate (its y is not finite)."""
+        return self.y is None or not np.all(np.isfinite(self.y))
+
+
+def project_to_box(x, C, lower, upper) -> np.ndarray:
+    """The point of the box [lower, upper] nearest to x in the metric of C^-1.
+
+    argmin (z - x)^T C^-1 (z - x) subject to lower <= z <= upper ("estimate projection", Simon &
+    Chia 2002): the most probable point of the Gaussian N(x, C) inside the box. Along a valley of
+    correlated parameters it slides along the valley rather than cutting across it, as clipping
+    each parameter on its own would. Solved by :func:`scipy.optimize.lsq_linear` in standardised
+    variables; clipping is the fallback when C is numerically singular.
+    """
+    x = np.asarray(x, float)
+    if np.all((x >= lower) & (x <= upper)):
+        return x
+    scale = np.sqrt(np.diag(C))
+    try:
+        W = np.linalg.cholesky(np.linalg.inv(C / np.outer(scale, scale))).T  # W^T W = (standardised C)^-1
+        z = lsq_linear(W, W @ (x / scale), bounds=(lower / scale, upper / scale)).x * scale
+    except (np.linalg.LinAlgError, ValueError):
+        z = x
+    z = np.clip(z, lower, upper)
+    span = np.where(np.isfinite(upper - lower), upper - lower, np.abs(z) + 1.0)
+    z = np.where(z - lower <= 1e-9 * span, lower, z)  # the solver's tolerance: an active bound is exact
+    return np.where(upper - z <= 1e-9 * span, upper, z)
 
 
 def _observation_groups(n, groups):
@@ -102,12 +142,64 @@ def _check_inputs(y_exp, C_exp, x0, C0):
     return y_exp, C_exp, x0, C0
 
 
-def _clip(x, bounds):
-    return x if bounds is None else np.clip(x, bounds[0], bounds[1])
+def _box(bounds, p):
+    if bounds is None:
+        return np.full(p, -np.inf), np.full(p, np.inf)
+    lower, upper = (np.broadcast_to(np.asarray(b, float), (p,)).copy() for b in bounds)
+    if np.any(lower > upper):
+        raise ValueError(f"bounds: lower {lower.tolist()} above upper {upper.tolist()}")
+    return lower, upper
 
 
 def _converged(x_new, x_old, C, tol):
     return bool(np.all(np.abs(x_new - x_old) <= tol * np.sqrt(np.diag(C))))
+
+
+class _Linearizer:
+    """Runs and sensitivities at the filter's points, with backtracking over failed runs.
+
+    ``at(x, anchor, needed)`` tries x, then the points anchor + 2^-k (x - anchor), k = 1..max_backtracks,
+    and returns the first (point, y, S) whose run succeeds (and that ``accept`` takes); failures are
+    recorded in the result. The run at the point comes first, alone, so that a failing or worse point
+    costs one run, not 2 p + 1.
+    """
+
+    def __init__(self, evaluate, sensitivity, executor, result, max_backtracks, n_outputs):
+        self.evaluate, self.sensitivity, self.executor = memoized(evaluate), sensitivity, executor
+        self.result, self.max_backtracks, self.n_outputs = result, max_backtracks, n_outputs
+        self.last_full = None  # (point, y) of the last successful run over all outputs
+        self.last_error = ""
+
+    def at(self, x, anchor, needed, where, accept=None):
+        tried = []
+        for attempt in range(self.max_backtracks + 1):
+            point = x if anchor is None or attempt == 0 else anchor + 0.5**attempt * (x - anchor)
+            if any(np.array_equal(point, t) for t in tried):
+                break
+            tried.append(point)
+            centre = evaluate_points(self.evaluate, [point], needed, self.executor)[0]
+            if not centre.ok:
+                self._fail(point, centre.error, where)
+                continue
+            if accept is not None and not accept(point, centre.y):
+                self.last_error = "the objective does not decrease along the step"
+                continue
+            try:
+                y, S, records = self.sensitivity(self.evaluate, point, needed, self.executor)
+            except ForwardRunError as err:
+                self._fail(point, str(err), where)
+                continue
+            self.result.runs += len(records)
+            self.result.run_equivalents += len(records) * (self.n_outputs if needed is None else needed) / self.n_outputs
+            if needed is None or needed >= self.n_outputs:
+                self.last_full = (point, y)
+            return point, y, S
+        return None
+
+    def _fail(self, point, error, where):
+        self.result.runs += 1
+        self.last_error = error
+        self.result.failures.append({**where, "x": point.tolist(), "error": error})
 
 
 def kalman_filter(
@@ -125,8 +217,9 @@ def kalman_filter(
     executor=None,
     bounds=None,
     callback=None,
+    max_backtracks: int = 4,
 ) -> KalmanResult:
-    """Step-by-step Kalman filter with global iterations (SPEC section 4).
+    """Step-by-step Kalman filter with global iterations (SPEC section 4), bounded and failure tolerant.
 
     For t = 1..n the observations of group t are assimilated with :func:`kalman_update`, using
     S_t = d h_t / d x and h_t at a linearisation point (forward runs only up to the last
@@ -137,7 +230,10 @@ def kalman_filter(
         Every pass starts again from the prior (x0, C0) and linearises h about the previous pass's
         estimate: y_t - h_t(x_lin) - S_t (x_{t-1} - x_lin) is the innovation. The fixed point is the
         Bayesian maximum a posteriori estimate; for a linear h every pass gives the closed-form
-        posterior, and its sensitivities come from one set of full runs per pass.
+        posterior, and its sensitivities come from one set of full runs per pass. The passes are
+        damped Gauss-Newton steps: a new linearisation point whose objective
+        (y - h)^T C_exp^-1 (y - h) + (x - x0)^T C0^-1 (x - x0) is higher than the last one's is
+        moved halfway back, up to ``max_backtracks`` times.
     ``restart="prior-mean"``
         The thesis's wording: the last estimate becomes the new prior mean (prior covariance C0),
         linearising at the running estimate. It re-uses the data in every pass, so the covariance
@@ -146,12 +242,13 @@ def kalman_filter(
     Parameters
     ----------
     evaluate : callable(x, needed) -> RunRecord or ndarray
-        The forward operator (e.g. :class:`~fracid.inverse.forward_operator.ForwardOperator`).
+        The forward operator (e.g. :class:`~fracid.inverse.forward_operator.ForwardOperator`, or
+        :class:`~fracid.inverse.runs.StoredOperator` to store every run).
     y_exp, C_exp : ndarray
         Measured observations and their covariance. Sequential assimilation assumes no correlation
         between groups (a block-diagonal C_exp); within a group any covariance is used.
     x0, C0 : ndarray
-        Prior mean and covariance (from KNN or the user).
+        Prior mean and covariance (from KNN or the user). x0 is moved into the bounds first.
     groups : sequence of index arrays, optional
         The observation sequence; one observation per step by default.
     sensitivity : callable
@@ -159,52 +256,114 @@ def kalman_filter(
     executor : Executor, optional
         Runs the 2 p + 1 runs of each sensitivity in parallel.
     bounds : (lower, upper) arrays, optional
-        Estimates are clipped to these (the parameters' valid ranges).
+        The box every estimate stays in (the identification bounds).
     callback : callable(iteration, step, x, C), optional
+    max_backtracks : int
+        Halvings of a step towards the last good point when the run at the filter's point fails.
 
-    Raises
-    ------
-    ForwardRunError
-        When the forward run at the filter's own point fails.
+    Returns
+    -------
+    KalmanResult
+        Never raises for a failed forward run: when no point near the filter's runs, the stage
+        stops with the last complete estimate and ``status = "stopped: ..."``.
+
+    Notes
+    -----
+    Bounds: an update that leaves the box is projected back by :func:`project_to_box` (the most
+    probable point of the update's Gaussian inside the box), and backtracking only moves between
+    points of the box, so every point the filter evaluates is inside it. The covariance is the
+    linearised posterior's, unchanged by the projection. For a parameter on a bound it describes the
+    curvature of the objective there, not the spread of a posterior cut by the bound: the true
+    posterior is one-sided, and the parameter is flagged in ``at_bound``.
     """
     if restart not in ("linearize", "prior-mean"):
         raise ValueError(f"restart = {restart!r}; choose 'linearize' or 'prior-mean'")
     y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
     groups = _observation_groups(y_exp.size, groups)
+    lower, upper = _box(bounds, x0.size)
+    x0 = np.clip(x0, lower, upper)
     result = KalmanResult(x=x0.copy(), C=C0.copy())
-    previous = x0.copy()
+    lin = _Linearizer(evaluate, sensitivity, executor, result, max_backtracks, y_exp.size)
+    objective = _map_objective(y_exp, C_exp, x0, C0)
+    previous, stopped = x0.copy(), ""
     for iteration in range(1, max_iterations + 1):
         fixed_point = restart == "linearize" and iteration > 1
         x, C = (x0.copy() if restart == "linearize" else previous.copy()), C0.copy()
         if fixed_point:  # one linearisation for the whole pass
-            y_lin, S_lin, records = sensitivity(evaluate, previous, None, executor)
-            result.runs += len(records)
-            result.run_equivalents += len(records)
+            anchor = lin.last_full[0] if lin.last_full is not None else None
+            accept = None if anchor is None else _decreases(objective, *lin.last_full)
+            got = lin.at(previous, anchor, None, {"iteration": iteration, "step": 0}, accept)
+            if got is None:  # keep the last point that ran (and its pass's covariance)
+                stopped = f"at iteration {iteration}: {lin.last_error}"
+                result.x = anchor if anchor is not None else result.x
+                break
+            previous, y_lin, S_lin = got
+        last_point = None
         for step, rows in enumerate(groups, start=1):
             if fixed_point:
-                lin, y, S = previous, y_lin, S_lin
+                point, y, S = previous, y_lin, S_lin
             else:
-                needed = int(rows.max()) + 1
-                lin = x
-                y, S, records = sensitivity(evaluate, x, needed, executor)
-                result.runs += len(records)
-                result.run_equivalents += len(records) * needed / y_exp.size
-            innovation = y_exp[rows] - y[rows] - S[rows] @ (x - lin)
+                got = lin.at(x, last_point, int(rows.max()) + 1, {"iteration": iteration, "step": step})
+                if got is None:
+                    stopped = f"at iteration {iteration}, step {step}: {lin.last_error}"
+                    break
+                point, y, S = got
+                x = last_point = point
+            innovation = y_exp[rows] - y[rows] - S[rows] @ (x - point)
             x, C, _ = kalman_update(x, C, S[rows], innovation, C_exp[np.ix_(rows, rows)])
-            x = _clip(x, bounds)
+            x = project_to_box(x, C, lower, upper)
             result.history.append({"iteration": iteration, "step": step, "observations": rows.tolist(),
                                    "x": x.copy(), "C": C.copy()})
             if callback is not None:
                 callback(iteration, step, x, C)
+        if stopped:
+            break
         result.iterations = iteration
         done = iteration > 1 and _converged(x, previous, C, tol)
+        moved = np.max(np.abs(x - previous) / np.sqrt(np.diag(C)))
         previous, result.x, result.C = x, x, C
         if done:
             result.converged = True
             break
-    record = evaluate_points(evaluate, [result.x], None, executor)[0]
-    result.y, result.runs, result.run_equivalents = record.y, result.runs + 1, result.run_equivalents + 1
+    _finish(result, lin, lower, upper, stopped, max_iterations, moved if not stopped and result.iterations else None)
     return result
+
+
+def _map_objective(y_exp, C_exp, x0, C0):
+    """(x, y) -> (y_exp - y)^T C_exp^-1 (y_exp - y) + (x - x0)^T C0^-1 (x - x0)."""
+    W_exp, W0 = np.linalg.inv(C_exp), np.linalg.inv(C0)
+
+    def f(x, y):
+        r, d = y_exp - y, x - x0
+        return float(r @ W_exp @ r + d @ W0 @ d)
+
+    return f
+
+
+def _decreases(objective, anchor, y_anchor):
+    """Accept a point whose objective is not above the anchor's (a relative 1e-9 for round-off)."""
+    reference = objective(anchor, y_anchor)
+    return lambda x, y: np.all(np.isfinite(y)) and objective(x, y) <= reference * (1 + 1e-9) + 1e-12
+
+
+def _finish(result, lin, lower, upper, stopped, max_iterations, moved):
+    """The run at the final estimate (backtracking to the last full run if it fails), status and bound flags."""
+    got = lin.at(result.x, lin.last_full[0] if lin.last_full is not None else None, None,
+                 {"iteration": result.iterations, "step": "final"})
+    if got is not None:
+        result.x, result.y = got[0], got[1]
+    else:
+        result.y = np.full(result.y.size if result.y is not None else lin.n_outputs, np.nan)
+        stopped = stopped or f"the forward run at the final estimate failed: {lin.last_error}"
+    if stopped:
+        result.status = f"stopped: {stopped}"
+    elif result.converged:
+        result.status = "converged"
+    else:
+        result.status = (f"not converged: {max_iterations} global iterations reached, the last moved the estimate "
+                         f"by {moved:.3g} std")
+    span = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
+    result.at_bound = (np.abs(result.x - lower) <= 1e-9 * span) | (np.abs(upper - result.x) <= 1e-9 * span)
 
 
 def batch_kalman(
@@ -225,6 +384,7 @@ def batch_kalman(
     x_{k+1} = x0 + K_k (y_exp - h(x_k) - S_k (x0 - x_k)),  K_k = C0 S_k^T (S_k C0 S_k^T + C_exp)^-1,
     which is Gauss-Newton on the Bayesian objective: the step-by-step filter with a single group of
     all observations and re-linearised global iterations.
+    Bounded and failure tolerant as :func:`kalman_filter`.
     """
     n = np.asarray(y_exp).size
     return kalman_filter(evaluate, y_exp, C_exp, x0, C0, groups=[np.arange(n)], max_iterations=max_iterations,

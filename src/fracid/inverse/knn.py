@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,6 +123,8 @@ class KnnResult:
     k : int
     x0, C0 : ndarray
         Mean and covariance of the k nearest neighbours (the Kalman filter's prior).
+    Y : ndarray, shape (N, n_outputs), optional
+        Computed values of every point (NaN rows for failed runs).
     """
 
     space: ParameterSpace
@@ -132,6 +136,7 @@ class KnnResult:
     k: int
     x0: np.ndarray
     C0: np.ndarray
+    Y: np.ndarray | None = None
 
     @property
     def neighbours(self) -> np.ndarray:
@@ -174,11 +179,11 @@ def knn_from_population(space, points, Y, status, errors, y_exp, C_exp, k) -> Kn
     spread = np.cov(best.T, ddof=1).reshape(p, p) if k > 1 else np.zeros((p, p))
     spacing = (space.upper - space.lower) / n ** (1.0 / p) / 2.0
     C0 = spread + np.diag(spacing**2)
-    return KnnResult(space, points, f, list(status), list(errors), order, k, x0, C0)
+    return KnnResult(space, points, f, list(status), list(errors), order, k, x0, C0, np.atleast_2d(np.asarray(Y, float)))
 
 
 def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sobol", seed=0, k=5,
-               executor=None, store=None, progress=None, stats=None) -> KnnResult:
+               executor=None, store=None, progress=None, stats=None, retry_failed=False) -> KnnResult:
     """Run the forward operator on a population and rank it against the data.
 
     Parameters
@@ -195,20 +200,53 @@ def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="s
         Stored runs are reused, new ones stored as they finish (an interrupted population resumes).
     stats : fracid.parallel.BatchStats, optional
         Filled with the numbers of runs computed, reused and failed.
+    retry_failed : bool
+        Run again the points stored as failed.
+
+    Raises
+    ------
+    AllRunsFailed
+        When fewer than k runs of the population succeeded; the message gives the most common reason.
     """
     if tuple(operator.names) != tuple(space.names):
         raise ValueError(f"operator parameters {operator.names} differ from the space's {space.names}")
     points = design(space, n, method, seed)
     if not 1 <= k <= len(points):
         raise ValueError(f"k = {k} must be between 1 and the population size {len(points)}")
-    records = evaluate_population(operator, points, executor=executor, store=store, progress=progress, stats=stats)
+    records = evaluate_population(operator, points, executor=executor, store=store, progress=progress, stats=stats,
+                                  retry_failed=retry_failed)
+    succeeded = sum(r.ok for r in records)
+    if succeeded < k:
+        raise AllRunsFailed(succeeded, len(records), k, [r.error for r in records if not r.ok])
     Y = np.array([r.y for r in records])
     return knn_from_population(space, points, Y, [r.status for r in records], [r.error for r in records],
                                y_exp, C_exp, k)
 
 
-def evaluate_population(operator, points, *, executor=None, store=None, progress=None, stats=None):
+def evaluate_population(operator, points, *, executor=None, store=None, progress=None, stats=None, retry_failed=False):
     """Forward runs of every point, through the executor and the run store when given."""
     from fracid.inverse.runs import run_population
 
-    return run_population(operator, points, executor=executor, store=store, progress=progress, stats=stats)
+    return run_population(operator, points, executor=executor, store=store, progress=progress, stats=stats,
+                          retry_failed=retry_failed)
+
+
+class AllRunsFailed(RuntimeError):
+    """Too few forward runs of a population succeeded to rank it; the message names the commonest failure."""
+
+    def __init__(self, succeeded: int, total: int, k: int, errors):
+        self.succeeded, self.total, self.k = succeeded, total, k
+        examples = {}
+        for error in errors:
+            examples.setdefault(_reason(error), error or "unknown")
+        self.reasons = [(examples[r], n) for r, n in Counter(_reason(e) for e in errors).most_common()]
+        common, count = self.reasons[0] if self.reasons else ("unknown", 0)
+        super().__init__(
+            f"only {succeeded} of {total} forward runs of the KNN population succeeded (k = {k} needed); "
+            f"the most common failure ({count} of {total - succeeded} runs), for example: {common}")
+
+
+def _reason(error: str) -> str:
+    """A failure message without the numbers that differ from run to run (so that equal causes count together)."""
+    text = re.sub(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?", "#", str(error) or "unknown")
+    return text[:300]

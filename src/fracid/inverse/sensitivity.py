@@ -23,7 +23,12 @@ def evaluate_points(evaluate, points, needed=None, executor=None) -> list[RunRec
     """Evaluate ``evaluate(x, needed)`` at every point, in parallel when an executor is given.
 
     Plain arrays returned by ``evaluate`` (analytic test models) are wrapped in a :class:`RunRecord`.
+    An ``evaluate`` with an ``evaluate_many(points, needed, executor)`` method (a run store or a
+    memory of runs, see :class:`Memoized` and :class:`fracid.inverse.runs.StoredOperator`) is
+    asked through it, so that runs already made are not made again.
     """
+    if hasattr(evaluate, "evaluate_many"):
+        return evaluate.evaluate_many(points, needed, executor)
     if executor is None:
         outputs = [evaluate(np.asarray(x, float), needed) for x in points]
     else:
@@ -31,6 +36,33 @@ def evaluate_points(evaluate, points, needed=None, executor=None) -> list[RunRec
         outputs = [f.result() for f in futures]
     return [out if isinstance(out, RunRecord) else RunRecord(np.asarray(x, float), np.asarray(out, float))
             for x, out in zip(points, outputs)]
+
+
+class Memoized:
+    """``evaluate`` that remembers its runs in this process: a point asked again is not run again.
+
+    The Kalman filter asks for the run at its own point before the perturbed ones (to see whether
+    it succeeds and lowers the objective), then the sensitivity method asks for it again.
+    """
+
+    def __init__(self, evaluate):
+        self.evaluate = evaluate
+        self.memory: dict = {}
+
+    def __call__(self, x, needed=None):
+        return self.evaluate_many([x], needed, None)[0]
+
+    def evaluate_many(self, points, needed=None, executor=None) -> list[RunRecord]:
+        keys = [(np.asarray(x, float).tobytes(), needed) for x in points]
+        missing = {key: x for key, x in zip(keys, points) if key not in self.memory}
+        fresh = evaluate_points(self.evaluate, list(missing.values()), needed, executor)
+        self.memory.update(zip(missing, fresh))
+        return [self.memory[key] for key in keys]
+
+
+def memoized(evaluate):
+    """``evaluate`` itself if it already avoids repeated runs (has ``evaluate_many``), else :class:`Memoized`."""
+    return evaluate if hasattr(evaluate, "evaluate_many") else Memoized(evaluate)
 
 
 @dataclass(frozen=True)

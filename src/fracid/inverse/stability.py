@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fracid.inverse.kalman import kalman_filter
-from fracid.inverse.sensitivity import ForwardRunError
 
 
 @dataclass
@@ -96,12 +95,12 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     estimates, errors = np.full((len(data), np.size(x0)), np.nan), []
     stds = []
     for i, y in enumerate(data):
-        try:
-            result = kalman_filter(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor, **kalman)
+        result = kalman_filter(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor, **kalman)
+        if result.failed:  # a replicate that fails is recorded; the study goes on
+            error = result.status
+        else:
             estimates[i], error = result.x, ""
             stds.append(result.std)
-        except ForwardRunError as err:  # a replicate that fails is recorded; the study goes on
-            error = str(err)
         errors.append(error)
         if progress is not None:
             progress(i + 1, len(data))

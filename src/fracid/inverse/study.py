@@ -20,7 +20,8 @@ from fracid.inverse.analyses import sensitivity_history
 from fracid.inverse.knn import knn_search
 from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError
 from fracid.inverse.stability import stability as stability_check
-from fracid.inverse.strategy import refine
+from fracid.inverse.runs import StoredOperator
+from fracid.inverse.strategy import identification_bounds, refine
 from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
 from fracid.inverse.verdict import DataDescription, parameter_verdicts
 
@@ -90,13 +91,26 @@ class StudyResult:
     predictions: list
     verdict: object
     timings: dict = field(default_factory=dict)
+    runs: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
     @property
     def names(self) -> list:
         return list(self.identification.names)
 
+    def runs_text(self) -> str:
+        """One line per stage: forward runs and how many failed."""
+        parts = [f"{stage} {total} ({failed} failed)" for stage, (total, failed) in self.runs.items()]
+        return "Forward runs: " + ", ".join(parts) if parts else ""
+
     def summary(self) -> str:
         lines = ["Verdict:", self.verdict.text(self.identification.units)]
+        if self.runs:
+            lines.append(self.runs_text())
+        ident = self.identification
+        if getattr(ident, "status", ""):
+            lines.append(f"Kalman filter: {ident.status}")
+        lines += [f"Note: {note}" for note in self.notes]
         if self.predictions:
             lines.append("Predictions of data not used for calibration:")
             lines += [f"  {p.name}: RMS {p.relative_rms:.1%} of the peak, chi2/point {p.chi2_per_point:.2f}"
@@ -110,7 +124,9 @@ class StudyResult:
                "valley_extent": dict(zip(self.names, self.valley_extent.tolist())),
                "maps": [{"pair": list(m.names), "correlation_in_valley": m.correlation, "valley_points": int(m.valley.sum()),
                          "level": m.level} for m in self.maps],
-               "timings_seconds": self.timings}
+               "timings_seconds": self.timings,
+               "runs": {stage: {"runs": total, "failed": failed} for stage, (total, failed) in self.runs.items()},
+               "notes": list(self.notes)}
         if self.sensitivity is not None:
             out["sensitivity"] = {"normalised": self.sensitivity.normalised.tolist(),
                                   "variance_share": self.sensitivity.variance_share.tolist(), "x": self.sensitivity.x.tolist()}
@@ -152,7 +168,8 @@ class StudyResult:
 
 def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates: int = 5, noise_seed: int = 0,
               tolerance: float = 0.1, n=64, method="sobol", seed=0, k=5, groups=None, max_iterations=10, tol=0.01,
-              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=None) -> StudyResult:
+              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=None,
+              retry_failed=False) -> StudyResult:
     """Run the identification strategy with its checks and return the verdict.
 
     Parameters
@@ -184,6 +201,12 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         be ``"blocks"`` (one filter step per data block) or ``"all"`` (one step: the batch filter).
     log : callable(str), optional
         Receives one line per stage (the command line prints them); silent if None.
+    retry_failed : bool
+        Run again the runs stored as failed.
+
+    Every forward run goes through ``store`` (when given). A failed forward run never ends the
+    study: the stage that met it records it (``StudyResult.runs`` counts the failures of every stage,
+    ``notes`` says which checks could not be made).
     """
     if data.y.size != operator.n_outputs:
         raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
@@ -200,37 +223,61 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     if isinstance(groups, str):
         groups = _named_groups(groups, data)
     kalman = {"groups": groups, "max_iterations": max_iterations, "tol": tol, "restart": restart}
-    bounds = operator.valid_bounds()
+    bounds = identification_bounds(operator, space)
     C_bounds = bounds_covariance(space)
     if prior not in ("knn", "bounds"):
         raise ValueError(f"prior = {prior!r}; choose 'knn' or 'bounds'")
+    evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
+    runs, notes = {}, []
+
+    def count(name, before):
+        runs[name] = (evaluate.computed + evaluate.reused - before[0], evaluate.failed - before[1])
+        stage(name)
+
     log(f"KNN: population of {n} ({method})")
     knn = knn_search(operator, y, C, space, n=n, method=method, seed=seed, k=k, executor=executor, store=store,
-                     progress=progress)
+                     progress=progress, retry_failed=retry_failed)
+    runs["KNN"] = (len(knn.points), knn.n_failed)
     stage("knn")
     C0 = knn.C0 if prior == "knn" else C_bounds
     log("sensitivity along the load history at the KNN estimate")
-    history = sensitivity_history(operator, knn.x0, C, C_bounds, names=space.names, blocks=data.blocks,
-                                  executor=executor)
-    stage("sensitivity")
+    mark = (evaluate.computed + evaluate.reused, evaluate.failed)
+    try:
+        history = sensitivity_history(evaluate, knn.x0, C, C_bounds, names=space.names, blocks=data.blocks,
+                                      executor=executor)
+    except ForwardRunError as err:
+        history = None
+        notes.append(f"sensitivity history skipped: {err}")
+    count("sensitivity", mark)
     maps, extent = objective_maps(knn), valley_extent(knn)
     log("Kalman filter from the KNN prior")
-    ident = refine(operator, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
-                   method=method, seed=seed, C0=C0, **kalman)
-    stage("kalman")
+    mark = (evaluate.computed + evaluate.reused, evaluate.failed)
+    ident = refine(evaluate, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
+                   method=method, seed=seed, C0=C0, progress=progress, **kalman)
+    count("Kalman", mark)
     ms = None
     if starts > 1:
         points = starting_points(knn, starts)
         log(f"multi-start check from {len(points)} starting points")
+        mark = (evaluate.computed + evaluate.reused, evaluate.failed)
         if len(points) > 1:
-            ms = multi_start(operator, y, C, points, C_bounds, bounds=bounds, executor=executor, **kalman)
-        stage("multi_start")
+            try:
+                ms = multi_start(evaluate, y, C, points, C_bounds, bounds=bounds, executor=executor, **kalman)
+            except ForwardRunError as err:
+                notes.append(f"multi-start check skipped: {err}")
+            if ms is not None and ms.failed:
+                notes.append(f"multi-start: {len(ms.failed)} of {len(points)} filters failed")
+        count("multi-start", mark)
     st = None
     if replicates:
         log(f"stability check: {replicates} noisy replicates")
-        st = stability_check(operator, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
+        mark = (evaluate.computed + evaluate.reused, evaluate.failed)
+        st = stability_check(evaluate, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
                              executor=executor, **kalman)
-        stage("stability")
+        failed_replicates = sum(bool(e) for e in st.errors)
+        if failed_replicates:
+            notes.append(f"stability: {failed_replicates} of {replicates} replicates failed")
+        count("stability", mark)
     predictions = []
     for op, held in held_out:
         name = ", ".join(b[0] for b in held.blocks)
@@ -238,9 +285,11 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         predictions.append(predict(op, held, ident.x, ident.C, executor=executor, name=name))
     if held_out:
         stage("prediction")
+    if runs["KNN"][1]:
+        notes.insert(0, f"{runs['KNN'][1]} of {runs['KNN'][0]} KNN runs failed (they rank last; see population.csv)")
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
                                  tolerance=tolerance, multi_start=ms, stability=st)
-    return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings)
+    return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes)
 
 
 def _named_groups(name, data):

@@ -151,10 +151,11 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
 
     starts, results, failed = np.atleast_2d(starts), [], []
     for x in starts:
-        try:
-            results.append(kalman_filter(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor, **kalman))
-        except ForwardRunError as err:  # recorded; the other starts still tell
-            failed.append(f"start {x.tolist()}: {err}")
+        result = kalman_filter(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor, **kalman)
+        if result.failed:  # recorded; the other starts still tell
+            failed.append(f"start {x.tolist()}: {result.status}")
+        else:
+            results.append(result)
     if not results:
         raise ForwardRunError("the Kalman filter failed from every starting point: " + "; ".join(failed))
     ends = np.array([r.x for r in results])
