@@ -529,3 +529,219 @@ BAD_MODELS = [
 @pytest.mark.parametrize("text, purpose, words", BAD_MODELS)
 def test_bad_model_config_is_named(tmp_path, text, purpose, words):
     test_bad_config_is_named(tmp_path, text, purpose, words)
+
+
+# --------------------------------------------------------------- data formats, limits, warnings
+
+SINGLE = """\
+[specimen]
+type = "notched-beam"
+h_fine = 1.0
+
+[[experiments]]
+file = "curve.csv"
+control_column = "cmod_mm"
+control_unit = "mm"
+force_unit = "N"
+kind = "single"
+force_columns = ["F_N"]
+std = 10.0
+n_points = 5
+
+[identify]
+parameters = ["c"]
+bounds = { c = [1.0, 30.0] }
+"""
+
+
+def curve_file(tmp_path, text, name="curve.csv"):
+    (tmp_path / name).write_text(text)
+    return tmp_path
+
+
+def ramp(separator=",", decimal=".", n=12):
+    """A CSV text cmod_mm, F_N: 0.01 k mm, 100 k + 10 N, written with the given separator and decimal mark."""
+    rows = [f"{0.01 * k:.2f}{separator}{100.0 * k + 10.0:.1f}".replace(".", decimal) for k in range(n)]
+    return separator.join(["cmod_mm", "F_N"]) + "\n" + "\n".join(rows) + "\n"
+
+
+@pytest.mark.parametrize("separator, decimal, keys", [
+    (";", ",", 'delimiter = ";"\ndecimal = ","'),
+    ("\t", ",", 'delimiter = "tab"\ndecimal = ","'),
+    ("\t", ".", 'delimiter = "\\t"'),
+    (" ", ".", 'delimiter = " "'),
+])
+def test_delimiter_and_decimal_reach_the_reader(tmp_path, separator, decimal, keys):
+    curve_file(tmp_path, ramp(separator, decimal))
+    cfg = load_config(write(tmp_path, variant("n_points = 5", "n_points = 5\n" + keys, SINGLE)))
+    (exp,) = cfg.experiments
+    assert exp.delimiter == separator and exp.decimal == decimal
+    data = build_data(cfg)
+    np.testing.assert_allclose(data.control, np.linspace(0.0, 0.11, 5))
+    np.testing.assert_allclose(data.y, 10000.0 * data.control + 10.0)
+
+
+def test_a_semicolon_file_read_with_the_default_delimiter_is_named(tmp_path):
+    curve_file(tmp_path, "cmod_mm;F_N\n0,001;12,5\n0,002;13,5\n")
+    path = write(tmp_path, SINGLE)
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: experiments[0].file = 'curve.csv': the header is one cell 'cmod_mm;F_N'")
+    assert "the file seems to be separated by ';'" in message and 'set delimiter = ";"' in message
+    assert 'decimal = ","' in message and "no such column" not in message
+    # the separator right, the decimal mark not: the first data row is named
+    with pytest.raises(ConfigError) as info:
+        load_config(write(tmp_path, variant("n_points = 5", 'n_points = 5\ndelimiter = ";"', SINGLE)))
+    message = str(info.value)
+    assert "experiments[0].file = 'curve.csv': the first data row ('0,001', '12,5')" in message
+    assert 'set decimal = ","' in message
+
+
+def test_backtrack_tolerance_is_a_key_in_control_unit(tmp_path):
+    """An unloading loop of 30 um: refused by the default tolerance (1 % of the range) with a message
+    pointing to the key; dropped as noise with backtrack_tolerance = 50 um (0.05 mm)."""
+    control = [0.0, 20.0, 40.0, 60.0, 80.0, 100.0, 70.0, 110.0, 120.0, 140.0, 160.0, 180.0, 200.0]
+    curve_file(tmp_path, "u_um,F_N\n" + "".join(f"{u},{10.0 * u + 1.0}\n" for u in control))
+    text = SINGLE.replace('"cmod_mm"', '"u_um"').replace('control_unit = "mm"', 'control_unit = "um"')
+    cfg = load_config(write(tmp_path, text))
+    assert cfg.experiments[0].backtrack_tolerance is None
+    with pytest.raises(ConfigError) as info:
+        build_data(cfg)
+    message = str(info.value)
+    assert "experiments[0]" in message and "backwards at row 8" in message
+    assert "backtrack_tolerance: the key of [[experiments]]" in message
+    for tolerance, ok in ((20, False), (50, True)):
+        key = f"n_points = 5\nbacktrack_tolerance = {tolerance}"
+        cfg = load_config(write(tmp_path, variant("n_points = 5", key, text)))
+        assert cfg.experiments[0].backtrack_tolerance_mm == pytest.approx(tolerance * 1e-3)
+        if ok:
+            assert build_data(cfg).n_y == 5
+        else:
+            with pytest.raises(ConfigError, match="backwards at row 8"):
+                build_data(cfg)
+
+
+@pytest.mark.parametrize("forces, words", [
+    ([-100.0 * k - 5.0 for k in range(12)], ["the forces are all negative", "negate the column"]),
+    ([0.0] * 12, ["all forces are zero"]),
+])
+def test_negated_or_zero_forces_are_refused(tmp_path, forces, words):
+    curve_file(tmp_path, "cmod_mm,F_N\n" + "".join(f"{0.01 * k},{f}\n" for k, f in enumerate(forces)))
+    cfg = load_config(write(tmp_path, SINGLE))
+    with pytest.raises(ConfigError) as info:
+        build_data(cfg)
+    message = str(info.value)
+    assert "experiments[0]" in message and str(tmp_path / "curve.csv") in message and "column 'F_N'" in message
+    for word in words:
+        assert word in message
+
+
+def test_warnings(tmp_path):
+    assert load_config(CONFIGS / "beam_identify.toml").warnings == ()  # h_fine = 1 mm, c >= 1 mm^2: l >= 1.41 mm
+    text = variant("std = 10.0", "relative_std = 5", SINGLE)
+    curve_file(tmp_path, ramp())
+    cfg = load_config(write(tmp_path, text))
+    assert cfg.warnings == ("experiments[0].relative_std = 5 is more than 1, i.e. more than 100 % of the value; "
+                            "if you meant 5 %, write 0.05",)
+    # elements larger than the internal length l = sqrt(2 c) of the smallest c the study may try
+    cfg = load_config(write(tmp_path, variant("h_fine = 2.0", "h_fine = 4.0")))  # c >= 1: l >= 1.41 mm
+    (warning,) = cfg.warnings
+    assert warning.startswith("specimen.h_fine = 4: the element size h_fine = 4 mm is larger than the internal "
+                              "length l = sqrt(2 c) = 1.41 mm (with the lower bound c = 1 mm^2 of identify.bounds.c)")
+    assert "use h_fine <= l/2" in warning
+    cfg = load_config(write(tmp_path, BAR_SIMULATE.replace('"local-damage"', '"gradient-damage"')
+                            .replace("n_elements = 120", "n_elements = 20")), purpose="simulate")
+    (warning,) = cfg.warnings  # c = 2: l = 2 mm, elements of 100 / 20 = 5 mm
+    assert warning.startswith("specimen.n_elements = 20: the element size length / n_elements = 5 mm is larger than "
+                              "the internal length l = sqrt(2 c) = 2 mm (with c = 2 mm^2)")
+    assert "use n_elements >= 100" in warning
+    # the local model has no internal length: nothing to resolve
+    cfg = load_config(write(tmp_path, BAR_SIMULATE.replace("n_elements = 120", "n_elements = 20")), purpose="simulate")
+    assert cfg.warnings == ()
+
+
+def test_mesh_size_is_counted_without_building_the_mesh():
+    from fracid.specimens.dogbone import DogBone
+
+    for specimen in (NotchedBeam(h_fine=2.0), NotchedBeam(notch_width=8.0, plate_width=3.0), NotchedBeam(span=175.0),
+                     DogBone(), DogBone(size=200.0, platens="hinged", hinge_offset=5.0)):
+        mesh = specimen.mesh()
+        assert specimen.mesh_size() == (len(mesh.cells), len(mesh.nodes), mesh.n_vertices)
+
+
+LIMITS = [
+    pytest.param(variant("n = 64", "n = 1000000000"), "identify",
+                 ["identify.knn.n", "1000000000", "population of 1,000,000,000 points", "limit of 100,000",
+                  "one forward run", "320 GiB"], id="population"),
+    pytest.param(variant("n = 64\nmethod = \"sobol\"", "n = 100\nmethod = \"grid\""), "identify",
+                 ["identify.knn.n", "100", "1,000,000 points (n**p = 100**3", "limit of 100,000"],
+                 id="grid-population"),
+    pytest.param(variant("n_points = 40", "n_points = 50000"), "identify",
+                 ["experiments[0].n_points", "50000", "n_y = 50,000", "n_y^2 x 8 bytes = 18.6 GiB", "at most 5,000"],
+                 id="n_points"),
+    pytest.param(BAR_SIMULATE.replace("n_elements = 120", "n_elements = 100000000"), "simulate",
+                 ["specimen.n_elements", "100000000", "373 GiB", "at most 200,000 elements"], id="bar-elements"),
+    pytest.param(variant("h_fine = 2.0", "h_fine = 0.01"), "identify",
+                 ["specimen.h_fine = 0.01", "2,643,904 elements", "18,525,256 unknowns", "at most 2,000,000 unknowns",
+                  "GiB"], id="beam-h_fine"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nspecimen = { h_fine = 0.02 }"), "identify",
+                 ["experiments[0].specimen.h_fine = 0.02", "unknowns", "at most 2,000,000"], id="override-h_fine"),
+    pytest.param('[specimen]\ntype = "dogbone"\n[[experiments]]\nfile = "load_cmod.csv"\n'
+                 'control_column = "cmod_mm"\ncontrol_unit = "mm"\nforce_unit = "N"\nkind = "single"\n'
+                 'force_columns = ["load_mean_N"]\nstd = 10.0\nn_points = 10\nspecimen = { size = 10000.0 }\n',
+                 "simulate",
+                 ["specimen.h_fine = 2 (default) with experiments[0].specimen = {size = 10000.0}", "3,001,428 unknowns",
+                  "at most 2,000,000"], id="override-size"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\ndecimal = ","'), "identify",
+                 ["experiments[0].decimal", "','", 'delimiter = ","', 'set delimiter = ";"'],
+                 id="decimal-comma-with-comma"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\ndelimiter = "|"'), "identify",
+                 ["experiments[0].delimiter", "'|'", '",", ";", "\\t" (or "tab"), " "'], id="unknown-delimiter"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nbacktrack_tolerance = -0.1"), "identify",
+                 ["experiments[0].backtrack_tolerance", "-0.1", ">= 0 [mm]"], id="negative-backtrack-tolerance"),
+]
+
+
+@pytest.mark.parametrize("text, purpose, words", LIMITS)
+def test_limits_and_formats_are_named(tmp_path, text, purpose, words):
+    test_bad_config_is_named(tmp_path, text, purpose, words)
+
+
+def test_data_values_are_limited_over_the_calibration_blocks(tmp_path):
+    block = BEAM[BEAM.index("[[experiments]]"):BEAM.index("[identify]")]
+    two = variant("n_points = 40", "n_points = 3000", BEAM.replace("[identify]", block + "[identify]", 1))
+    assert load_config(write(tmp_path, two)).n_y == 3040  # each block and the sum within the limit
+    with pytest.raises(ConfigError) as info:
+        load_config(write(tmp_path, two.replace("n_points = 40", "n_points = 2001")))
+    message = str(info.value)
+    assert "experiments = [3000, 2001]" in message and "add up to n_y = 5,001" in message
+    assert "at most 5,000" in message
+    # a prediction block is not stacked with them: only its own size counts
+    predicted = two.replace("n_points = 40", 'n_points = 2001\nrole = "prediction"')
+    assert load_config(write(tmp_path, predicted)).n_y == 3000
+
+
+def test_beam_supported_at_its_ends():
+    """S = L is a valid beam: supports at the end nodes; longer span, softer beam (elastic run)."""
+    import fracid
+
+    params = fracid.DamageParameters(E=37000.0, kappa_i=1e-3)
+    ends, usual = (NotchedBeam(span=span, length=175.0, h_fine=5.0) for span in (175.0, 125.0))
+    mesh = ends.mesh()
+    assert mesh.nodes[:, 0].max() == pytest.approx(87.5)  # nothing meshed beyond the end
+    fixed = ends._conditions(mesh)["fixed_dofs"]
+    support = mesh.nodes[fixed[fixed % 2 == 1] // 2]
+    assert np.all(support[:, 1] == 0.0) and support[:, 0].min() == pytest.approx(85.0)
+    assert support[:, 0].max() == pytest.approx(87.5)  # the end node holds the beam
+    runs = [fracid.simulate(b, params, target=0.002, stop_force_fraction=None) for b in (ends, usual)]
+    for run in runs:  # elastic: force proportional to the CMOD
+        assert run.force[-1] / run.control[-1] == pytest.approx(run.force[1] / run.control[1], rel=1e-6)
+    k_ends, k_usual = (run.force[-1] / run.control[-1] for run in runs)
+    # CMOD grows with the bending moment F S / 4: F / CMOD about in the ratio of the spans 125 / 175 = 0.71
+    assert 0.6 < k_ends / k_usual < 0.75
+    # the deflection grows faster than the span (bending ~ S^3, shear ~ S)
+    c_ends, c_usual = (run.observables["deflection"][-1] / run.force[-1] for run in runs)
+    assert 175.0 / 125.0 < c_ends / c_usual < (175.0 / 125.0) ** 3
+    with pytest.raises(ValueError, match="span = 176.0 must not exceed length = 175.0"):
+        NotchedBeam(span=176.0)

@@ -14,6 +14,7 @@ from fracid.data import (
     gregoire2013_beam4_path,
     local_block,
     read_curve_csv,
+    require_positive_force,
     sample_points,
     stack,
     with_std,
@@ -94,6 +95,7 @@ def test_control_going_backwards_beyond_noise_names_the_row(tmp_path):
         read(path)
     message = str(info.value)
     assert "curve.csv" in message and "backwards at row 9" in message and "row 8" in message
+    assert "backtrack_tolerance: the key of [[experiments]] in a configuration" in message
 
 
 def test_fewer_points_than_requested(tmp_path):
@@ -111,6 +113,84 @@ def test_row_with_missing_cells(tmp_path):
     path = write_csv(tmp_path, rows)
     with pytest.raises(DataError, match="row 5 has 1 cells but the header has 2"):
         read(path)
+
+
+# ------------------------------------------------------------------------- separators and decimals
+
+
+def write_text(tmp_path, text, name="curve.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_semicolon_and_decimal_comma_are_read(tmp_path):
+    path = write_text(tmp_path, "cmod_mm;F_N\n0,001;12,5\n0,002;-13,25\n0,5e-2;1,5E2\n")
+    (curve,) = read_curve_csv(path, control_column="cmod_mm", force_columns="F_N", delimiter=";", decimal=",",
+                              min_points=3)
+    np.testing.assert_allclose(curve.control, [0.001, 0.002, 0.005])
+    np.testing.assert_allclose(curve.force, [12.5, -13.25, 150.0])
+
+
+@pytest.mark.parametrize("delimiter, text", [
+    ("\t", "cmod\tF\n" + "".join(f"{0.01 * k}\t{100.0 * k}\n" for k in range(12))),
+    (" ", "  cmod   F \n" + "".join(f" {0.01 * k} \t {100.0 * k}\n" for k in range(12))),  # any run of whitespace
+])
+def test_tab_and_whitespace_separated_files(tmp_path, delimiter, text):
+    (curve,) = read(write_text(tmp_path, text), delimiter=delimiter)
+    np.testing.assert_allclose(curve.force, 100.0 * np.arange(12))
+
+
+@pytest.mark.parametrize("header, separator", [("cmod;F", ";"), ("cmod\tF", "\t"), ("cmod   F", " ")])
+def test_a_one_cell_header_names_the_separator_it_holds(tmp_path, header, separator):
+    path = write_text(tmp_path, header + "\n" + "".join(f"{0.01 * k}{separator}{k}\n" for k in range(12)))
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and f"the header is one cell {header!r}" in message
+    assert f"seems to be separated by {separator!r}" in message and "no column" not in message
+
+
+def test_decimal_commas_read_with_a_decimal_point_are_named(tmp_path):
+    path = write_text(tmp_path, "cmod;F\n" + "".join(f"0,0{k};{k},5\n" for k in range(1, 13)))
+    with pytest.raises(DataError) as info:
+        read(path, delimiter=";")
+    message = str(info.value)
+    assert "row 2" in message and "'0,01' is not a number" in message and 'set decimal = ","' in message
+    # a comma-separated file cannot hold decimal commas: the rows split into too many cells
+    path = write_text(tmp_path, "cmod,F\n" + "".join(f"0,0{k},{k},5\n" for k in range(1, 13)), name="comma.csv")
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "row 2 has 4 cells but the header has 2" in message and "decimal commas" in message
+    assert 'delimiter = ";" and decimal = ","' in message
+
+
+def test_decimal_comma_refuses_a_point_and_the_comma_delimiter(tmp_path):
+    path = write_text(tmp_path, "cmod;F\n" + "".join(f"0,0{k};1.00{k},5\n" for k in range(1, 13)))
+    with pytest.raises(DataError, match=r"row 2, column 'F': '1.001,5' is not a number; with decimal = \",\" a \"\.\""):
+        read(path, delimiter=";", decimal=",")
+    with pytest.raises(DataError, match="a comma cannot both separate the cells and mark the decimals"):
+        read(path, delimiter=",", decimal=",")
+    with pytest.raises(DataError, match="decimal = ';'"):
+        read(path, delimiter=",", decimal=";")
+
+
+# ------------------------------------------------------------------------------------ force sign
+
+
+def test_negative_or_zero_forces_are_refused_naming_file_and_column(tmp_path):
+    rows = [[0.01 * k, -100.0 * k, 0.0, 100.0 * k - 50.0] for k in range(12)]
+    path = write_csv(tmp_path, rows, header="cmod,F_neg,F_zero,F_ok")
+    negative, zero, mixed = read(path, force_columns=["F_neg", "F_zero", "F_ok"])
+    require_positive_force([mixed])  # a few values below 0 (offset, noise) are fine
+    with pytest.raises(DataError) as info:
+        require_positive_force([mixed, negative])
+    message = str(info.value)
+    assert "curve.csv" in message and "'F_neg'" in message and "the forces are all negative" in message
+    assert "from -1100 to 0 N" in message and "negate the column" in message
+    with pytest.raises(DataError, match=r"curve.csv, column 'F_zero'.*all forces are zero"):
+        require_positive_force([zero])
 
 
 # ------------------------------------------------------------------------------- reading rules

@@ -14,6 +14,13 @@ are pure functions of the validated :class:`Config`.
 
 Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
 
+Limits: a configuration beyond what a workstation holds is refused with the estimate and the limit
+(:data:`MAX_POPULATION` KNN points, :data:`MAX_BAR_ELEMENTS` bar elements, :data:`MAX_UNKNOWNS`
+unknowns of a 2D mesh counted from the geometry, :data:`MAX_DATA_VALUES` data values).
+
+Warnings: valid settings that are probably not meant (``relative_std`` above 1, process-zone
+elements larger than the internal length l = sqrt(2 c)) are returned in ``Config.warnings``.
+
 Schema
 ------
 The sections ``[[experiments]]`` and ``[identify]`` are required for identification
@@ -85,6 +92,11 @@ present they are always validated. Every other key is optional unless marked *re
                                         #   the width (default 0: any damage)
     role = "calibration"                # "calibration" (default) | "prediction": predicted at the
                                         #   estimate by `fracid study`, not calibrated on
+    delimiter = ","                     # cell separator: "," (default) | ";" | "\\t" (or "tab") | " " (any
+                                        #   run of spaces and tabs)
+    decimal = "."                       # decimal mark: "." (default) | "," (0,001); "," needs another delimiter
+    backtrack_tolerance = 0.002         # optional number >= 0 in control_unit: the largest backtrack of the
+                                        #   control column dropped as noise (default 1 % of its range)
 
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
@@ -198,6 +210,9 @@ def _model_of(kind: str):
 
 
 _CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
+#: ``delimiter`` values -> the cell separator ("tab" spells a tab; " " is any run of whitespace)
+_DELIMITERS = {",": ",", ";": ";", "\t": "\t", "tab": "\t", " ": " "}
+_DECIMALS = (".", ",")
 _FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 _LOCAL_UNITS = dict(_CONTROL_UNITS)
 _KINDS = ("repeats", "envelope", "single")
@@ -231,7 +246,8 @@ _TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate
 _MODEL_KEYS = ("type", "parameters")
 _EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                     "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
-                    "name", "specimen", "weight", "damage_threshold", "role")
+                    "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
+                    "backtrack_tolerance")
 _KIND_KEYS = {
     "repeats": ("force_columns",),
     "envelope": ("mean_column", "lower_column", "upper_column"),
@@ -244,6 +260,43 @@ _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
 _ROLES = ("calibration", "prediction")
+
+
+# ------------------------------------------------------------------------------ size limits
+# A configuration asking for more than a workstation can hold is refused when it is loaded, with
+# the estimate, instead of failing (or swapping for hours) in the middle of a study.
+
+#: largest KNN population (n, or n**p for a grid): each member is one forward run (seconds to
+#: minutes each), so 1e5 is already days of computing; n = 1e9 allocated 23.5 GB before the first run
+MAX_POPULATION = 100_000
+
+#: largest number of bar elements: about 4 kB each in a forward run (measured), so 2e5 elements
+#: take about 1 GB; 1e8 elements hung the machine
+MAX_BAR_ELEMENTS = 200_000
+
+#: measured memory of a forward run of the bar per element [bytes]
+BAR_BYTES_PER_ELEMENT = 4_000
+
+#: largest number of unknowns (2 displacements per node + 1 nonlocal strain per vertex) of a 2D
+#: mesh: about 6 kB each in a forward run (measured, before the sparse factorisation's own
+#: memory), so 2e6 unknowns take about 12 GB, and every step factorises the matrix again
+MAX_UNKNOWNS = 2_000_000
+
+#: measured memory of a forward run of the 2D specimens per unknown [bytes]
+BYTES_PER_UNKNOWN = 6_000
+
+#: largest number of data values n_y (the n_points of the calibration blocks together, and of each
+#: prediction block): the covariance C_exp is a dense n_y x n_y matrix of 8-byte numbers (5000 ->
+#: 191 MiB, 50000 -> 18.6 GiB) factorised by every Kalman step; 40 to 100 points describe a curve
+MAX_DATA_VALUES = 5_000
+
+
+def _bytes(n: float) -> str:
+    """A memory size in words: ``18.6 GiB``, ``195 MiB``, ``12 KiB``."""
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n:.0f} bytes"
 
 
 # ------------------------------------------------------------------------------ validated config
@@ -296,6 +349,9 @@ class ExperimentConfig:
     weight: float = 1.0
     damage_threshold: float = 0.0
     role: str = "calibration"
+    delimiter: str = ","  # the cell separator itself ("tab" is stored as "\t"; " " is any whitespace)
+    decimal: str = "."
+    backtrack_tolerance: float | None = None  # in control_unit, as given; None: 1 % of the control range
 
     @property
     def control_scale(self) -> float:
@@ -313,6 +369,11 @@ class ExperimentConfig:
         if self.control_range is None:
             return None
         return tuple(v * self.control_scale for v in self.control_range)
+
+    @property
+    def backtrack_tolerance_mm(self) -> float | None:
+        """``backtrack_tolerance`` in mm (None: the reader's default, 1 % of the control range)."""
+        return None if self.backtrack_tolerance is None else self.backtrack_tolerance * self.control_scale
 
 
 @dataclass(frozen=True)
@@ -392,6 +453,7 @@ class Config:
     output: OutputConfig
     simulate: SimulateConfig
     study: StudyConfig = StudyConfig()
+    warnings: tuple = ()  # of str: valid but probably unintended settings, for the user to read
 
     @property
     def base_dir(self) -> Path:
@@ -425,9 +487,15 @@ class _Checker:
 
     def __init__(self, path: Path):
         self.path = path
+        self.warnings: list[str] = []
 
     def fail(self, key: str, value, allowed: str):
         raise ConfigError(f"{self.path}: {key} = {_show(value)}: {allowed}")
+
+    def warn(self, text: str) -> None:
+        """Record a warning (a valid value that is probably not what was meant), once."""
+        if text not in self.warnings:
+            self.warnings.append(text)
 
     def missing(self, key: str, allowed: str):
         raise ConfigError(f"{self.path}: {key} is missing (no value given); it is required: {allowed}")
@@ -607,6 +675,48 @@ def _check_specimen(ck: _Checker, prefix: str, kind: str, cls, options: dict, gi
         raise ConfigError(f"{ck.path}: {where} = {_show(value)}{default}: {err}") from None
 
 
+def _field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, str]:
+    """The dotted key of specimen field ``name`` (under ``prefix`` if given there, else ``specimen``)
+    and " (default)" when it was not given at all."""
+    return (f"{prefix}.{name}" if name in given else f"specimen.{name}"), ("" if name in options else " (default)")
+
+
+def _check_specimen_size(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+    """Refuse a mesh beyond :data:`MAX_BAR_ELEMENTS` or :data:`MAX_UNKNOWNS`, estimated from the
+    geometry without building it (the specimen is valid: :func:`_check_specimen` ran first)."""
+    specimen = cls(**options)
+    if kind == "bar":
+        n = specimen.n_elements
+        if n > MAX_BAR_ELEMENTS:
+            key, default = _field_key(prefix, "n_elements", options, given)
+            raise ConfigError(
+                f"{ck.path}: {key} = {n}{default}: a forward run of {n:,} bar elements needs about "
+                f"{_bytes(n * BAR_BYTES_PER_ELEMENT)} of memory ({BAR_BYTES_PER_ELEMENT:,} bytes per element, "
+                f"measured); at most {MAX_BAR_ELEMENTS:,} elements are allowed, and a few elements per internal length "
+                "l = sqrt(2 c) are enough")
+        return
+    elements, nodes, vertices = specimen.mesh_size()
+    unknowns = 2 * nodes + vertices
+    if unknowns > MAX_UNKNOWNS:
+        key, default = _field_key(prefix, "h_fine", options, given)
+        if prefix != "specimen" and "h_fine" not in given:  # the experiment's overrides make the mesh too large
+            default += f" with {prefix} = {{" + ", ".join(f"{k} = {_show(v)}" for k, v in given.items()) + "}"
+        shape = ", ".join(f"{name} = {value:g}" for name, value in options.items()
+                          if isinstance(value, float) and name != "h_fine")
+        raise ConfigError(
+            f"{ck.path}: {key} = {specimen.h_fine:g}{default}: the mesh of this {kind} would have about {elements:,} "
+            f"elements and {unknowns:,} unknowns (estimated from the geometry{': ' + shape if shape else ''}), "
+            f"needing about {_bytes(unknowns * BYTES_PER_UNKNOWN)} of memory in a forward run "
+            f"({BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most {MAX_UNKNOWNS:,} unknowns are allowed: "
+            "use a larger h_fine (a few elements per internal length l = sqrt(2 c) are enough)")
+
+
+def _data_limit_text(n_y: int, what: str) -> str:
+    return (f"{what} n_y = {n_y:,} data values, whose covariance takes n_y^2 x 8 bytes = {_bytes(8.0 * n_y * n_y)}; "
+            f"at most {MAX_DATA_VALUES:,} are allowed ({_bytes(8.0 * MAX_DATA_VALUES**2)}), and 40 to 100 points "
+            "describe a curve: lower n_points")
+
+
 def _specimen(ck: _Checker, raw) -> SpecimenConfig:
     if raw is None:
         ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in _SPECIMENS))
@@ -622,18 +732,48 @@ def _specimen(ck: _Checker, raw) -> SpecimenConfig:
     control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
     options = _specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
     _check_specimen(ck, "specimen", kind, cls, options, options)
+    _check_specimen_size(ck, "specimen", kind, cls, options, options)
     return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
 
 
-def _csv_header(ck: _Checker, key: str, path: Path) -> list[str]:
+def _csv_header(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str) -> list[str]:
+    """The header cells of a data file, split by ``delimiter``; a header that is one cell holding
+    another separator, or a first data row with decimal commas read with ``decimal = "."``, is named
+    as such (instead of a missing column or a cell that is not a number)."""
+    from fracid.data.curves import decimal_comma_hint, delimiter_hint, iter_rows
+
+    header = first = None
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:
-            for cells in csv.reader(handle):
-                if any(cell.strip() for cell in cells):
-                    return [cell.strip() for cell in cells]
+            for _, cells in iter_rows(handle, delimiter):
+                if not any(cell.strip() for cell in cells):
+                    continue
+                if header is None:
+                    header = [cell.strip() for cell in cells]
+                else:
+                    first = cells
+                    break
     except (UnicodeDecodeError, csv.Error) as err:
-        raise ConfigError(f"{ck.path}: {key} = {_show(str(path))}: not a readable UTF-8 CSV file ({err})") from None
-    raise ConfigError(f"{ck.path}: {key} = {_show(str(path))}: the file is empty (no header row)")
+        ck.fail(key, value, f"not a readable UTF-8 CSV file ({err})")
+    if header is None:
+        ck.fail(key, value, f"the file is empty (no header row): {path}")
+    guess = delimiter_hint(header, delimiter)
+    if guess is not None:
+        given = _toml_text(delimiter) + (" (the default)" if delimiter == "," else "")
+        ck.fail(key, value, f"the header is one cell {header[0]!r} when split by delimiter = {given}: the file seems "
+                            f"to be separated by {guess!r}; set delimiter = {_toml_text(guess)} (and decimal = \",\" "
+                            "for decimal commas)")
+    hint = first is not None and decimal_comma_hint(first, delimiter, decimal, len(header))
+    if hint:
+        row = ", ".join(repr(cell.strip()) for cell in first)
+        ck.fail(key, value, f"the first data row ({row}) cannot be read with delimiter = {_toml_text(delimiter)} and "
+                            f"decimal = {_toml_text(decimal)}: {hint}")
+    return header
+
+
+def _toml_text(text: str) -> str:
+    """A string as written in TOML: ``";"``, ``"\\t"``."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\t", "\\t") + '"'
 
 
 def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig) -> ExperimentConfig:
@@ -660,8 +800,26 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
             ck.fail(f"{prefix}.{name}", raw[name], f"not used by kind {kind!r}, which takes "
                     + ", ".join(_KIND_KEYS[kind]))
     n_points = ck.integer(f"{prefix}.n_points", required("n_points"), "must be an integer >= 3", lambda v: v >= 3)
+    if n_points > MAX_DATA_VALUES:
+        ck.fail(f"{prefix}.n_points", n_points, _data_limit_text(n_points, "this block alone has"))
 
-    header = _csv_header(ck, f"{prefix}.file", file)
+    delimiter = raw.get("delimiter", ",")
+    if not isinstance(delimiter, str) or delimiter not in _DELIMITERS:
+        ck.fail(f"{prefix}.delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run of '
+                                                 "spaces and tabs); the cell separator of the file")
+    delimiter = _DELIMITERS[delimiter]
+    decimal = ck.choice(f"{prefix}.decimal", raw.get("decimal", "."), _DECIMALS)
+    if decimal == delimiter:
+        ck.fail(f"{prefix}.decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
+                                              'default) a comma cannot also mark the decimals; files with decimal '
+                                              'commas are separated by ";" or tabs: set delimiter = ";" or "tab"')
+    backtrack = None
+    if "backtrack_tolerance" in raw:
+        backtrack = ck.number(f"{prefix}.backtrack_tolerance", raw["backtrack_tolerance"],
+                              f"must be a number >= 0 [{control_unit}] (the largest backtrack of the control column "
+                              "treated as noise)", lambda v: v >= 0)
+
+    header = _csv_header(ck, f"{prefix}.file", raw["file"], file, delimiter, decimal)
     available = "available columns: " + ", ".join(repr(c) for c in header)
 
     def column(name, value):
@@ -698,6 +856,10 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
         name = given[0]
         unit = f" [{force_unit}]" if name == "std" else " (fraction of |y|)"
         options[name] = ck.number(f"{prefix}.{name}", raw[name], f"must be a number > 0{unit}", lambda v: v > 0)
+        value = options[name]
+        if name == "relative_std" and value > 1:
+            ck.warn(f"{prefix}.relative_std = {value:g} is more than 1, i.e. more than 100 % of the value; "
+                    f"if you meant {value:g} %, write {value / 100:g}")
     control_range = None
     if "control_range" in raw:
         value = raw["control_range"]
@@ -714,6 +876,7 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
         fields = [f.name for f in dataclasses.fields(cls)]
         given = _specimen_options(ck, f"{prefix}.specimen", ck.table(f"{prefix}.specimen", raw["specimen"], fields), cls)
         _check_specimen(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)
+        _check_specimen_size(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)
         overrides = tuple(given.items())
     weight = ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0 (p in f = sum p_b f_b)",
                        lambda v: v > 0)
@@ -728,7 +891,8 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
     return ExperimentConfig(index=i, file=file, control_column=control_column, control_unit=control_unit,
                             force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
                             quantity=quantity, name=name, specimen=overrides, weight=weight,
-                            damage_threshold=threshold, role=role, **options)
+                            damage_threshold=threshold, role=role, delimiter=delimiter, decimal=decimal,
+                            backtrack_tolerance=backtrack, **options)
 
 
 _REQUIRED_TEXT = {
@@ -814,6 +978,13 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
     knn = KnnConfig(n=n, method=method, k=5, seed=seed)
     population = knn.population(len(names))
     how = f"n**p = {n}**{len(names)}" if method == "grid" else f"n = {n}"
+    if population > MAX_POPULATION:
+        values = population * (len(names) + (n_y or 0))
+        ck.fail("identify.knn.n", n, f"the population of {population:,} points ({how}, method {method!r}) is above the "
+                                     f"limit of {MAX_POPULATION:,}: each point is one forward run (seconds to minutes "
+                                     f"each), and the points and their outputs alone take {values:,} x 8 bytes = "
+                                     f"{_bytes(8.0 * values)} (p = {len(names)} parameters + n_y = {n_y or 0} outputs "
+                                     "per point); a few hundred points are enough to start the Kalman filter")
     k_value = raw_knn.get("k", 5)
     k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), k_value,
                    f"must be an integer with 1 <= k <= the population size {population} ({how}, method {method!r})",
@@ -918,12 +1089,59 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
     if experiments and not n_y and purpose == "identify":
         ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
+    if n_y and n_y > MAX_DATA_VALUES:
+        ck.fail("experiments", [e.n_points for e in experiments if e.role == "calibration"],
+                _data_limit_text(n_y, "the n_points of the calibration blocks add up to"))
     identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
     output = _output(ck, raw.get("output"), base)
     simulate = _simulate(ck, raw.get("simulate"))
     study = _study(ck, raw.get("study"))
+    _mesh_warnings(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
-                  identify=identify, output=output, simulate=simulate, study=study)
+                  identify=identify, output=output, simulate=simulate, study=study, warnings=tuple(ck.warnings))
+
+
+def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:
+    """Warn when the element size in the process zone exceeds the internal length l = sqrt(2 c) of a
+    gradient or integral damage model (the smallest c: the given one, or the lower bound when c is
+    identified): the damage band, a few l wide, is then not resolved and the results depend on the mesh.
+
+    Element size: ``h_fine`` for the notched beam and the dog-bone (8-node elements in the refined
+    band), ``length / n_elements`` for the bar.
+    """
+    if model.regularization not in ("gradient", "integral"):
+        return
+    c = _model_parameters(model).c
+    where = f"c = {c:g} mm^2" if "c" in dict(model.parameters) else f"c = {c:g} mm^2 (default)"
+    if identify is not None and "c" in identify.parameters:
+        lower = identify.lower[identify.parameters.index("c")]
+        if lower < c:
+            c, where = lower, f"the lower bound c = {lower:g} mm^2 of identify.bounds.c"
+    length = math.sqrt(2.0 * c)
+    variants = [("specimen", dict(specimen.options), dict(specimen.options))]
+    variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))
+                 for e in experiments if e.specimen]
+    cls = _specimen_class(specimen.type)
+    for prefix, options, given in variants:
+        built = cls(**options)
+        if specimen.type == "bar":
+            h = built.length / built.n_elements
+            key, default = _field_key(prefix, "n_elements", options, given)
+            size = f"{key} = {built.n_elements}{default}: the element size length / n_elements = {h:.3g} mm"
+            advice = f"use n_elements >= {math.ceil(2.0 * built.length / length)} (h <= l/2)"
+        else:
+            h = built.h_fine
+            key, default = _field_key(prefix, "h_fine", options, given)
+            size = f"{key} = {h:g}{default}: the element size h_fine = {h:g} mm"
+            advice = "use h_fine <= l/2"
+        if h > length:
+            ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
+                    f"the damage band is not resolved and the results depend on the mesh; {advice}")
+
+
+def _model_parameters(model: ModelConfig):
+    """The parameters of a validated ``[model]`` section (those given, the rest the class's defaults)."""
+    return _model_of(model.type).parameters(**dict(model.parameters))
 
 
 # ------------------------------------------------------------------------------------ builders
@@ -959,14 +1177,18 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
 
 
 def _experiment_data(exp: ExperimentConfig):
-    from fracid.data import from_envelope, from_repeats, read_curve_csv, with_std
+    from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
 
     if exp.kind == "envelope":
         columns = [exp.mean_column, exp.lower_column, exp.upper_column]
     else:
         columns = list(exp.force_columns)
     curves = read_curve_csv(exp.file, control_column=exp.control_column, force_columns=columns,
-                            control_unit_scale=exp.control_scale, force_unit_scale=exp.force_scale)
+                            control_unit_scale=exp.control_scale, force_unit_scale=exp.force_scale,
+                            delimiter=exp.delimiter, decimal=exp.decimal,
+                            backtrack_tolerance=exp.backtrack_tolerance_mm)
+    if exp.quantity == "force":
+        require_positive_force(curves)
     span = exp.control_range_mm
     if exp.kind == "repeats":
         return from_repeats(curves, exp.n_points, span, name=exp.name)

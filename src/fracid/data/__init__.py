@@ -8,7 +8,7 @@ Units: control quantities in mm, forces in N.
 ((40,), (40, 40))
 """
 
-from fracid.data.curves import Curve, DataError, curve_from_arrays, read_curve_csv
+from fracid.data.curves import Curve, DataError, curve_from_arrays, read_curve_csv, require_positive_force
 from fracid.data.experimental import (
     ExperimentalData,
     from_envelope,
@@ -32,6 +32,7 @@ __all__ = [
     "gregoire2013_beam4_path",
     "local_block",
     "read_curve_csv",
+    "require_positive_force",
     "sample_points",
     "stack",
     "with_std",

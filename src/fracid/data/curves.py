@@ -9,6 +9,11 @@ kept only if its control value exceeds the maximum control value of all earlier 
 maximum). A row lying more than ``backtrack_tolerance`` below that running maximum is not noise but a
 defect (unloading, a spliced file, a wrong column) and raises :class:`DataError`; smaller backtracks,
 and repeated control values, are measurement noise and the row is dropped.
+
+Cell separator and decimal mark: ``delimiter`` is ``","`` (default), ``";"``, ``"\\t"`` or ``" "``
+(any run of spaces and tabs); ``decimal`` is ``"."`` (default) or ``","`` (decimal commas, e.g.
+``0,001``; then a ``"."`` in a number is refused: it would be a thousands separator). A file read
+with the wrong separator or decimal mark gets a message saying which one it seems to use.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ import csv
 import math
 import operator
 import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -27,6 +33,18 @@ DEFAULT_BACKTRACK_FRACTION = 0.01
 
 #: how many dropped rows a note lists explicitly
 _MAX_LISTED_ROWS = 10
+
+#: cell separators read by :func:`read_curve_csv`; " " splits at any run of spaces and tabs
+DELIMITERS = (",", ";", "\t", " ")
+
+#: decimal marks read by :func:`read_curve_csv`
+DECIMALS = (".", ",")
+
+#: a number written with a decimal comma (``0,001``, ``-12,5e3``)
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+(?:[eE][+-]?\d+)?$")
+
+#: a run of digits: the pieces a comma-separated file makes of decimal-comma numbers
+_DIGITS = re.compile(r"^[+-]?\d+(?:[eE][+-]?\d+)?$")
 
 
 class DataError(ValueError):
@@ -137,8 +155,10 @@ def _monotonic_mask(
         raise DataError(
             f"{where}: control goes backwards at {unit_label} {rows[i]}: {control[i]!r} mm is "
             f"{backtrack[i]:.6g} mm below the maximum {control[j]!r} mm reached at {unit_label} {rows[j]}, "
-            f"more than the noise tolerance {tolerance:.6g} mm (backtrack_tolerance); "
-            "unloading branches or spliced series must be cut before use"
+            f"more than the noise tolerance {tolerance:.6g} mm (backtrack_tolerance: the key of "
+            "[[experiments]] in a configuration, in its control_unit, or the argument of read_curve_csv "
+            "in mm; default 1 % of the control range); unloading branches or spliced series must be cut "
+            "before use, or a larger backtrack_tolerance drops them as noise"
         )
     dropped = np.flatnonzero(~keep)
     if dropped.size == 0:
@@ -221,20 +241,90 @@ def _column_names(force_columns) -> list[str]:
     return names
 
 
-def _is_number(text: str) -> bool:
+def check_format(delimiter, decimal) -> tuple[str, str]:
+    """``delimiter`` and ``decimal`` checked: a separator of :data:`DELIMITERS` (or any other single
+    character) and a decimal mark of :data:`DECIMALS`, the two different.
+
+    Raises
+    ------
+    DataError
+        If the delimiter is not one character, the decimal mark not "." or ",", or both are ",".
+    """
+    if not isinstance(delimiter, str) or len(delimiter) != 1:
+        raise DataError(f"delimiter = {delimiter!r}: give one character, e.g. ',' ';' '\\t' or ' ' (whitespace)")
+    if decimal not in DECIMALS:
+        raise DataError(f"decimal = {decimal!r}: give '.' or ','")
+    if decimal == delimiter:
+        raise DataError(f"decimal = {decimal!r} and delimiter = {delimiter!r}: a comma cannot both separate the cells "
+                        "and mark the decimals; files with decimal commas are separated by ';' or tabs")
+    return delimiter, decimal
+
+
+def iter_rows(handle, delimiter: str):
+    """(file row, cells) of every line of an open text file; ``delimiter`` " " splits at any run of
+    whitespace, any other is read by :mod:`csv` (quotes allowed)."""
+    if delimiter == " ":
+        for number, line in enumerate(handle, start=1):
+            yield number, line.split()
+        return
+    reader = csv.reader(handle, delimiter=delimiter)
+    for cells in reader:
+        yield reader.line_num, cells
+
+
+def delimiter_hint(header: Sequence[str], delimiter: str) -> str | None:
+    """The separator a file seems to use when its header, split by ``delimiter``, is one cell
+    holding another separator (``"cmod_mm;F_N"`` read with ","); None otherwise."""
+    if len(header) != 1:
+        return None
+    cell = header[0].strip()
+    for candidate in (";", "\t", ",", " "):
+        if candidate != delimiter and candidate in cell:
+            return candidate
+    return None
+
+
+def decimal_comma_hint(cells: Sequence[str], delimiter: str, decimal: str, n_header: int) -> str | None:
+    """Why the numbers of a data row cannot be read if they seem to have decimal commas, else None.
+
+    Either cells such as ``0,001`` read with decimal ".", or (delimiter ",") a row split into more
+    cells than the header, all of them digits: the pieces of decimal-comma numbers.
+    """
+    if decimal != ".":
+        return None
+    texts = [cell.strip() for cell in cells if cell.strip()]
+    if delimiter != "," and any(_DECIMAL_COMMA.match(text) for text in texts):
+        example = next(text for text in texts if _DECIMAL_COMMA.match(text))
+        return f'numbers such as {example!r} have decimal commas: set decimal = ","'
+    if delimiter == "," and len(cells) > n_header and texts and all(_DIGITS.match(text) for text in texts):
+        return ("the row has more cells than the header, all digits: the numbers seem to have decimal commas, "
+                "which a comma-separated file cannot hold; save the file separated by ';' and set "
+                'delimiter = ";" and decimal = ","')
+    return None
+
+
+def _to_float(text: str, decimal: str) -> float:
+    """``float`` of a stripped cell with the given decimal mark (ValueError if it is not a number)."""
+    if decimal == ",":
+        if "." in text:
+            raise ValueError(text)
+        text = text.replace(",", ".")
+    return float(text)
+
+
+def _is_number(text: str, decimal: str = ".") -> bool:
     try:
-        float(text)
+        _to_float(text.strip(), decimal)
     except ValueError:
         return False
     return True
 
 
-def _read_rows(path: str, delimiter: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+def _read_rows(path: str, delimiter: str, decimal: str = ".") -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Header cells and (file row, cells) of every data row; blank lines after the data are ignored."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:
-            reader = csv.reader(handle, delimiter=delimiter)
-            rows = [(reader.line_num, cells) for cells in reader]
+            rows = list(iter_rows(handle, delimiter))
     except UnicodeDecodeError as error:
         raise DataError(f"{path}: not a UTF-8 text file ({error})") from None
     except csv.Error as error:
@@ -248,7 +338,7 @@ def _read_rows(path: str, delimiter: str) -> tuple[list[str], list[tuple[int, li
         raise DataError(f"{path}: the file is empty (no header row, no data)")
     header_line, header = rows[first]
     header = [cell.strip() for cell in header]
-    if all(_is_number(cell) for cell in header if cell):
+    if all(_is_number(cell, decimal) for cell in header if cell):
         raise DataError(
             f"{path}: row {header_line} looks like data ({', '.join(header)}); a header row naming the columns is required"
         )
@@ -259,11 +349,18 @@ def _read_rows(path: str, delimiter: str) -> tuple[list[str], list[tuple[int, li
     return header, data
 
 
-def _column_indices(path: str, header: list[str], wanted: list[str]) -> list[int]:
+def _column_indices(path: str, header: list[str], wanted: list[str], delimiter: str = ",") -> list[int]:
     indices = []
     for name in wanted:
         hits = [k for k, cell in enumerate(header) if cell == name]
         if not hits:
+            guess = delimiter_hint(header, delimiter)
+            if guess is not None:
+                raise DataError(
+                    f"{path}: the header is one cell {header[0]!r} when split by delimiter = {delimiter!r}: the file "
+                    f"seems to be separated by {guess!r}; give delimiter = {guess!r} (and decimal = \",\" for "
+                    "decimal commas)"
+                )
             available = ", ".join(repr(cell) for cell in header)
             raise DataError(f"{path}: the header has no column {name!r}; available columns: {available}")
         if len(hits) > 1:
@@ -272,14 +369,19 @@ def _column_indices(path: str, header: list[str], wanted: list[str]) -> list[int
     return indices
 
 
-def _parse_cell(path: str, line: int, column: str, text: str) -> float:
+def _parse_cell(path: str, line: int, column: str, text: str, decimal: str = ".", delimiter: str = ",") -> float:
     stripped = text.strip()
     if not stripped:
         raise DataError(f"{path}: row {line}, column {column!r}: empty cell (missing value)")
     try:
-        value = float(stripped)
+        value = _to_float(stripped, decimal)
     except ValueError:
-        raise DataError(f"{path}: row {line}, column {column!r}: {stripped!r} is not a number") from None
+        hint = decimal_comma_hint([stripped], delimiter, decimal, 1)
+        if decimal == "," and "." in stripped:
+            hint = 'with decimal = "," a "." is not allowed in a number (a thousands separator?)'
+        raise DataError(
+            f"{path}: row {line}, column {column!r}: {stripped!r} is not a number" + (f"; {hint}" if hint else "")
+        ) from None
     if math.isnan(value):
         raise DataError(f"{path}: row {line}, column {column!r}: missing value ({stripped!r})")
     if math.isinf(value):
@@ -288,20 +390,27 @@ def _parse_cell(path: str, line: int, column: str, text: str) -> float:
 
 
 def _parse_table(
-    path: str, header: list[str], data: list[tuple[int, list[str]]], names: list[str], indices: list[int]
+    path: str,
+    header: list[str],
+    data: list[tuple[int, list[str]]],
+    names: list[str],
+    indices: list[int],
+    decimal: str = ".",
+    delimiter: str = ",",
 ) -> tuple[np.ndarray, np.ndarray]:
     """Values (n_rows, n_columns) of the requested columns and the file row of each data row."""
     values = np.empty((len(data), len(names)))
     lines = np.empty(len(data), dtype=int)
     for r, (line, cells) in enumerate(data):
         if len(cells) != len(header):
+            hint = decimal_comma_hint(cells, delimiter, decimal, len(header))
             raise DataError(
                 f"{path}: row {line} has {len(cells)} cells but the header has {len(header)} "
-                f"({', '.join(repr(cell) for cell in header)})"
+                f"({', '.join(repr(cell) for cell in header)})" + (f"; {hint}" if hint else "")
             )
         lines[r] = line
         for c, (name, index) in enumerate(zip(names, indices)):
-            values[r, c] = _parse_cell(path, line, name, cells[index])
+            values[r, c] = _parse_cell(path, line, name, cells[index], decimal, delimiter)
     return values, lines
 
 
@@ -324,6 +433,7 @@ def read_curve_csv(
     control_unit_scale: float = 1.0,
     force_unit_scale: float = 1.0,
     delimiter: str = ",",
+    decimal: str = ".",
     min_points: int = 10,
     backtrack_tolerance: float | None = None,
 ) -> list[Curve]:
@@ -345,7 +455,10 @@ def read_curve_csv(
     force_unit_scale : float
         Multiplier turning the force column(s) into N (e.g. 1e3 for kN); non-zero.
     delimiter : str
-        Cell separator.
+        Cell separator: ``","`` (default), ``";"``, ``"\\t"``, or ``" "`` for any run of spaces and
+        tabs. A header read as one cell holding another separator is reported as such.
+    decimal : {".", ","}
+        Decimal mark of the numbers; ``","`` (e.g. ``0,001``) needs a delimiter other than ``","``.
     min_points : int
         Fewest data rows accepted (before and after the backtracking rule), >= 2.
     backtrack_tolerance : float, optional
@@ -362,7 +475,8 @@ def read_curve_csv(
     DataError
         Naming the file, and the row (header = row 1) and column where relevant, if the file is
         empty, lacks a requested column, holds text, an empty or NaN cell, has fewer than
-        ``min_points`` rows, or its control goes backwards by more than the tolerance.
+        ``min_points`` rows, or its control goes backwards by more than the tolerance; a wrong
+        delimiter or decimal mark is named as such.
 
     Examples
     --------
@@ -375,12 +489,14 @@ def read_curve_csv(
     f_scale = _check_scale(force_unit_scale, "force_unit_scale", positive=False)
     min_points = integer_at_least(min_points, 2, "min_points")
 
-    header, data = _read_rows(path, delimiter)
+    delimiter, decimal = check_format(delimiter, decimal)
+
+    header, data = _read_rows(path, delimiter, decimal)
     wanted = [control_column, *names]
-    indices = _column_indices(path, header, wanted)
+    indices = _column_indices(path, header, wanted, delimiter)
     if len(data) < min_points:
         raise DataError(f"{path}: {len(data)} data rows, fewer than the minimum of {min_points} (min_points)")
-    values, lines = _parse_table(path, header, data, wanted, indices)
+    values, lines = _parse_table(path, header, data, wanted, indices, decimal, delimiter)
 
     control = values[:, 0] * c_scale
     forces = values[:, 1:] * f_scale
@@ -407,3 +523,27 @@ def read_curve_csv(
             )
         )
     return curves
+
+
+def require_positive_force(curves: Sequence[Curve]) -> None:
+    """Refuse force curves that are all <= 0: negated forces, or a column of zeros.
+
+    A tension or bending test gives positive forces (the specimens' forces are positive); a
+    machine that records them negative needs its column negated (e.g. ``force_unit_scale=-1``).
+
+    Raises
+    ------
+    DataError
+        Naming the curve's file and column, if every force of a curve is zero, or <= 0 with one below 0.
+    """
+    for curve in curves:
+        force = curve.force
+        if np.all(force == 0.0):
+            raise DataError(f"{curve.source}: all forces are zero; is it the right column?")
+        if np.all(force <= 0.0):
+            lowest, highest = float(force.min()), float(force.max()) + 0.0  # + 0.0: -0 written 0
+            raise DataError(
+                f"{curve.source}: the forces are all negative (from {lowest:g} to {highest:g} N): "
+                "a tension or bending test gives positive forces; if the sign convention of the machine is "
+                "negative, negate the column"
+            )

@@ -10,7 +10,7 @@ from fracid.model.discretization import plane_stress_discretization
 from fracid.model.problem import DamageProblem
 from fracid.specimens.checks import require_positive
 from fracid.specimens.fpz import fpz_width_observer
-from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
+from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
 
 @dataclass(frozen=True)
@@ -19,12 +19,13 @@ class NotchedBeam:
 
     The half x >= 0 is meshed (symmetry: u_x = 0 on the ligament above the notch). The load acts on
     a rigid loading plate at mid-span, the support is a roller at x = S/2. Curves are for the full
-    specimen: force [N], CMOD and mid-span deflection [mm].
+    specimen: force [N], CMOD and mid-span deflection [mm]. S = L (a beam supported at its ends) is
+    allowed: the support then holds the nodes of the bottom edge within ``plate_width / 2`` of the end.
 
     Parameters
     ----------
     depth, thickness, length, span : float
-        D, b, L, S [mm].
+        D, b, L, S [mm], S <= L.
     notch_depth, notch_width : float
         a0 and the notch width [mm].
     plate_width : float
@@ -58,8 +59,8 @@ class NotchedBeam:
     def __post_init__(self):
         require_positive(self, ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
                                 "h_fine", "h_coarse", "fine_width"), " [mm]")
-        if not self.span < self.length:
-            raise ValueError(f"span = {self.span} must be smaller than length = {self.length}")
+        if not self.span <= self.length:
+            raise ValueError(f"span = {self.span} must not exceed length = {self.length} (S = L: supports at the ends)")
         if not self.notch_depth < self.depth:
             raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
         if not self.notch_width / 2 < self.fine_width < self.span / 2 - self.plate_width / 2:
@@ -71,19 +72,33 @@ class NotchedBeam:
 
         return replace(self, h_fine=self.h_fine / factor, h_coarse=self.h_coarse / factor if everywhere else self.h_coarse)
 
-    def mesh(self) -> QuadMesh:
+    def _grid(self):
+        """Keypoints and element-size functions of the grid lines in x and in y."""
         h_f, h_c, w = self.h_fine, self.h_coarse, self.fine_width
         h_plate = self.plate_width / 4  # the rigid support's edges concentrate the reaction
         x_size = lambda x: np.minimum.reduce(  # noqa: E731
             [np.full_like(x, h_c), h_f + 0.3 * np.maximum(x - w, 0.0), h_plate + 0.3 * np.abs(x - self.span / 2)]
         )
-        p = self.plate_width / 2
-        x_keys = sorted({0.0, self.notch_width / 2, p, w, self.span / 2 - p, self.span / 2 + p, self.length / 2})
-        xs = graded_lines(x_keys, x_size)
+        p, end = self.plate_width / 2, self.length / 2
+        keys = {0.0, self.notch_width / 2, p, w, self.span / 2 - p, self.span / 2 + p}
+        x_keys = sorted({k for k in keys if k < end - 1e-9 * end} | {end})  # a support at the end: no line beyond it
         y_size = lambda y: np.minimum(h_c, h_f + 0.15 * np.maximum(self.notch_depth - h_f * 4 - y, 0.0))  # noqa: E731
-        ys = graded_lines([0.0, self.notch_depth, self.depth], y_size)
+        return x_keys, x_size, [0.0, self.notch_depth, self.depth], y_size
+
+    def mesh(self) -> QuadMesh:
+        x_keys, x_size, y_keys, y_size = self._grid()
+        xs = graded_lines(x_keys, x_size)
+        ys = graded_lines(y_keys, y_size)
         in_notch = lambda s, t: (s < self.notch_width / 2) & (t < self.notch_depth)  # noqa: E731
         return structured_quad8(xs, ys, keep=lambda s, t: ~in_notch(s, t))
+
+    def mesh_size(self) -> tuple[int, int, int]:
+        """(elements, nodes, vertices) of :meth:`mesh`, counted from the geometry without building it
+        (a configuration checks the size of the problem before any run)."""
+        x_keys, x_size, y_keys, y_size = self._grid()
+        in_notch = [k for k in x_keys if k <= self.notch_width / 2]  # the keypoints up to the notch's side
+        notch = (graded_count(in_notch, x_size), graded_count([0.0, self.notch_depth], y_size))
+        return quad8_grid_size(graded_count(x_keys, x_size), graded_count(y_keys, y_size), notch)
 
     def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
         mesh = mesh or self.mesh()

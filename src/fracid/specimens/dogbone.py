@@ -11,7 +11,7 @@ from fracid.model.discretization import plane_stress_discretization
 from fracid.model.problem import DamageProblem
 from fracid.specimens.checks import require_positive
 from fracid.specimens.fpz import fpz_width_observer
-from fracid.specimens.meshing import QuadMesh, graded_lines, structured_quad8
+from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
 
 @dataclass(frozen=True)
@@ -111,20 +111,36 @@ class DogBone:
         arc = centre - np.sqrt(np.maximum(R * R - y * y, 0.0))
         return np.where(arc < 0.5 * D, np.minimum(arc, 0.5 * D), 0.5 * D)
 
-    def mesh(self) -> QuadMesh:
+    def _grid(self):
+        """Keypoints and element-size function of the lines in height, the number of elements across
+        the half-width, and the number of element rows of a hinged platen (0 if glued)."""
         D, h = self.size, self.h_fine
         fine, coarse = self._fine_height, self.h_coarse or 0.1 * D
         R = self.notch_radius * D
         end_of_arc = math.sqrt(max(R * R - (0.5 * D - (0.5 * self.notch_width * D + R)) ** 2, 0.0))
         keys = sorted({0.0, self._gauge / 2, min(end_of_arc, 0.75 * D), 0.75 * D})
-        ts = graded_lines(keys, lambda t: np.minimum(coarse, h + 0.25 * np.maximum(t - fine, 0.0)))
+        size = lambda t: np.minimum(coarse, h + 0.25 * np.maximum(t - fine, 0.0))  # noqa: E731
         n_s = max(2, math.ceil(0.5 * self.notch_width * D / h))
+        n_platen = max(2, math.ceil(self.platen_height * D / coarse)) if self.platens == "hinged" else 0
+        return keys, size, n_s, n_platen
+
+    def mesh(self) -> QuadMesh:
+        D = self.size
+        keys, size, n_s, n_platen = self._grid()
+        ts = graded_lines(keys, size)
         s_lines = np.linspace(0.0, 1.0, n_s + 1)
         if self.platens == "hinged":
             s_lines = np.concatenate([-s_lines[:0:-1], s_lines])
             top = 0.75 * D + self.platen_height * D
-            ts = np.concatenate([ts, np.linspace(0.75 * D, top, max(2, math.ceil(self.platen_height * D / coarse)) + 1)[1:]])
+            ts = np.concatenate([ts, np.linspace(0.75 * D, top, n_platen + 1)[1:]])
         return structured_quad8(s_lines, ts, mapping=lambda s, t: (s * self.half_width(t), t))
+
+    def mesh_size(self) -> tuple[int, int, int]:
+        """(elements, nodes, vertices) of :meth:`mesh`, counted from the geometry without building it
+        (a configuration checks the size of the problem before any run)."""
+        keys, size, n_s, n_platen = self._grid()
+        across = 2 * n_s if self.platens == "hinged" else n_s
+        return quad8_grid_size(across, graded_count(keys, size) + n_platen)
 
     def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
         mesh = mesh or self.mesh()

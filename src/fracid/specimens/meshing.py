@@ -52,18 +52,44 @@ def graded_lines(keypoints, size: Callable[[np.ndarray], np.ndarray], samples: i
     size : callable
         Desired element size at positions x [mm], positive.
     """
-    keys = np.asarray(keypoints, dtype=float)
-    if np.any(np.diff(keys) <= 0):
-        raise ValueError(f"keypoints must increase strictly: {keys.tolist()}")
+    keys = _check_keys(keypoints)
     lines = [keys[:1]]
     for a, b in zip(keys[:-1], keys[1:]):
-        x = np.linspace(a, b, samples)
-        density = 1.0 / np.asarray(size(x), dtype=float)
-        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(x))])
-        n = max(1, int(np.ceil(cumulative[-1] - 1e-9)))
+        x, cumulative, n = _equidistribution(a, b, size, samples)
         lines.append(np.interp(np.linspace(0, cumulative[-1], n + 1)[1:], cumulative, x))
         lines[-1][-1] = b
     return np.concatenate(lines)
+
+
+def graded_count(keypoints, size: Callable[[np.ndarray], np.ndarray], samples: int = 2000) -> int:
+    """Number of intervals :func:`graded_lines` makes with the same arguments, without making them
+    (cheap even when the size function would give millions of lines)."""
+    keys = _check_keys(keypoints)
+    return sum(_equidistribution(a, b, size, samples)[2] for a, b in zip(keys[:-1], keys[1:]))
+
+
+def _check_keys(keypoints) -> np.ndarray:
+    keys = np.asarray(keypoints, dtype=float)
+    if np.any(np.diff(keys) <= 0):
+        raise ValueError(f"keypoints must increase strictly: {keys.tolist()}")
+    return keys
+
+
+def _equidistribution(a: float, b: float, size, samples: int):
+    """Sample positions of [a, b], the cumulative integral of 1/size there, and the element count."""
+    x = np.linspace(a, b, samples)
+    density = 1.0 / np.asarray(size(x), dtype=float)
+    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(x))])
+    return x, cumulative, max(1, int(np.ceil(cumulative[-1] - 1e-9)))
+
+
+def quad8_grid_size(n_s: int, n_t: int, hole: tuple[int, int] = (0, 0)) -> tuple[int, int, int]:
+    """(elements, nodes, vertices) of :func:`structured_quad8` on ``n_s`` x ``n_t`` grid cells, without
+    the ``hole[0]`` x ``hole[1]`` cells at the corner s, t = first lines (e.g. a notch)."""
+    a, b = hole
+    vertices = (n_s + 1) * (n_t + 1) - a * b
+    edges = n_s * (n_t + 1) + n_t * (n_s + 1) - 2 * a * b
+    return n_s * n_t - a * b, vertices + edges, vertices
 
 
 def structured_quad8(
