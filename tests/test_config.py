@@ -252,7 +252,8 @@ knn = { method = "grid", n = 5, k = 5 }
     assert [o.control for o in operator.observations] == ["end_displacement"] * 2
     assert operator.n_outputs == 8
     settings = identify_settings(cfg)
-    assert settings["groups"] is None and settings["method"] == "grid"
+    assert settings["method"] == "grid"  # default grouping: DEFAULT_KALMAN_GROUPS = 4 consecutive steps
+    assert [g.tolist() for g in settings["groups"]] == [[0, 1], [2, 3], [4, 5], [6, 7]]
 
 
 def test_specimen_maps_match_the_specimens():

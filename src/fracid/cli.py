@@ -11,15 +11,20 @@
     fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
     fracid demo               identification of the bundled real test (Gregoire et al. 2013 beam)
 
-Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet. Configuration errors
-end with exit status 2 and a one-paragraph message naming the file, the key and the value.
+Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
+Every expected failure ends with a one-paragraph message and a documented exit status (see
+:mod:`fracid.exits`): 2 bad input, 3 the computation failed, 4 files and storage, 5 out of memory,
+130 interrupted; ``--debug`` shows the traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
 import time
+import traceback
 from importlib import resources
 from pathlib import Path
 
@@ -32,6 +37,8 @@ def _parser() -> argparse.ArgumentParser:
     common.add_argument("--workers", type=int, help="parallel forward runs (default: one per core; 1 = serial)")
     common.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:port) instead of local workers")
     common.add_argument("--quiet", action="store_true", help="no progress bars or summaries")
+    common.add_argument("--retry-failed", action="store_true", help="run again the forward runs stored as failed")
+    common.add_argument("--debug", action="store_true", help="show the traceback of a failure")
     parser = argparse.ArgumentParser(prog="fracid", description="Parameter identification for localized-failure models.")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("simulate", "forward analysis of the configured specimen"),
@@ -56,28 +63,63 @@ def demo_config_path() -> Path:
 
 def _say(args, text):
     if not args.quiet:
-        print(text)
+        print(text, flush=True)
+
+
+def _warn(text):
+    print(f"fracid: warning: {text}", file=sys.stderr, flush=True)
+
+
+def _load(args, path, purpose):
+    from fracid.config import load_config
+
+    cfg = load_config(path, purpose=purpose)
+    for text in cfg.warnings:
+        _warn(text)
+    return cfg
 
 
 def _out_dir(args, cfg) -> Path:
     out = args.out if args.out is not None else Path(cfg.output.directory)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(20, "not a directory", str(out))
     out.mkdir(parents=True, exist_ok=True)
+    args.out_dir = out
     return out
 
 
+@contextlib.contextmanager
+def _working_in(args, out, store=False):
+    """The output directory's lock, and (``store``) its run store; the store's path goes to messages."""
+    from fracid.lock import directory_lock
+    from fracid.store import RunStore
+
+    with directory_lock(out):
+        if not store:
+            yield None
+            return
+        args.store_path = out / "runs.sqlite"
+        with RunStore(args.store_path) as runs:
+            yield runs
+
+
+def _progress(args):
+    return False if args.quiet else None
+
+
 def run_simulate(args) -> int:
-    from fracid.config import build_model, build_parameters, build_specimen, load_config, simulate_settings
+    from fracid.config import build_model, build_parameters, build_specimen, simulate_settings
     from fracid.progress import progress_bar
     from fracid.report.figures import curve_figure, to_png
 
-    cfg = load_config(args.config, purpose="simulate")
+    cfg = _load(args, args.config, "simulate")
     model, specimen, params = build_model(cfg), build_specimen(cfg), build_parameters(cfg)
     settings = simulate_settings(cfg)
     settings.pop("regularization", None)  # the model carries its own
     if settings.get("target") is None:
         settings["target"] = specimen.default_target(params)
     out = _out_dir(args, cfg)
-    with progress_bar(settings["target"], "forward analysis", False if args.quiet else None, unit="mm") as bar:
+    with _working_in(args, out), progress_bar(settings["target"], "forward analysis", _progress(args), unit="mm") as bar:
         result = model.simulate(specimen, params, callback=lambda step, tau, force: bar.update(tau - bar.n),
                                 **settings)
     columns = {result.control_name: result.control, "force_N": result.force, **result.observables}
@@ -98,20 +140,20 @@ def run_simulate(args) -> int:
 
 
 def run_identify(args, config_path=None) -> int:
-    from fracid.config import build_data, build_operator, build_space, identify_settings, load_config
+    from fracid.config import build_data, build_operator, build_space, identify_settings
     from fracid.inverse.strategy import identify_data
-    from fracid.parallel import make_executor
+    from fracid.parallel import executor_session
     from fracid.report.html import write_report
-    from fracid.store import RunStore
 
-    cfg = load_config(config_path or args.config, purpose="identify")
+    cfg = _load(args, config_path or args.config, "identify")
     data = build_data(cfg)
     operator, space, settings = build_operator(cfg, data), build_space(cfg), identify_settings(cfg)
     out = _out_dir(args, cfg)
+    _say(args, _stage_costs(settings, data.n_y, len(space.names)))
     start = time.perf_counter()
-    with RunStore(out / "runs.sqlite") as store, make_executor(args.workers, args.scheduler) as executor:
-        result = identify_data(operator, data, space, executor=executor, store=store,
-                               progress=None if not args.quiet else False, **settings)
+    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
+        result = identify_data(operator, data, space, executor=executor, store=store, progress=_progress(args),
+                               retry_failed=args.retry_failed, **settings)
     result.runs["wall_seconds"] = time.perf_counter() - start
     result.save(out / "result.json")
     header = "control_mm,measured,std,computed,block"
@@ -125,11 +167,31 @@ def run_identify(args, config_path=None) -> int:
                  data_notes=data.notes)
     _write_figures(out / "figures", result, data.control)
     _say(args, result.summary())
-    rms = float(np.sqrt(np.mean((result.y_fit - data.y) ** 2)))
-    _say(args, f"fit: RMS error {rms:.4g} ({100 * rms / np.max(np.abs(data.y)):.2f} % of the measured peak); "
-               f"forward runs: {result.runs['knn']} KNN ({result.runs['knn_failed']} failed) + {result.runs['kalman']} "
-               f"Kalman; {result.runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, figures/*.png")
+    runs = result.runs
+    _say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {runs['knn']} KNN "
+               f"({runs['knn_failed']} failed, {runs.get('knn_computed', runs['knn'])} computed) + {runs['kalman']} "
+               f"Kalman ({runs.get('kalman_failed', 0)} failed, {runs.get('kalman_computed', runs['kalman'])} "
+               f"computed); {runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, "
+               "figures/*.png")
+    for text in result.warnings():
+        _warn(text)
+    if not np.all(np.isfinite(result.x)) or not np.all(np.isfinite(result.y_fit)):
+        print(f"fracid: the identification gave no finite result ({result.status}); see {out / 'report.html'}",
+              file=sys.stderr)
+        return 3
     return 0
+
+
+def _stage_costs(settings, n_y, p) -> str:
+    """What the Kalman stage will cost, said before the work starts."""
+    groups = settings.get("groups")
+    steps = n_y if groups is None else len(groups)
+    per_step = 2 * p + 1
+    first = per_step * (steps + 1) / 2  # step t runs up to observation t/steps of the curve
+    return (f"KNN: {settings['n']} forward runs. Kalman filter: {steps} steps per pass "
+            f"({per_step} runs per step: the run and 2 per parameter); the first pass costs about {first:.0f} "
+            f"full-curve runs, each later one {per_step}, at most {settings['max_iterations']} passes "
+            "([identify.kalman] groups, max_iterations).")
 
 
 def _size_effect(cfg, params, executor, sizes=(), quiet=True):
@@ -163,22 +225,21 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0}, "stability": {"sta
 
 
 def run_study_command(args) -> int:
-    from fracid.config import (build_data, build_held_out, build_operator, build_space, load_config,
-                               study_settings)
+    from fracid.config import build_data, build_held_out, build_operator, build_space, study_settings
     from fracid.inverse.study import run_study
-    from fracid.parallel import make_executor
+    from fracid.parallel import executor_session
     from fracid.report.study import write_study
-    from fracid.store import RunStore
 
-    cfg = load_config(args.config, purpose="identify")
+    cfg = _load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     settings = {**study_settings(cfg), **_STUDY_PARTS[args.command]}
     held_out = build_held_out(cfg) if args.command == "study" else []
     out = _out_dir(args, cfg)
-    with RunStore(out / "runs.sqlite") as store, make_executor(args.workers, args.scheduler) as executor:
+    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
         study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
-                          progress=None if not args.quiet else False, log=lambda text: _say(args, text), **settings)
+                          progress=_progress(args), log=lambda text: _say(args, text),
+                          retry_failed=args.retry_failed, **settings)
         size = None
         if args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
@@ -188,24 +249,28 @@ def run_study_command(args) -> int:
                           size_effect=size.figure_arguments() if size is not None else None)
     _say(args, study.summary())
     _say(args, f"wrote in {out}: " + ", ".join(str(Path(p).relative_to(out)) for p in written))
+    for text in study.identification.warnings():
+        _warn(text)
     return 0
 
 
 def run_sensitivity_command(args) -> int:
-    from fracid.config import build_data, build_operator, build_parameters, build_space, load_config
+    from fracid.config import build_data, build_operator, build_parameters, build_space
     from fracid.inverse.analyses import sensitivity_history
+    from fracid.inverse.runs import StoredOperator
     from fracid.inverse.uniqueness import bounds_covariance
-    from fracid.parallel import make_executor
+    from fracid.parallel import executor_session
     from fracid.report.figures import sensitivity_figure, to_png
 
-    cfg = load_config(args.config, purpose="identify")
+    cfg = _load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     params = build_parameters(cfg)
     x = np.array([getattr(params, n) for n in space.names])
     out = _out_dir(args, cfg)
-    with make_executor(args.workers, args.scheduler) as executor:
-        history = sensitivity_history(operator, x, data.covariance, bounds_covariance(space), names=space.names,
+    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
+        history = sensitivity_history(StoredOperator(operator, store, retry_failed=args.retry_failed), x,
+                                      data.covariance, bounds_covariance(space), names=space.names,
                                       blocks=data.blocks, executor=executor)
     columns = ["control_mm", "y"] + [f"S_{n}" for n in space.names] + [f"variance_removed_{n}" for n in space.names]
     np.savetxt(out / "sensitivity.csv", np.column_stack([data.control, history.y, history.normalised,
@@ -219,13 +284,13 @@ def run_sensitivity_command(args) -> int:
 
 
 def run_size_effect_command(args) -> int:
-    from fracid.config import build_parameters, load_config
-    from fracid.parallel import make_executor
+    from fracid.config import build_parameters
+    from fracid.parallel import executor_session
     from fracid.report.figures import size_effect_figure, to_png
 
-    cfg = load_config(args.config, purpose="simulate")
+    cfg = _load(args, args.config, "simulate")
     out = _out_dir(args, cfg)
-    with make_executor(args.workers, args.scheduler) as executor:
+    with _working_in(args, out), executor_session(args.workers, args.scheduler) as executor:
         size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
     if size is None:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
@@ -254,29 +319,61 @@ def _write_figures(directory: Path, result, control) -> None:
 
 
 def main(argv=None) -> int:
-    args = _parser().parse_args(argv)
-    from fracid.config import ConfigError
+    """Run the command; returns its exit status (see :mod:`fracid.exits`), never raises."""
+    from fracid import exits
 
+    args = _parser().parse_args(argv)
     if args.workers is not None and args.workers < 1:
         print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
-        return 2
+        return exits.INPUT
+    args.store_path = args.out_dir = None
+    previous = _terminate_as_interrupt()
     try:
-        if args.command == "simulate":
-            return run_simulate(args)
-        if args.command == "identify":
-            return run_identify(args)
-        if args.command in _STUDY_PARTS:
-            return run_study_command(args)
-        if args.command == "sensitivity":
-            return run_sensitivity_command(args)
-        if args.command == "size-effect":
-            return run_size_effect_command(args)
-        if args.out is None:  # not next to the bundled config inside the installation
-            args.out = Path.cwd() / "fracid-demo"
-        return run_identify(args, demo_config_path())
-    except ConfigError as err:
-        print(f"fracid: {err}", file=sys.stderr)
-        return 2
+        return _dispatch(args)
+    except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
+        if isinstance(err, SystemExit):
+            raise
+        status, text = exits.describe(err, store_path=args.store_path, out=args.out_dir)
+        if args.debug:
+            traceback.print_exc()
+        print(f"fracid: {text}", file=sys.stderr)
+        return status
+    finally:
+        _restore(previous)
+
+
+def _dispatch(args) -> int:
+    if args.command == "simulate":
+        return run_simulate(args)
+    if args.command == "identify":
+        return run_identify(args)
+    if args.command in _STUDY_PARTS:
+        return run_study_command(args)
+    if args.command == "sensitivity":
+        return run_sensitivity_command(args)
+    if args.command == "size-effect":
+        return run_size_effect_command(args)
+    if args.out is None:  # not next to the bundled config inside the installation
+        args.out = Path.cwd() / "fracid-demo"
+    return run_identify(args, demo_config_path())
+
+
+def _terminate_as_interrupt():
+    """SIGTERM ends the run like Ctrl-C (finished runs stored, a message, exit 143)."""
+    from fracid.exits import Terminated
+
+    def handler(signum, frame):
+        raise Terminated()
+
+    try:
+        return signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread (e.g. called from a test runner's thread)
+        return None
+
+
+def _restore(previous):
+    if previous is not None:
+        signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

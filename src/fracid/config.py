@@ -260,6 +260,10 @@ _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
 _ROLES = ("calibration", "prediction")
+#: Kalman steps per pass when [identify.kalman] groups is not given. One observation per step costs
+#: 2 p + 1 partial runs per observation (a 30-point curve: over 100 full-run equivalents per pass);
+#: with linearised restarts the later passes use one linearisation each whatever the grouping.
+DEFAULT_KALMAN_GROUPS = 4
 
 
 # ------------------------------------------------------------------------------ size limits
@@ -1289,18 +1293,17 @@ def build_space(cfg: Config):
 def identify_settings(cfg: Config) -> dict:
     """Keyword arguments of :func:`fracid.inverse.strategy.identify_data` (and ``identify``).
 
-    ``n``, ``method``, ``seed``, ``k``, ``groups`` (None, or ``groups`` consecutive index arrays
-    covering the n_y observations), ``max_iterations``, ``tol`` and ``restart`` (only when
-    ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
+    ``n``, ``method``, ``seed``, ``k``, ``groups`` (``groups`` consecutive index arrays covering
+    the n_y observations; :data:`DEFAULT_KALMAN_GROUPS` when not given), ``max_iterations``,
+    ``tol`` and ``restart`` (only when ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
     (executor, store, progress) is not configuration: add it at the call.
     """
     from fracid.inverse.strategy import identify
 
     settings = _require(cfg, "identify")
     knn, kalman = settings.knn, settings.kalman
-    groups = None
-    if kalman.groups is not None:
-        groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), kalman.groups)]
+    count = kalman.groups if kalman.groups is not None else min(DEFAULT_KALMAN_GROUPS, cfg.n_y)
+    groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), count)]
     out = {"n": knn.n, "method": knn.method, "seed": knn.seed, "k": knn.k, "groups": groups,
            "max_iterations": kalman.max_iterations, "tol": kalman.tol}
     if "restart" in inspect.signature(identify).parameters:

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 from fracid.store import decode_record, encode_record
 
-__all__ = ["BatchStats", "SerialExecutor", "make_executor", "run_batch"]
+__all__ = ["BatchStats", "SerialExecutor", "executor_session", "make_executor", "run_batch"]
 
 THREAD_VARIABLES = (
     "OPENBLAS_NUM_THREADS",
@@ -121,7 +121,48 @@ def make_executor(workers=None, scheduler: str | None = None):
     n = available_cores() if workers is None else _check_workers(workers)
     if n == 1:
         return SerialExecutor()
-    return cf.ProcessPoolExecutor(max_workers=n, mp_context=_SingleThreadSpawnContext(), initializer=limit_threads)
+    return cf.ProcessPoolExecutor(max_workers=n, mp_context=_SingleThreadSpawnContext(), initializer=_init_worker)
+
+
+@contextlib.contextmanager
+def executor_session(workers=None, scheduler: str | None = None):
+    """:func:`make_executor` as a context that stops at once when interrupted.
+
+    A process pool used as a plain context manager waits for its running tasks at exit, so Ctrl-C
+    would wait for every forward run in flight (minutes on a fine mesh). Here an exception (Ctrl-C
+    included) terminates the workers at once: the runs in flight are lost, those finished are already
+    stored. Workers ignore SIGINT (the terminal sends it to the whole process group) and leave the
+    decision to the parent. A dask client is closed, never its cluster.
+    """
+    executor = make_executor(workers, scheduler)
+    try:
+        yield executor
+    except BaseException:
+        _stop_now(executor)
+        raise
+    _close(executor, wait=True)
+
+
+def _stop_now(executor) -> None:
+    if isinstance(executor, cf.ProcessPoolExecutor):
+        for process in list((getattr(executor, "_processes", None) or {}).values()):
+            process.terminate()
+    _close(executor, wait=False)
+
+
+def _close(executor, wait: bool) -> None:
+    if _is_dask(executor):
+        executor.close()
+    else:
+        executor.shutdown(wait=wait, cancel_futures=not wait)
+
+
+def _init_worker() -> None:
+    """Pool initializer: one BLAS thread, and SIGINT ignored (the parent stops the workers)."""
+    import signal
+
+    limit_threads()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def available_cores() -> int:

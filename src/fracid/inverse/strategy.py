@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -11,6 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.kalman import GaussianEstimate, kalman_filter
+
+#: RMS fit error [% of the measured peak] above which a fit is reported as poor
+POOR_FIT_PERCENT = 10.0
 from fracid.inverse.knn import ParameterSpace, knn_search
 from fracid.inverse.runs import StoredOperator
 from fracid.parallel import BatchStats
@@ -62,6 +66,28 @@ class IdentificationResult(GaussianEstimate):
         scale = np.max(np.abs(self.y_exp)) if self.y_exp.size else 0.0
         rms = np.sqrt(np.mean((self.y_fit - self.y_exp) ** 2))
         return float(100 * rms / scale) if scale > 0 else float("nan")
+
+    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT) -> list[str]:
+        """What a user must know before trusting the result: a non-finite or poor fit, estimates at a
+        bound, a filter that did not converge or stopped, failed forward runs."""
+        out = []
+        rms = self.rms_percent
+        if not np.all(np.isfinite(self.x)) or not math.isfinite(rms):
+            out.append("the result is not finite: no forward run succeeded at the estimate")
+        elif rms > poor_fit_percent:
+            out.append(f"the fit is poor: RMS error {rms:.3g} % of the measured peak (above {poor_fit_percent:g} %). "
+                       "Check the data's units (force_unit, control_unit) and sign, the bounds and the model")
+        if self.at_bound:
+            where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.names, self.x) if n in self.at_bound)
+            out.append(f"estimate at a bound of [identify.bounds]: {where}; the data pull it outside the bounds "
+                       "(widen them if that is physical); its std is the curvature there, not a spread")
+        if self.status and not self.converged:
+            out.append(f"Kalman filter {self.status}")
+        failed = {k: self.runs.get(k, 0) for k in ("knn_failed", "kalman_failed")}
+        if any(failed.values()):
+            out.append(f"failed forward runs: {failed['knn_failed']} of {self.runs.get('knn', 0)} KNN, "
+                       f"{failed['kalman_failed']} in the Kalman stage (recorded; see report.html)")
+        return out
 
     def summary(self) -> str:
         units = self.units

@@ -47,7 +47,10 @@ window.addEventListener("load", function () {
 _RUN_LABELS = {
     "knn": "KNN forward runs (population)",
     "knn_failed": "KNN failed runs",
+    "knn_computed": "KNN runs computed (the others loaded from the store)",
     "kalman": "Kalman filter forward runs",
+    "kalman_failed": "Kalman filter failed runs",
+    "kalman_computed": "Kalman runs computed (the others loaded from the store)",
     "kalman_run_equivalents": "Kalman filter run equivalents (full curves)",
     "kalman_iterations": "Kalman filter global iterations",
     "wall_seconds": "wall time",
