@@ -1,0 +1,143 @@
+"""Every run of an identification is stored: the Kalman stage resumes after a kill, reruns compute nothing,
+run keys change with the forward code, failed runs are retried on request."""
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import fracid
+from fracid.inverse import runs as runs_module
+from fracid.inverse.forward_operator import ForwardOperator, Observation
+from fracid.inverse.runs import StoredOperator, run_key
+from fracid.store import RunStore
+
+N_KNN = 8
+CONFIG = f"""
+[model.parameters]
+c = 1.0
+beta = 300.0
+
+[specimen]
+type = "bar"
+n_elements = 120
+
+[[experiments]]
+file = "bar.csv"
+control_column = "u_mm"
+control_unit = "mm"
+force_unit = "N"
+kind = "single"
+force_columns = ["F_N"]
+std = 0.02
+n_points = 12
+control_range = [0.004, 0.03]
+
+[identify]
+parameters = ["c", "beta"]
+[identify.bounds]
+c = [1.0, 4.0]
+beta = [100.0, 500.0]
+[identify.knn]
+n = {N_KNN}
+k = 3
+[identify.kalman]
+groups = 3
+max_iterations = 4
+"""
+
+
+@pytest.fixture()
+def bar_config(tmp_path):
+    run = fracid.simulate(fracid.BarWithWeakZone(n_elements=120), fracid.DamageParameters(c=2.0, beta=250.0),
+                          target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))
+    np.savetxt(tmp_path / "bar.csv", np.column_stack([run.control, run.force]), delimiter=",", header="u_mm,F_N",
+               comments="")
+    (tmp_path / "bar.toml").write_text(CONFIG)
+    return tmp_path / "bar.toml"
+
+
+def identify(config, out, **popen):
+    command = [sys.executable, "-m", "fracid", "identify", str(config), "--out", str(out), "--workers", "1", "--quiet"]
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+
+
+def stored_rows(path):
+    try:
+        with RunStore(path, readonly=True) as store:
+            return len(store)
+    except (sqlite3.DatabaseError, FileNotFoundError):
+        return 0
+
+
+def finished(config, out):
+    process = identify(config, out)
+    stdout, stderr = process.communicate(timeout=600)
+    assert process.returncode == 0 and "Traceback" not in stderr, stderr
+    return json.loads((out / "result.json").read_text())
+
+
+def test_identification_killed_in_its_kalman_stage_resumes(bar_config, tmp_path):
+    out = tmp_path / "killed"
+    store = out / "runs.sqlite"
+    child = identify(bar_config, out, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and child.poll() is None and stored_rows(store) < N_KNN + 6:
+            time.sleep(0.02)
+        assert child.poll() is None, f"finished or died before the kill: {child.stderr.read()}"
+        os.killpg(child.pid, signal.SIGKILL)  # in the Kalman stage: the population (8) and 6 Kalman runs stored
+    finally:
+        child.communicate()
+    before = stored_rows(store)
+    assert before >= N_KNN + 6 and not (out / "result.json").exists()
+
+    resumed = finished(bar_config, out)
+    runs = resumed["runs"]
+    # nothing stored is recomputed: every stored Kalman run is reused, every computed one is new
+    assert runs["knn_computed"] == 0 and runs["kalman_reused"] == before - N_KNN
+    assert stored_rows(store) - before == runs["kalman_computed"] > 0
+
+    again = finished(bar_config, out)  # a finished identification run again recomputes nothing
+    assert again["runs"]["knn_computed"] == 0 and again["runs"]["kalman_computed"] == 0
+    assert again["runs"]["kalman"] == resumed["runs"]["kalman"] > 0
+
+    fresh = finished(bar_config, tmp_path / "fresh")  # uninterrupted
+    np.testing.assert_allclose(resumed["x"], fresh["x"], rtol=1e-10)
+    np.testing.assert_allclose(again["x"], fresh["x"], rtol=1e-10)
+
+
+def test_run_keys_change_with_the_forward_code_and_the_outputs_needed(monkeypatch):
+    bar = fracid.BarWithWeakZone(n_elements=40)
+    op = ForwardOperator([Observation(bar, np.linspace(0.004, 0.03, 6))], fracid.DamageParameters(), ("c",))
+    x = np.array([2.0])
+    key = run_key(op, x)
+    assert run_key(op, x, needed=3) != key and run_key(op, x, needed=6) == key  # all 6 outputs: the full run
+    assert runs_module.code_version().startswith(fracid.__version__ + "+")
+    monkeypatch.setattr(runs_module, "code_version", lambda: "0.0.0+edited")
+    assert run_key(op, x) != key
+
+
+def test_stored_operator_reuses_runs_and_retries_failed_ones_on_request(tmp_path):
+    bar = fracid.BarWithWeakZone(n_elements=40)
+    op = ForwardOperator([Observation(bar, np.linspace(0.004, 0.03, 6))], fracid.DamageParameters(), ("c", "kappa_i"))
+    good, bad = np.array([2.0, 1e-4]), np.array([2.0, -1.0])  # kappa_i < 0: a failed run
+    with RunStore(tmp_path / "runs.sqlite") as store:
+        first = StoredOperator(op, store)
+        records = first.evaluate_many([good, bad, good])
+        assert [r.ok for r in records] == [True, False, True] and first.computed == 2 and first.failed == 1
+        second = StoredOperator(op, store)
+        again = second.evaluate_many([good, bad])
+        assert second.computed == 0 and second.reused == 2
+        np.testing.assert_array_equal(again[0].y, records[0].y)
+        retry = StoredOperator(op, store, retry_failed=True)
+        retry.evaluate_many([good, bad])
+        assert retry.computed == 1 and retry.reused == 1  # the failed run only
+        partial = second(good, 3)
+        assert second.computed == 1 and np.all(np.isnan(partial.y[3:])) and np.isfinite(partial.y[:3]).all()
