@@ -113,7 +113,9 @@ def _verdict_section(study) -> str:
     table = _table(["parameter", "verdict", "estimate", "std", "std/|x|", "most correlated with", "prior variance removed",
                     "remarks"], rows, text_columns=(0, 1, 5, 7))
     text = "<pre>" + _e(study.verdict.text(units)) + "</pre>"
-    return table + text
+    runs = f"<p>{_e(study.runs_text())}</p>" if getattr(study, "runs", None) else ""
+    notes = "".join(f"<li>{_e(n)}</li>" for n in getattr(study, "notes", ()))
+    return table + text + runs + (f'<ul class="notes">{notes}</ul>' if notes else "")
 
 
 def study_sections(study, figures: dict) -> list:
