@@ -60,7 +60,7 @@ def _readonly_vector(values, what: str) -> np.ndarray:
         raise DataError(f"{what} must be one-dimensional, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         bad = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise DataError(f"{what} holds a non-finite value ({array[bad]!r}) at index {bad}")
+        raise DataError(f"{what} holds a non-finite value ({float(array[bad]):g}) at index {bad}")
     array.setflags(write=False)
     return array
 
@@ -106,7 +106,7 @@ class Curve:
             i = int(np.flatnonzero(steps <= 0.0)[0])
             raise DataError(
                 f"curve {self.source!r}: control must increase strictly, but value {i + 1} "
-                f"({control[i + 1]!r} mm) does not exceed value {i} ({control[i]!r} mm); "
+                f"({float(control[i + 1]):.6g} mm) does not exceed value {i} ({float(control[i]):.6g} mm); "
                 "curve_from_arrays() applies the documented backtracking rule"
             )
         notes = tuple(str(note) for note in self.notes)
@@ -153,8 +153,8 @@ def _monotonic_mask(
         i = int(too_far[0])
         j = int(np.argmax(control[:i]))
         raise DataError(
-            f"{where}: control goes backwards at {unit_label} {rows[i]}: {control[i]!r} mm is "
-            f"{backtrack[i]:.6g} mm below the maximum {control[j]!r} mm reached at {unit_label} {rows[j]}, "
+            f"{where}: control goes backwards at {unit_label} {rows[i]}: {float(control[i]):.6g} mm is "
+            f"{backtrack[i]:.6g} mm below the maximum {float(control[j]):.6g} mm reached at {unit_label} {rows[j]}, "
             f"more than the noise tolerance {tolerance:.6g} mm (backtrack_tolerance: the key of "
             "[[experiments]] in a configuration, in its control_unit, or the argument of read_curve_csv "
             "in mm; default 1 % of the control range); unloading branches or spliced series must be cut "
