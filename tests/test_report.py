@@ -241,3 +241,19 @@ def test_images_load_in_a_browser(report, tmp_path):
     assert loaded and total, f"the load script did not run: {body.group(0)}"
     assert int(total.group(1)) == 5
     assert int(loaded.group(1)) == int(total.group(1))
+
+
+def test_warnings_head_the_report_poor_fit_bound_and_failed_runs(tmp_path):
+    from dataclasses import replace
+
+    result = make_result()
+    poor = replace(result, y_fit=result.y_exp * 0.5, at_bound=["beta"], status="not converged: 10 global iterations "
+                   "reached, the last moved the estimate by 0.3 std", converged=False,
+                   runs={**result.runs, "kalman_failed": 2})
+    text = "\n".join(poor.warnings())
+    assert "fit is poor" in text and f"{poor.rms_percent:.3g} %" in text and "beta = " in text
+    assert "not converged" in text and "2 in the Kalman stage" in text and "1 of 20 KNN" in text
+    html = write_report(tmp_path / "r.html", poor, control=CONTROL).read_text(encoding="utf-8")
+    assert html.count('<span class="warn">warning</span>') == 4 and "beta (at a bound)" in html
+    assert make_result().warnings() == ["failed forward runs: 1 of 20 KNN, 0 in the Kalman stage (recorded; see "
+                                        "report.html)"]

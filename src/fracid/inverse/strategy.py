@@ -63,8 +63,9 @@ class IdentificationResult(GaussianEstimate):
     @property
     def rms_percent(self) -> float:
         """RMS of (measured - computed) in per cent of the largest |measured| value (NaN if not computed)."""
-        scale = np.max(np.abs(self.y_exp)) if self.y_exp.size else 0.0
-        rms = np.sqrt(np.mean((self.y_fit - self.y_exp) ** 2))
+        y_exp, y_fit = np.asarray(self.y_exp, float), np.asarray(self.y_fit, float)
+        scale = np.max(np.abs(y_exp)) if y_exp.size else 0.0
+        rms = np.sqrt(np.mean((y_fit - y_exp) ** 2))
         return float(100 * rms / scale) if scale > 0 else float("nan")
 
     def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT) -> list[str]:
@@ -72,7 +73,7 @@ class IdentificationResult(GaussianEstimate):
         bound, a filter that did not converge or stopped, failed forward runs."""
         out = []
         rms = self.rms_percent
-        if not np.all(np.isfinite(self.x)) or not math.isfinite(rms):
+        if not np.all(np.isfinite(np.asarray(self.x, float))) or not math.isfinite(rms):
             out.append("the result is not finite: no forward run succeeded at the estimate")
         elif rms > poor_fit_percent:
             out.append(f"the fit is poor: RMS error {rms:.3g} % of the measured peak (above {poor_fit_percent:g} %). "
@@ -83,7 +84,7 @@ class IdentificationResult(GaussianEstimate):
                        "(widen them if that is physical); its std is the curvature there, not a spread")
         if self.status and not self.converged:
             out.append(f"Kalman filter {self.status}")
-        failed = {k: self.runs.get(k, 0) for k in ("knn_failed", "kalman_failed")}
+        failed = {k: (self.runs or {}).get(k, 0) for k in ("knn_failed", "kalman_failed")}
         if any(failed.values()):
             out.append(f"failed forward runs: {failed['knn_failed']} of {self.runs.get('knn', 0)} KNN, "
                        f"{failed['kalman_failed']} in the Kalman stage (recorded; see report.html)")

@@ -163,15 +163,21 @@ def _parameter_section(result) -> str:
     x = np.asarray(result.x, float)
     std = np.asarray(result.std, float)
     rows = []
+    at_bound = set(getattr(result, "at_bound", None) or ())
     for name, v, s in zip(result.names, x, std):
         rel = f"{100.0 * s / abs(v):.3g}" if v != 0 and math.isfinite(v) and math.isfinite(s) else "n/a"
-        rows.append([name, _num(v), _num(s, 4), units.get(name, ""), rel])
+        shown = f"{name} (at a bound)" if name in at_bound else name
+        rows.append([shown, _num(v), _num(s, 4), units.get(name, ""), rel])
     table = _table(["parameter", "value", "std", "unit", "std / value [%]"], rows, text_columns=(0, 3))
-    status = ("converged" if result.converged
-              else '<span class="warn">not converged</span> (the last global iteration still moved the estimate)')
+    text = getattr(result, "status", "") or ("converged" if result.converged else "not converged")
+    status = _e(text) if result.converged else f'<span class="warn">{_e(text)}</span>'
+    warnings = result.warnings() if hasattr(result, "warnings") else []
+    shown = "".join(f'<li><span class="warn">warning</span>: {_e(w)}</li>' for w in warnings)
+    rms = getattr(result, "rms_percent", float("nan"))
     return (f"<h2>Identified parameters</h2>\n{table}\n"
-            f"<p>Kalman filter: {status}. Standard deviations are the square roots of the diagonal of the "
-            "posterior covariance C.</p>")
+            f"<p>Kalman filter: {status}. Fit: RMS error {_num(rms, 3)} % of the measured peak. Standard "
+            "deviations are the square roots of the diagonal of the posterior covariance C.</p>"
+            + (f'\n<ul class="notes">{shown}</ul>' if shown else ""))
 
 
 def _correlation_section(result, figures) -> str:
