@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -262,7 +263,9 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         mark = (evaluate.computed + evaluate.reused, evaluate.failed)
         if len(points) > 1:
             try:
-                ms = multi_start(evaluate, y, C, points, C_bounds, bounds=bounds, executor=executor, **kalman)
+                with stage_bar(progress, len(points), "multi-start filters") as tick:
+                    ms = multi_start(evaluate, y, C, points, C_bounds, bounds=bounds, executor=executor,
+                                     progress=tick, **kalman)
             except ForwardRunError as err:
                 notes.append(f"multi-start check skipped: {err}")
             if ms is not None and ms.failed:
@@ -272,8 +275,9 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     if replicates:
         log(f"stability check: {replicates} noisy replicates")
         mark = (evaluate.computed + evaluate.reused, evaluate.failed)
-        st = stability_check(evaluate, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
-                             executor=executor, **kalman)
+        with stage_bar(progress, replicates, "noisy replicates") as tick:
+            st = stability_check(evaluate, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
+                                 executor=executor, progress=tick, **kalman)
         failed_replicates = sum(bool(e) for e in st.errors)
         if failed_replicates:
             notes.append(f"stability: {failed_replicates} of {replicates} replicates failed")
@@ -290,6 +294,15 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
                                  tolerance=tolerance, multi_start=ms, stability=st)
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes)
+
+
+@contextmanager
+def stage_bar(progress, total, description):
+    """A progress bar over the filters of a study stage; yields its ``progress(done, total)`` callable."""
+    from fracid.progress import batch_progress, progress_bar
+
+    with progress_bar(total, description, progress, unit="filter") as bar:
+        yield batch_progress(bar)
 
 
 def _named_groups(name, data):

@@ -134,7 +134,8 @@ class MultiStart:
         return self.distance <= tolerance
 
 
-def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=None, **kalman) -> MultiStart:
+def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=None, progress=None,
+                **kalman) -> MultiStart:
     """Run the Kalman filter from every starting point with the prior covariance C0.
 
     Parameters
@@ -144,6 +145,8 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
     C0 : ndarray, shape (p, p)
         Prior covariance of every start (wide, e.g. from the bounds: a tight prior would pin each
         end to its start).
+    progress : callable(done, total), optional
+        Called after each filter.
     kalman
         Settings of :func:`~fracid.inverse.kalman.kalman_filter` (groups, max_iterations, ...).
     """
@@ -156,6 +159,8 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
             failed.append(f"start {x.tolist()}: {result.status}")
         else:
             results.append(result)
+        if progress is not None:
+            progress(len(results) + len(failed), len(starts))
     if not results:
         raise ForwardRunError("the Kalman filter failed from every starting point: " + "; ".join(failed))
     ends = np.array([r.x for r in results])
