@@ -638,6 +638,23 @@ def test_negated_or_zero_forces_are_refused(tmp_path, forces, words):
         assert word in message
 
 
+def test_control_in_the_wrong_unit_is_refused(tmp_path):
+    """The Gregoire CMOD (mm) declared in um would be fine; the same values scaled by 1000 as if um were mm
+    reach 200 mm of CMOD, far past any failure of the beam: refused naming control_unit."""
+    raw = np.genfromtxt(gregoire2013_beam4_path(), delimiter=",", names=True)
+    rows = "".join(f"{1000 * c},{f},{lo},{hi}\n" for c, f, lo, hi in
+                   zip(raw["cmod_mm"], raw["load_mean_N"], raw["load_min_N"], raw["load_max_N"]))
+    path = write(tmp_path, BEAM)
+    (tmp_path / "load_cmod.csv").write_text("cmod_mm,load_mean_N,load_min_N,load_max_N\n" + rows)
+    with pytest.raises(ConfigError) as info:
+        build_data(load_config(path))
+    message = str(info.value)
+    for word in ("experiments[0].control_unit = 'mm'", "reach 2", "check control_unit", "1000 times too large"):
+        assert word in message
+    path.write_text(BEAM.replace('control_unit = "mm"', 'control_unit = "um"'))  # the right unit: accepted
+    assert build_data(load_config(path)).control.max() == pytest.approx(raw["cmod_mm"].max(), rel=0.05)
+
+
 def test_warnings(tmp_path):
     assert load_config(CONFIGS / "beam_identify.toml").warnings == ()  # h_fine = 1 mm, c >= 1 mm^2: l >= 1.41 mm
     text = variant("std = 10.0", "relative_std = 5", SINGLE)

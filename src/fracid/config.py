@@ -1213,7 +1213,39 @@ def _stacked_data(cfg: Config, experiments):
             blocks.append(block.weighted({exp.name: exp.weight}) if exp.weight != 1.0 else block)
         except DataError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
+        _check_control_scale(cfg, exp, float(np.max(block.control)))
     return blocks[0] if len(blocks) == 1 else stack(*blocks)
+
+
+#: Data whose control values go further than this many times the specimen's default target (a point
+#: well past the peak for the configured parameters, the identified ones at their upper bounds) are
+#: refused: the control is almost surely in another unit (um declared as mm gives 1000 times), and
+#: every forward run would trace a far too long path (a bar identification took minutes to fail).
+CONTROL_SCALE_LIMIT = 30.0
+
+
+def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> None:
+    specimen = build_specimen(cfg, exp)
+    if not hasattr(specimen, "default_target"):
+        return
+    params = build_parameters(cfg)
+    candidates = [params]
+    if cfg.identify is not None:
+        for name, upper in zip(cfg.identify.parameters, cfg.identify.upper):
+            try:
+                candidates.append(params.replace(**{name: upper}))
+            except ValueError:
+                continue
+    try:
+        target = max(float(specimen.default_target(p)) for p in candidates)
+    except (AttributeError, ValueError, TypeError):
+        return
+    if target > 0 and reach > CONTROL_SCALE_LIMIT * target:
+        raise ConfigError(
+            f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of "
+            f"{exp.file} reach {reach:.6g} mm, {reach / target:.0f} times the {target:.3g} mm at which this "
+            f"specimen has long failed with these parameters; check control_unit (values in um declared as mm "
+            f"are 1000 times too large) and control_range")
 
 
 def build_experiment_data(cfg: Config, experiment: ExperimentConfig):
