@@ -232,8 +232,8 @@ def kalman_filter(
         Bayesian maximum a posteriori estimate; for a linear h every pass gives the closed-form
         posterior, and its sensitivities come from one set of full runs per pass. The passes are
         damped Gauss-Newton steps: a new linearisation point whose objective
-        (y - h)^T C_exp^-1 (y - h) + (x - x0)^T C0^-1 (x - x0) is higher than the last one's is
-        moved halfway back, up to ``max_backtracks`` times.
+        (y - h)^T C_exp^-1 (y - h) + (x - x0)^T C0^-1 (x - x0) is higher than the last one's (by more than
+        :data:`OBJECTIVE_SLACK`) is moved halfway back, up to ``max_backtracks`` times.
     ``restart="prior-mean"``
         The thesis's wording: the last estimate becomes the new prior mean (prior covariance C0),
         linearising at the running estimate. It re-uses the data in every pass, so the covariance
@@ -340,10 +340,15 @@ def _map_objective(y_exp, C_exp, x0, C0):
     return f
 
 
+#: Rise of the objective (in chi^2 units) a damped step may bring and still be taken: far below the
+#: one-std level (1), and above the noise that adaptive load steps put in the computed curve.
+OBJECTIVE_SLACK = 0.1
+
+
 def _decreases(objective, anchor, y_anchor):
-    """Accept a point whose objective is not above the anchor's (a relative 1e-9 for round-off)."""
+    """Accept a point whose objective is not above the anchor's (within :data:`OBJECTIVE_SLACK`)."""
     reference = objective(anchor, y_anchor)
-    return lambda x, y: np.all(np.isfinite(y)) and objective(x, y) <= reference * (1 + 1e-9) + 1e-12
+    return lambda x, y: bool(np.all(np.isfinite(y))) and objective(x, y) <= reference + OBJECTIVE_SLACK
 
 
 def _finish(result, lin, lower, upper, stopped, max_iterations, moved):
