@@ -107,6 +107,25 @@ def _progress(args):
     return False if args.quiet else None
 
 
+@contextlib.contextmanager
+def _executor(args):
+    """The executor of --workers / --scheduler; an unusable option is named (exit 2)."""
+    from fracid.exits import UsageError
+    from fracid.parallel import executor_session
+
+    if args.scheduler is not None and args.workers is not None:
+        raise UsageError(f"--workers {args.workers} and --scheduler {args.scheduler}: give one of them (the Dask "
+                         "cluster has its own workers)")
+    stack = contextlib.ExitStack()
+    try:
+        executor = stack.enter_context(executor_session(args.workers, args.scheduler))
+    except (ValueError, ImportError, OSError) as err:
+        raise UsageError(f"--scheduler {args.scheduler}: cannot use this Dask scheduler ({err}); give its address "
+                         "as tcp://host:port, with the dask extra installed (pip install 'fracid[dask]')") from None
+    with stack:
+        yield executor
+
+
 def run_simulate(args) -> int:
     from fracid.config import build_model, build_parameters, build_specimen, simulate_settings
     from fracid.progress import progress_bar
@@ -142,7 +161,6 @@ def run_simulate(args) -> int:
 def run_identify(args, config_path=None) -> int:
     from fracid.config import build_data, build_operator, build_space, identify_settings
     from fracid.inverse.strategy import identify_data
-    from fracid.parallel import executor_session
     from fracid.report.html import write_report
 
     cfg = _load(args, config_path or args.config, "identify")
@@ -151,7 +169,7 @@ def run_identify(args, config_path=None) -> int:
     out = _out_dir(args, cfg)
     _say(args, _stage_costs(settings, data.n_y, len(space.names)))
     start = time.perf_counter()
-    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
+    with _working_in(args, out, store=True) as store, _executor(args) as executor:
         result = identify_data(operator, data, space, executor=executor, store=store, progress=_progress(args),
                                retry_failed=args.retry_failed, **settings)
     result.runs["wall_seconds"] = time.perf_counter() - start
@@ -215,7 +233,12 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
     base = next(iter(specimens.values()), None) or build_specimen(cfg)
     size_field = "size" if hasattr(base, "size") else "depth" if hasattr(base, "depth") else "length"
     for D in sizes or ():
-        specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
+        try:
+            specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
+        except ValueError as err:
+            from fracid.exits import UsageError
+
+            raise UsageError(f"--sizes {D:g}: not a valid {type(base).__name__}.{size_field} ({err})") from None
     return compare_size_effect(params, specimens, measured, calibrated, model=build_model(cfg), executor=executor,
                                progress=False if quiet else None)
 
@@ -227,7 +250,6 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0}, "stability": {"sta
 def run_study_command(args) -> int:
     from fracid.config import build_data, build_held_out, build_operator, build_space, study_settings
     from fracid.inverse.study import run_study
-    from fracid.parallel import executor_session
     from fracid.report.study import write_study
 
     cfg = _load(args, args.config, "identify")
@@ -236,7 +258,7 @@ def run_study_command(args) -> int:
     settings = {**study_settings(cfg), **_STUDY_PARTS[args.command]}
     held_out = build_held_out(cfg) if args.command == "study" else []
     out = _out_dir(args, cfg)
-    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
+    with _working_in(args, out, store=True) as store, _executor(args) as executor:
         study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
                           progress=_progress(args), log=lambda text: _say(args, text),
                           retry_failed=args.retry_failed, **settings)
@@ -259,7 +281,6 @@ def run_sensitivity_command(args) -> int:
     from fracid.inverse.analyses import sensitivity_history
     from fracid.inverse.runs import StoredOperator
     from fracid.inverse.uniqueness import bounds_covariance
-    from fracid.parallel import executor_session
     from fracid.report.figures import sensitivity_figure, to_png
 
     cfg = _load(args, args.config, "identify")
@@ -268,7 +289,7 @@ def run_sensitivity_command(args) -> int:
     params = build_parameters(cfg)
     x = np.array([getattr(params, n) for n in space.names])
     out = _out_dir(args, cfg)
-    with _working_in(args, out, store=True) as store, executor_session(args.workers, args.scheduler) as executor:
+    with _working_in(args, out, store=True) as store, _executor(args) as executor:
         history = sensitivity_history(StoredOperator(operator, store, retry_failed=args.retry_failed), x,
                                       data.covariance, bounds_covariance(space), names=space.names,
                                       blocks=data.blocks, executor=executor)
@@ -285,12 +306,11 @@ def run_sensitivity_command(args) -> int:
 
 def run_size_effect_command(args) -> int:
     from fracid.config import build_parameters
-    from fracid.parallel import executor_session
     from fracid.report.figures import size_effect_figure, to_png
 
     cfg = _load(args, args.config, "simulate")
     out = _out_dir(args, cfg)
-    with _working_in(args, out), executor_session(args.workers, args.scheduler) as executor:
+    with _working_in(args, out), _executor(args) as executor:
         size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
     if size is None:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "

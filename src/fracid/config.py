@@ -566,7 +566,9 @@ class _Checker:
 def _read_toml(path: Path) -> dict:
     try:
         with open(path, "rb") as handle:
-            return tomllib.load(handle)
+            raw = handle.read()
+        # a byte-order mark (Windows Notepad) is not TOML but says nothing wrong about the file
+        return tomllib.loads(raw.removeprefix(b"\xef\xbb\xbf").decode("utf-8"))
     except FileNotFoundError:
         raise ConfigError(f"{path}: configuration file not found") from None
     except IsADirectoryError:
@@ -626,6 +628,15 @@ def _model(ck: _Checker, raw) -> ModelConfig:
     except ValueError as err:
         ck.fail("model.parameters", params, f"rejected together by {cls.__name__} (model.type = {kind!r}): {err}")
     return ModelConfig(type=kind, parameters=tuple(values.items()))
+
+
+def _check_model_runs_on(ck: _Checker, model: ModelConfig, specimen) -> None:
+    from fracid.models import runs_on
+
+    if not runs_on(_model_of(model.type), _specimen_class(specimen.type)):
+        fits = [kind for kind in _SPECIMENS if runs_on(_model_of(model.type), _specimen_class(kind))]
+        ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it; it runs on "
+                + (", ".join(repr(k) for k in fits) or "no built-in specimen"))
 
 
 def _field_kind(field: dataclasses.Field) -> str:
@@ -1089,6 +1100,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     base = path.parent
     model = _model(ck, raw.get("model"))
     specimen = _specimen(ck, raw.get("specimen"))
+    _check_model_runs_on(ck, model, specimen)
     experiments = _experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
     if experiments and not n_y and purpose == "identify":
@@ -1180,7 +1192,7 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
     return _specimen_class(cfg.specimen.type)(**options)
 
 
-def _experiment_data(exp: ExperimentConfig):
+def _experiment_data(cfg: Config, exp: ExperimentConfig):
     from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
 
     if exp.kind == "envelope":
@@ -1193,6 +1205,7 @@ def _experiment_data(exp: ExperimentConfig):
                             backtrack_tolerance=exp.backtrack_tolerance_mm)
     if exp.quantity == "force":
         require_positive_force(curves)
+    _check_control_scale(cfg, exp, max(float(np.max(curve.control)) for curve in curves))
     span = exp.control_range_mm
     if exp.kind == "repeats":
         return from_repeats(curves, exp.n_points, span, name=exp.name)
@@ -1209,18 +1222,18 @@ def _stacked_data(cfg: Config, experiments):
     blocks = []
     for exp in experiments:
         try:
-            block = _experiment_data(exp)
+            block = _experiment_data(cfg, exp)
             blocks.append(block.weighted({exp.name: exp.weight}) if exp.weight != 1.0 else block)
         except DataError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
-        _check_control_scale(cfg, exp, float(np.max(block.control)))
     return blocks[0] if len(blocks) == 1 else stack(*blocks)
 
 
 #: Data whose control values go further than this many times the specimen's default target (a point
-#: well past the peak for the configured parameters, the identified ones at their upper bounds) are
-#: refused: the control is almost surely in another unit (um declared as mm gives 1000 times), and
-#: every forward run would trace a far too long path (a bar identification took minutes to fail).
+#: well past the peak for the configured parameters, the identified ones at their upper bounds), or
+#: stop before 1/CONTROL_SCALE_LIMIT^2 of it (deep in the elastic range), are refused: the control is
+#: almost surely in another unit (um declared as mm gives 1000 times, m as mm 1/1000), and every
+#: forward run would trace a far too long path (a bar identification took minutes to fail).
 CONTROL_SCALE_LIMIT = 30.0
 
 
@@ -1240,12 +1253,17 @@ def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> No
         target = max(float(specimen.default_target(p)) for p in candidates)
     except (AttributeError, ValueError, TypeError):
         return
+    where = f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of {exp.file}"
     if target > 0 and reach > CONTROL_SCALE_LIMIT * target:
         raise ConfigError(
-            f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of "
-            f"{exp.file} reach {reach:.6g} mm, {reach / target:.0f} times the {target:.3g} mm at which this "
+            f"{where} reach {reach:.6g} mm, {reach / target:.0f} times the {target:.3g} mm at which this "
             f"specimen has long failed with these parameters; check control_unit (values in um declared as mm "
             f"are 1000 times too large) and control_range")
+    if target > 0 and reach < target / CONTROL_SCALE_LIMIT**2:
+        raise ConfigError(
+            f"{where} reach only {reach:.3g} mm, 1/{target / reach:.0f} of the {target:.3g} mm at which this "
+            f"specimen has long failed with these parameters, deep in its elastic range; check control_unit "
+            f"(values in m declared as mm are 1000 times too small)")
 
 
 def build_experiment_data(cfg: Config, experiment: ExperimentConfig):

@@ -27,6 +27,10 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, raised in the main thread so that the run ends as cleanly as after Ctrl-C."""
 
 
+class UsageError(ValueError):
+    """A command-line argument that cannot be used (the message names the option)."""
+
+
 class OutputInUse(OSError):
     """Another fracid process holds the lock of the output directory."""
 
@@ -47,7 +51,7 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     if isinstance(err, MemoryError):
         return MEMORY, ("out of memory. Use a coarser mesh (h_fine, n_elements), a smaller population "
                         "([identify.knn] n), fewer data points (n_points) or fewer workers (--workers).")
-    if isinstance(err, (ConfigError, DataError)):
+    if isinstance(err, (ConfigError, DataError, UsageError)):
         return INPUT, str(err)
     if isinstance(err, ConvergenceError):
         return FAILED, _convergence_text(err)
@@ -81,6 +85,8 @@ def _convergence_text(err) -> str:
 
 
 def _os_text(err: OSError, out) -> str:
+    if err.filename is None and err.errno is None:  # not about a file (e.g. a connection)
+        return f"{err}"
     name = err.filename or out or ""
     if err.errno == errno.ENOSPC:
         return f"the disk is full (writing {name}). Free some space and run again: finished runs are kept."

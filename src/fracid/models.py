@@ -32,6 +32,13 @@ class ForwardModel(Protocol):
     def simulate(self, specimen, params, **options): ...
 
 
+def runs_on(model, specimen) -> bool:
+    """Whether ``model`` can run on ``specimen`` (an instance or its class): the specimen offers the
+    builder the model names in ``specimen_builder`` (models without one run on every specimen)."""
+    builder = getattr(model, "specimen_builder", None)
+    return builder is None or hasattr(specimen, builder)
+
+
 @dataclass(frozen=True)
 class DamageModel:
     """Continuum damage with exponential softening (SPEC 1): ``"gradient"`` (implicit gradient
@@ -76,9 +83,10 @@ class CohesiveCrackModel(_HordijkModel):
 
     penalty_factor: float = 1000.0
     key: ClassVar[str] = "cohesive-crack-hordijk"
+    specimen_builder: ClassVar[str] = "build_cohesive_problem"
 
     def simulate(self, specimen, params, **options):
-        if not hasattr(specimen, "build_cohesive_problem"):
+        if not runs_on(self, specimen):
             raise TypeError(f"{type(specimen).__name__} has no cohesive crack (build_cohesive_problem)")
         problem = specimen.build_cohesive_problem(params, self.penalty_factor)
         observers = {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
@@ -95,9 +103,10 @@ class CrackBandModel(_HordijkModel):
     """
 
     key: ClassVar[str] = "crack-band-hordijk"
+    specimen_builder: ClassVar[str] = "build_crack_band_problem"
 
     def simulate(self, specimen, params, **options):
-        if not hasattr(specimen, "build_crack_band_problem"):
+        if not runs_on(self, specimen):
             raise TypeError(f"{type(specimen).__name__} has no crack band model (build_crack_band_problem)")
         return _follow(specimen.build_crack_band_problem(params), specimen, params, {}, **options)
 

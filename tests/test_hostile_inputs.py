@@ -1,0 +1,528 @@
+"""Hostile but realistic inputs, each run through the real ``fracid`` command (``python -m fracid``) as a
+subprocess in its own directory: the exit status of the contract (:mod:`fracid.exits`: 0 done, 1 a bug,
+2 bad input, 3 the computation failed, 4 files and storage, 130/143 interrupted), a few distinctive
+words of the message (paths of the case's directory removed first), and no traceback (except with
+``--debug``).
+
+Cost: most cases end while the configuration or the data are loaded (about 1.5 s each: the interpreter's
+start and the imports). All the cases of :data:`CASES` run in one batch, set up by the first of them,
+``FRACID_TEST_JOBS`` subprocesses at a time (default 2), the few that compute first; only the cases
+pytest selected run. The cases that compute use a 40-element bar, a KNN population of 8, 2 Kalman
+groups, 3 passes and ``--workers 1``. The subprocesses keep their bytecode in a cache under the temporary
+directory (``PYTHONPYCACHEPREFIX``), so that fracid is not compiled again in every one of them.
+``FRACID_TEST_TIMES=1`` (with ``pytest -s``) prints the wall time of every command.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pytest
+
+import fracid
+from fracid.lock import directory_lock
+
+FRACID = [sys.executable, "-m", "fracid"]
+JOBS = max(1, int(os.environ.get("FRACID_TEST_JOBS", "2")))
+IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
+_PYCACHE = Path(tempfile.gettempdir()) / f"fracid-test-pycache-{os.getuid() if hasattr(os, 'getuid') else 0}"
+#: one BLAS thread per forward run (the runs are tiny), and a shared bytecode cache outside the source tree
+ENV = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},
+       "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+       "PYTHONPYCACHEPREFIX": os.environ.get("PYTHONPYCACHEPREFIX", str(_PYCACHE))}
+TRUTH = (2.0, 250.0)  # (c, beta) of the synthetic measured curve
+
+
+# ------------------------------------------------------------------------------------ files
+
+
+@pytest.fixture(scope="module")
+def curve():
+    """Control [mm] and force [N] of the 40-element bar with (c, beta) = TRUTH, the synthetic test."""
+    run = fracid.simulate(fracid.BarWithWeakZone(n_elements=40), fracid.DamageParameters(c=TRUTH[0], beta=TRUTH[1]),
+                          target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))
+    return np.asarray(run.control, dtype=float), np.asarray(run.force, dtype=float)
+
+
+def _number(value: float, decimal: str) -> str:
+    text = f"{value:.9g}"
+    return text.replace(".", decimal) if decimal != "." else text
+
+
+def write_csv(path: Path, control, force, *, sep=",", decimal=".", bom=False) -> Path:
+    """The two-column data file "u_mm", "F_N" as a lab's software may write it (separator, decimal mark, BOM)."""
+    lines = [sep.join(("u_mm", "F_N"))]
+    lines += [sep.join((_number(c, decimal), _number(f, decimal))) for c, f in zip(control, force)]
+    path.write_text(("\ufeff" if bom else "") + "\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def write_rows(path: Path, rows) -> Path:
+    """A comma-separated data file from rows of cells (strings), the first row the header."""
+    path.write_text("\n".join(",".join(str(cell) for cell in row) for row in rows) + "\n", encoding="utf-8")
+    return path
+
+
+def _cells(curve, edit=None):
+    """Header and rows of the standard file as strings; ``edit(i, [c, f])`` may change row i."""
+    rows = [["u_mm", "F_N"]]
+    for i, (c, f) in enumerate(zip(*curve)):
+        row = [f"{c:.9g}", f"{f:.9g}"]
+        rows.append(edit(i, row) if edit else row)
+    return rows
+
+
+BAR = """\
+{top}
+[model]
+type = "{model}"
+[model.parameters]
+c = {c}
+beta = {beta}
+{params}
+
+[specimen]
+type = "bar"
+n_elements = {n_elements}
+{specimen}
+
+[[experiments]]
+file = "{file}"
+control_column = "u_mm"
+control_unit = "{control_unit}"
+force_unit = "{force_unit}"
+kind = "single"
+force_columns = ["F_N"]
+{std}
+n_points = {n_points}
+control_range = {control_range}
+{experiment}
+
+[identify]
+parameters = {parameters}
+{identify}
+[identify.bounds]
+{bounds}
+[identify.knn]
+n = {n}
+k = {k}
+{knn}
+[identify.kalman]
+groups = {groups}
+max_iterations = 3
+{kalman}
+
+[output]
+directory = "results"
+{tail}
+"""
+
+BAR_DEFAULTS = dict(top="", model="gradient-damage", c="1.0", beta="300.0", params="", n_elements="40", specimen="",
+                    file="bar.csv", control_unit="mm", force_unit="N", std="std = 0.02", n_points="12",
+                    control_range="[0.004, 0.03]", experiment="", parameters='["c", "beta"]', identify="",
+                    bounds="c = [0.5, 4.0]\nbeta = [100.0, 500.0]", n="8", k="3", knn="", groups="2", kalman="",
+                    tail="")
+
+
+def bar_config(*, drop=(), **changes) -> str:
+    """The tiny bar identification config, with template fields changed and lines whose key is in ``drop`` removed."""
+    unknown = set(changes) - set(BAR_DEFAULTS)
+    assert not unknown, unknown
+    text = BAR.format(**{**BAR_DEFAULTS, **changes})
+    return "\n".join(line for line in text.splitlines() if line.split("=")[0].strip() not in drop) + "\n"
+
+
+SIMULATE = """\
+[model.parameters]
+{params}
+
+[specimen]
+type = "bar"
+n_elements = 40
+{specimen}
+
+[simulate]
+{simulate}
+"""
+
+
+def simulate_config(params="", specimen="", simulate="") -> str:
+    return SIMULATE.format(params=params, specimen=specimen, simulate=simulate)
+
+
+# ------------------------------------------------------------------------------------ running
+
+
+def run_fracid(args, cwd, timeout=240) -> subprocess.CompletedProcess:
+    start = time.perf_counter()
+    proc = subprocess.run([*FRACID, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout,
+                          env=ENV)
+    proc.seconds = time.perf_counter() - start
+    if os.environ.get("FRACID_TEST_TIMES"):
+        print(f"TIME {proc.seconds:6.2f} s  {' '.join(map(str, args))}  ({cwd})", file=sys.__stderr__, flush=True)
+    return proc
+
+
+def _clean(text: str, directory: Path) -> str:
+    """Output with the case's directory written <dir>, so that words are never found in a path."""
+    for form in {str(directory.resolve()), str(directory)}:
+        text = text.replace(form, "<dir>")
+    return text
+
+
+def check(proc, directory: Path, status: int, words=(), *, traceback=False) -> str:
+    """Assert the exit status, the words of stderr (a tuple: any of them) and the absence (presence with
+    --debug) of a traceback; returns the cleaned stderr."""
+    out, err = _clean(proc.stdout, directory), _clean(proc.stderr, directory)
+    shown = f"exit status {proc.returncode}\n--- stdout:\n{out[-2500:]}\n--- stderr:\n{err[-4000:]}"
+    assert proc.returncode == status, shown
+    assert "Traceback" not in out, shown
+    assert ("Traceback" in err) == traceback, shown
+    for word in words:
+        alternatives = word if isinstance(word, tuple) else (word,)
+        assert any(w in err for w in alternatives), f"none of {alternatives} in stderr\n{shown}"
+    return err
+
+
+# ------------------------------------------------------------------------------------ cases
+
+
+@dataclass(frozen=True)
+class Case:
+    """``prepare(directory, curve)`` writes the files and returns the arguments after ``fracid``;
+    ``verify(proc, directory)``, when given, replaces the check of status and words."""
+
+    prepare: Callable
+    status: int | None
+    words: tuple = ()
+    lock: str | None = None  # hold the lock of this directory (relative) while the command runs
+    traceback: bool = False  # --debug: a traceback is expected
+    needs_user: bool = False  # file permissions do not bind root
+    slow: bool = False  # computes for a few seconds: started first
+    verify: Callable | None = None
+
+
+def _standard_csv(d, curve):
+    write_csv(d / "bar.csv", *curve)
+
+
+def case(status, words=(), *, config=None, csv=_standard_csv, args=("identify", "cfg.toml", "--quiet"), files=None,
+         **options) -> Case:
+    """A case on the tiny bar config (``config``: a text, or the template's changes as a dict) and a data file
+    (``csv(directory, curve)``); ``files(directory)`` adds or overwrites files."""
+    def prepare(d, curve):
+        if csv is not None:
+            csv(d, curve)
+        (d / "cfg.toml").write_text(config if isinstance(config, str) else bar_config(**(config or {})))
+        if files is not None:
+            files(d)
+        return list(args)
+
+    return Case(prepare, status, tuple(words), **options)
+
+
+def csv_case(status, words, edit=None, *, rows=None, **options) -> Case:
+    """A case whose data file is the standard one with rows edited (``edit(i, [control, force])``), or ``rows``."""
+    def csv(d, curve):
+        write_rows(d / "bar.csv", rows(curve) if rows else _cells(curve, edit))
+
+    return case(status, words, csv=csv, **options)
+
+
+def sim_case(status, words, **sections) -> Case:
+    """``fracid simulate`` of the 40-element bar with extra lines in [model.parameters], [specimen], [simulate]."""
+    return case(status, words, config=simulate_config(**sections), csv=None, args=("simulate", "cfg.toml", "--quiet"))
+
+
+def _config_bytes(data: bytes):
+    def files(d):
+        (d / "cfg.toml").write_bytes(data)
+    return files
+
+
+def _unloading(i, row):
+    """An unloading-reloading loop on the softening branch: the control goes back by 40 % of its range."""
+    return [f"{float(row[0]) - 0.013:.9g}", row[1]] if 60 <= i < 64 else row
+
+
+def _units_row(curve):
+    rows = _cells(curve)
+    return [rows[0], ["mm", "N"], *rows[1:]]
+
+
+def _out_is_file(d):
+    (d / "taken").write_text("a file where the output directory should be\n")
+
+
+def _corrupt_store(d):
+    (d / "out").mkdir()
+    (d / "out" / "runs.sqlite").write_bytes(b"\x00\x17garbage, not an SQLite database\xff" * 200)
+
+
+def _read_only_out(d):
+    (d / "out").mkdir()
+    (d / "out").chmod(0o555)
+
+
+def _out_dir(d):
+    (d / "out").mkdir()
+
+
+def _estimate_near_truth(proc, d):
+    check(proc, d, 0)
+    result = json.loads((d / "out" / "result.json").read_text())
+    x, std = np.array(result["x"]), np.array(result["std"])
+    assert np.all(np.abs(x - TRUTH) <= np.maximum(3 * std, 0.1 * np.array(TRUTH))), (x, std)
+
+
+def _scaled(control_factor, force_factor):
+    """The synthetic mm / N data scaled as if recorded in other units, still declared mm and N."""
+    def csv(d, curve):
+        write_csv(d / "bar.csv", curve[0] * control_factor, curve[1] * force_factor)
+    return case(None, csv=csv, args=IDENTIFY, slow=True, verify=_unit_contract)
+
+
+def _unit_contract(proc, d):
+    """Exit 0 with a "fit is poor" warning and an estimate inside the bounds, or exit 2 naming the likely
+    unit problem; never a traceback, never an internal error."""
+    err = _clean(proc.stderr, d)
+    assert proc.returncode in (0, 2), f"exit status {proc.returncode}\n{err}"
+    check(proc, d, proc.returncode)
+    if proc.returncode == 0:
+        assert "fit is poor" in err, err
+        x = np.array(json.loads((d / "out" / "result.json").read_text())["x"])
+        assert np.all((x >= [0.5, 100.0]) & (x <= [4.0, 500.0])), x
+    else:
+        assert "unit" in err.lower(), f"exit 2 without naming the units (control_unit, force_unit):\n{err}"
+
+
+OUT = ("--out", "out", "--workers", "1", "--quiet")
+IDENTIFY = ("identify", "cfg.toml", *OUT)
+REACHES_OUTPUT = ("--out", "taken", "--workers", "1", "--quiet")  # the data are built, then the output path fails
+
+CASES = {
+    # ---- the configuration file itself
+    "config-missing-file": case(2, ["configuration file not found"], args=("identify", "nope.toml")),
+    "config-is-a-directory": case(2, ["is a directory"], args=("identify", ".")),
+    "config-is-the-data-csv": case(2, ["not valid TOML"], args=("identify", "bar.csv")),
+    "config-utf8-bom-from-notepad": case(2, [("specimen.colour", "BOM", "byte order mark")], files=_config_bytes(
+        b"\xef\xbb\xbf" + b'[specimen]\ntype = "bar"\ncolour = "red"\n')),
+    "unknown-top-key": case(2, ["colour", "unknown key"], config={"top": 'colour = "red"'}),
+    # ---- keys and values
+    "unknown-nested-key-typo": case(2, ["experiments[0].force_colums", "unknown key"],
+                                    config={"experiment": 'force_colums = ["F_N"]'}),
+    "string-for-number": case(2, ["model.parameters.c", "must be a number"], config={"c": '"2.0"'}),
+    "negative-std": case(2, ["experiments[0].std", "> 0"], config={"std": "std = -0.02"}),
+    "nan-parameter": case(2, ["model.parameters.beta", "nan"], config={"beta": "nan"}),
+    "inf-target": sim_case(2, ["simulate.target", "inf"], simulate="target = inf"),
+    "missing-control_unit": case(2, ["experiments[0].control_unit is missing"], config={"drop": ("control_unit",)}),
+    "unknown-model-type": case(2, ["model.type", "'gradient'"], config={"model": "gradient"}),
+    "unknown-specimen-type": case(2, ["specimen.type", "'beam'"], config=bar_config().replace('"bar"', '"beam"')),
+    "unknown-control": case(2, ["specimen.control", "'cmod'"], config={"specimen": 'control = "cmod"'}),
+    # ---- [identify]
+    "bound-outside-valid-range": case(2, ["identify.bounds.beta", "valid range"],
+                                      config={"bounds": "c = [0.5, 4.0]\nbeta = [-10.0, 500.0]"}),
+    "lower-not-below-upper": case(2, ["identify.bounds.c", "below"],
+                                  config={"bounds": "c = [4.0, 0.5]\nbeta = [100.0, 500.0]"}),
+    "log-bound-zero": case(2, ["identify.bounds.log", "lower bound > 0"],
+                           config={"bounds": 'c = [0.5, 4.0]\nbeta = [0.0, 500.0]\nlog = ["beta"]'}),
+    "identify-unknown-parameter": case(2, ["identify.parameters", "'gamma'"], config={"parameters": '["c", "gamma"]'}),
+    # ---- limits: refused when the configuration is loaded
+    "knn-n-1e9": case(2, ["identify.knn.n", "limit", "GiB"], config={"n": "1_000_000_000"}),
+    "bar-n_elements-1e8": case(2, ["specimen.n_elements", "memory", "200,000"], config={"n_elements": "100_000_000"}),
+    "beam-h_fine-0.001": case(2, ["specimen.h_fine", "unknowns", "memory"], csv=None, args=("simulate", "cfg.toml"),
+                              config='[specimen]\ntype = "notched-beam"\nh_fine = 0.001\n'),
+    "n_points-50000": case(2, ["experiments[0].n_points", "covariance"], config={"n_points": "50000"}),
+    "groups-above-n_y": case(2, ["identify.kalman.groups", "n_y = 12"], config={"groups": "13"}),
+    "k-above-n": case(2, ["identify.knn.k", "population size 8"], config={"k": "9"}),
+    # ---- the data file
+    "data-missing-csv": case(2, ["experiments[0].file", "file not found"], csv=None),
+    "data-empty-csv": case(2, ["experiments[0].file", "empty"], csv=lambda d, c: (d / "bar.csv").write_text("")),
+    "data-header-only": case(2, ["0 data rows"], csv=lambda d, c: (d / "bar.csv").write_text("u_mm,F_N\n"), args=IDENTIFY),
+    "data-missing-column": csv_case(2, ["experiments[0].force_columns", "'F_N'", "'Force'"],
+                                    rows=lambda c: [["u_mm", "Force"], *_cells(c)[1:]]),
+    "data-units-row-below-header": csv_case(2, ["row 2", "'mm' is not a number"], rows=_units_row, args=IDENTIFY),
+    "data-nan-cell": csv_case(2, ["missing value", "'NaN'"], lambda i, row: [row[0], "NaN"] if i == 30 else row,
+                              args=IDENTIFY),
+    "data-semicolon-without-delimiter": case(2, ["delimiter", '";"'],
+                                             csv=lambda d, c: write_csv(d / "bar.csv", *c, sep=";", decimal=",")),
+    "data-decimal-comma-without-decimal": case(2, ["decimal", 'decimal = ","'], config={"experiment": 'delimiter = ";"'},
+                                               csv=lambda d, c: write_csv(d / "bar.csv", *c, sep=";", decimal=",")),
+    "data-negated-forces": case(2, ["negative", "negate"], csv=lambda d, c: write_csv(d / "bar.csv", c[0], -c[1]),
+                                args=IDENTIFY),
+    "data-all-zero-forces": case(2, ["all forces are zero"], csv=lambda d, c: write_csv(d / "bar.csv", c[0], 0 * c[1]),
+                                 args=IDENTIFY),
+    "data-unloading-loop": csv_case(2, ["goes backwards", "backtrack_tolerance"], _unloading, args=IDENTIFY),
+    "data-control_range-beyond-data": case(2, ["never extrapolated"], config={"control_range": "[0.004, 0.05]"},
+                                           args=IDENTIFY),
+    # ---- files that must be read: the data are built, then the output path (a file) ends the command
+    "reads-tab-separated": case(4, ["taken is a file"], csv=lambda d, c: write_csv(d / "bar.csv", *c, sep="\t"),
+                                config={"experiment": 'delimiter = "tab"'}, files=_out_is_file,
+                                args=("identify", "cfg.toml", *REACHES_OUTPUT)),
+    "reads-utf8-bom-header": case(4, ["taken is a file"], csv=lambda d, c: write_csv(d / "bar.csv", *c, bom=True),
+                                  files=_out_is_file, args=("identify", "cfg.toml", *REACHES_OUTPUT)),
+    # ---- output directory and run store
+    "demo-out-is-an-existing-file": case(4, ["taken is a file", "--out"], files=_out_is_file,
+                                         args=("demo", "--out", "taken", "--quiet")),
+    "out-read-only": case(4, ["permission denied", "--out"], files=_read_only_out, args=IDENTIFY, needs_user=True),
+    "store-corrupt": case(4, ["runs.sqlite", "move it away"], files=_corrupt_store, args=IDENTIFY),
+    "store-corrupt-debug-shows-traceback": case(4, ["runs.sqlite"], files=_corrupt_store, args=(*IDENTIFY, "--debug"),
+                                                traceback=True),
+    "out-locked-by-another-fracid": case(4, ["another fracid process", f"pid {os.getpid()}"], files=_out_dir,
+                                         args=IDENTIFY, lock="out"),
+    # ---- command line
+    "workers-zero": case(2, ["--workers = 0"], args=("identify", "cfg.toml", "--workers", "0")),
+    "unknown-subcommand": case(2, ["invalid choice", "'identfy'"], args=("identfy", "cfg.toml")),
+    "scheduler-not-an-address": case(2, ["--scheduler", "not-an-address"],
+                                     args=("identify", "cfg.toml", "--scheduler", "not-an-address", "--quiet")),
+    "scheduler-and-workers": case(2, ["--scheduler", "--workers"], args=(
+        "identify", "cfg.toml", "--workers", "1", "--scheduler", "tcp://127.0.0.1:9", "--quiet")),
+    "size-effect-negative-size": case(2, ["--sizes", "-100"], args=("size-effect", "cfg.toml", "--sizes", "-100",
+                                                                     "--out", "out", "--quiet")),
+    # ---- the computation fails
+    "simulate-snap-back-end-displacement": sim_case(3, ["did not converge", "weak_zone_elongation"],
+                                                    params="beta = 1000.0", specimen="length = 400.0"),
+    "simulate-c-1e12": sim_case(3, ["did not converge"], params="c = 1e12"),
+    "simulate-cohesive-crack-on-bar": case(2, ["cohesive", "bar"], csv=None, args=("simulate", "cfg.toml"), config=(
+        '[model]\ntype = "cohesive-crack"\n[specimen]\ntype = "bar"\nn_elements = 40\n')),
+    "identify-every-knn-run-fails": case(3, ["0 of 8 forward runs", "no convergence", "--retry-failed"], args=IDENTIFY,
+                                         config={"bounds": "c = [0.5, 1.0]\nbeta = [2000.0, 5000.0]"}, slow=True),
+    # ---- cases that compute and succeed
+    "semicolon-decimal-comma-identifies": case(
+        0, csv=lambda d, c: write_csv(d / "bar.csv", *c, sep=";", decimal=","), args=IDENTIFY, slow=True,
+        config={"experiment": 'delimiter = ";"\ndecimal = ","'}, verify=_estimate_near_truth),
+    "relative_std-5-warns": case(0, ["fracid: warning", "if you meant 5 %", "0.05"], config={"std": "relative_std = 5"},
+                                 args=("sensitivity", "cfg.toml", *OUT), slow=True),
+    "units-forces-in-kN-declared-N": _scaled(1.0, 1e-3),
+    "units-control-in-um-declared-mm": _scaled(1e3, 1.0),
+    "units-control-in-m-declared-mm": _scaled(1e-3, 1.0),
+}
+
+#: the cases whose output directory another test uses
+_SOURCE_OF = {"test_truncated_run_store": "semicolon-decimal-comma-identifies"}
+
+
+def _selected_cases(session) -> list[str]:
+    names = []
+    for item in session.items:
+        if getattr(item, "module", None) is None or item.module.__name__ != __name__:
+            continue
+        if item.originalname == "test_hostile_input":
+            names.append(item.callspec.params["name"])
+        elif item.originalname in _SOURCE_OF:
+            names.append(_SOURCE_OF[item.originalname])
+    names = [n for n in dict.fromkeys(names) if not (CASES[n].needs_user and IS_ROOT)]
+    return sorted(names, key=lambda n: not CASES[n].slow)
+
+
+@pytest.fixture(scope="module")
+def batch(request, curve, tmp_path_factory):
+    """Run every selected case, FRACID_TEST_JOBS at a time: name -> (completed process, or the exception
+    of its preparation, and the case's directory)."""
+    names = _selected_cases(request.session)
+    directories = {name: tmp_path_factory.mktemp("case") for name in names}  # here: mktemp is not thread-safe
+
+    def one(name):
+        spec, d = CASES[name], directories[name]
+        try:
+            args = spec.prepare(d, curve)
+            if spec.lock is None:
+                return run_fracid(args, d), d
+            with directory_lock(d / spec.lock):
+                return run_fracid(args, d), d
+        except Exception as err:  # noqa: BLE001 -- raised by the case's test
+            return err, d
+
+    with ThreadPoolExecutor(JOBS) as pool:
+        return dict(zip(names, pool.map(one, names)))
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, id=n, marks=pytest.mark.skipif(
+    CASES[n].needs_user and IS_ROOT, reason="root ignores file permissions")) for n in CASES])
+def test_hostile_input(name, batch):
+    proc, d = batch[name]
+    if isinstance(proc, BaseException):
+        raise proc
+    spec = CASES[name]
+    if spec.verify is not None:
+        spec.verify(proc, d)
+    else:
+        check(proc, d, spec.status, spec.words, traceback=spec.traceback)
+
+
+def test_truncated_run_store(batch, tmp_path):
+    """A real store (of the semicolon case) truncated to half its size, then the same command again."""
+    _, source = batch["semicolon-decimal-comma-identifies"]
+    work = tmp_path / "w"
+    shutil.copytree(source, work)
+    store = work / "out" / "runs.sqlite"
+    with open(store, "r+b") as handle:
+        handle.truncate(store.stat().st_size // 2)
+    check(run_fracid(IDENTIFY, work), work, 4, ["runs.sqlite", "move it away"])
+
+
+def _stored_runs(store: Path) -> int:
+    """Runs in a store another process is writing (0 while it is not readable yet)."""
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{store}?mode=ro", uri=True, timeout=1)) as conn:
+            return conn.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+    except sqlite3.Error:
+        return 0
+
+
+INTERRUPTED = ["interrupted", "run the same command again"]
+
+
+@pytest.mark.parametrize("sig, status, words, workers, group, when", [
+    pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", id="sigint"),
+    pytest.param(signal.SIGTERM, 143, ["terminated (SIGTERM)", "run the same command again"], "1", False, "stored",
+                 id="sigterm"),
+    pytest.param(signal.SIGINT, 130, INTERRUPTED, "2", True, "starting", id="ctrl-c-process-group-workers-starting"),
+])
+def test_signal_during_identify(sig, status, words, workers, group, when, curve, tmp_path):
+    """Ctrl-C or SIGTERM during the KNN stage (a population of 200 runs, longer than the wait), once a few runs
+    are stored, or (``when = "starting"``) just after the run store is opened, while the workers start.
+    ``group``: the signal goes to the whole process group, workers included, as Ctrl-C in a terminal does."""
+    write_csv(tmp_path / "bar.csv", *curve)
+    (tmp_path / "cfg.toml").write_text(bar_config(n="200"))
+    proc = subprocess.Popen([*FRACID, "identify", "cfg.toml", "--out", "out", "--workers", workers, "--quiet"],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
+                            start_new_session=group)
+    try:
+        store, start = tmp_path / "out" / "runs.sqlite", time.monotonic()
+        while time.monotonic() - start < 60 and proc.poll() is None:
+            if store.exists() and (when == "starting" or _stored_runs(store) >= 3):
+                break
+            time.sleep(0.05)
+        time.sleep(0.3)
+        assert proc.poll() is None, f"ended before the signal: {proc.returncode}\n{proc.communicate()}"
+        sent = time.monotonic()
+        if group:
+            os.killpg(proc.pid, sig)
+        else:
+            proc.send_signal(sig)
+        out, err = proc.communicate(timeout=15)
+        elapsed = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            if group:
+                os.killpg(proc.pid, signal.SIGKILL)
+            else:
+                proc.kill()
+            proc.communicate()
+    check(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), tmp_path, status, words)
+    assert elapsed < 15
