@@ -10,56 +10,17 @@ import numpy as np
 import pytest
 
 import fracid
+from _bar_study import write_bar_study
 from fracid import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = Path(__file__).with_name("configs")
 
-BAR_IDENTIFY = """
-[model.parameters]
-c = 1.0
-beta = 300.0
-
-[specimen]
-type = "bar"
-n_elements = 60
-
-[[experiments]]
-file = "bar.csv"
-control_column = "u_mm"
-control_unit = "mm"
-force_unit = "N"
-kind = "single"
-force_columns = ["F_N"]
-std = 0.02
-n_points = 12
-control_range = [0.004, 0.03]
-
-[identify]
-parameters = ["c", "beta"]
-[identify.bounds]
-c = [0.5, 4.0]
-beta = [100.0, 500.0]
-[identify.knn]
-n = 16
-k = 4
-[identify.kalman]
-groups = 3
-
-[output]
-directory = "results"
-"""
-
 
 @pytest.fixture()
 def bar_study(tmp_path):
     """Synthetic measured curve of the bar with (c, beta) = (2, 250), and the identification config."""
-    run = fracid.simulate(fracid.BarWithWeakZone(n_elements=60), fracid.DamageParameters(c=2.0, beta=250.0),
-                          target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))
-    np.savetxt(tmp_path / "bar.csv", np.column_stack([run.control, run.force]), delimiter=",", header="u_mm,F_N",
-               comments="")
-    (tmp_path / "study.toml").write_text(BAR_IDENTIFY)
-    return tmp_path / "study.toml"
+    return write_bar_study(tmp_path)
 
 
 def test_simulate_writes_curve_plot_and_vtk(tmp_path):

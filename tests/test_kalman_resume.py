@@ -4,13 +4,13 @@ run keys change with the forward code, failed runs are retried on request."""
 import json
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 
 import numpy as np
 import pytest
+from _bar_study import stored_rows, write_bar_study
 
 import fracid
 from fracid.inverse import runs as runs_module
@@ -19,61 +19,16 @@ from fracid.inverse.runs import StoredOperator, run_key
 from fracid.store import RunStore
 
 N_KNN = 8
-CONFIG = f"""
-[model.parameters]
-c = 1.0
-beta = 300.0
-
-[specimen]
-type = "bar"
-n_elements = 120
-
-[[experiments]]
-file = "bar.csv"
-control_column = "u_mm"
-control_unit = "mm"
-force_unit = "N"
-kind = "single"
-force_columns = ["F_N"]
-std = 0.02
-n_points = 12
-control_range = [0.004, 0.03]
-
-[identify]
-parameters = ["c", "beta"]
-[identify.bounds]
-c = [1.0, 4.0]
-beta = [100.0, 500.0]
-[identify.knn]
-n = {N_KNN}
-k = 3
-[identify.kalman]
-groups = 3
-max_iterations = 4
-"""
 
 
 @pytest.fixture()
 def bar_config(tmp_path):
-    run = fracid.simulate(fracid.BarWithWeakZone(n_elements=120), fracid.DamageParameters(c=2.0, beta=250.0),
-                          target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))
-    np.savetxt(tmp_path / "bar.csv", np.column_stack([run.control, run.force]), delimiter=",", header="u_mm,F_N",
-               comments="")
-    (tmp_path / "bar.toml").write_text(CONFIG)
-    return tmp_path / "bar.toml"
+    return write_bar_study(tmp_path, n_elements=120, n=N_KNN, k=3, c_lower=1.0, kalman="max_iterations = 4")
 
 
 def identify(config, out, **popen):
     command = [sys.executable, "-m", "fracid", "identify", str(config), "--out", str(out), "--workers", "1", "--quiet"]
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
-
-
-def stored_rows(path):
-    try:
-        with RunStore(path, readonly=True) as store:
-            return len(store)
-    except (sqlite3.DatabaseError, FileNotFoundError):
-        return 0
 
 
 def finished(config, out):

@@ -2,27 +2,19 @@
 
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _bar_study import stored_rows
 from _knn_child import N_RUNS, operator, search
 
 from fracid.parallel import BatchStats
 from fracid.store import RunStore
 
 CHILD = Path(__file__).with_name("_knn_child.py")
-
-
-def stored_rows(path):
-    try:
-        with RunStore(path, readonly=True) as store:
-            return len(store)
-    except (sqlite3.DatabaseError, FileNotFoundError):
-        return 0
 
 
 def test_killed_population_resumes_with_the_same_result(tmp_path):

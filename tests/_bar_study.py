@@ -1,0 +1,64 @@
+"""The small bar identification shared by command-line tests: synthetic data of (c, beta) = (2, 250) and its
+configuration, and the number of runs in a store."""
+
+import sqlite3
+
+import numpy as np
+
+import fracid
+from fracid.store import RunStore
+
+TEMPLATE = """
+[model.parameters]
+c = 1.0
+beta = 300.0
+
+[specimen]
+type = "bar"
+n_elements = {n_elements}
+
+[[experiments]]
+file = "bar.csv"
+control_column = "u_mm"
+control_unit = "mm"
+force_unit = "N"
+kind = "single"
+force_columns = ["F_N"]
+std = 0.02
+n_points = 12
+control_range = [0.004, 0.03]
+
+[identify]
+parameters = ["c", "beta"]
+[identify.bounds]
+c = [{c_lower}, 4.0]
+beta = [100.0, 500.0]
+[identify.knn]
+n = {n}
+k = {k}
+[identify.kalman]
+groups = 3
+{kalman}
+[output]
+directory = "results"
+"""
+
+
+def write_bar_study(directory, *, n_elements=60, n=16, k=4, c_lower=0.5, kalman="") -> "Path":
+    """bar.csv (the bar with ``n_elements`` at (c, beta) = (2, 250)) and study.toml in ``directory``."""
+    run = fracid.simulate(fracid.BarWithWeakZone(n_elements=n_elements), fracid.DamageParameters(c=2.0, beta=250.0),
+                          target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))
+    np.savetxt(directory / "bar.csv", np.column_stack([run.control, run.force]), delimiter=",", header="u_mm,F_N",
+               comments="")
+    path = directory / "study.toml"
+    path.write_text(TEMPLATE.format(n_elements=n_elements, n=n, k=k, c_lower=c_lower, kalman=kalman))
+    return path
+
+
+def stored_rows(path) -> int:
+    """Runs in the store at ``path`` (0 if it does not exist yet or is being created)."""
+    try:
+        with RunStore(path, readonly=True) as store:
+            return len(store)
+    except (sqlite3.DatabaseError, FileNotFoundError):
+        return 0
