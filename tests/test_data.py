@@ -103,7 +103,7 @@ def test_fewer_points_than_requested(tmp_path):
     with pytest.raises(DataError) as info:
         read(path)
     message = str(info.value)
-    assert "curve.csv" in message and "5 data rows" in message and "minimum of 10" in message
+    assert "curve.csv" in message and "5 data rows" in message and "fewer than the 10 a curve needs" in message
     assert len(read(path, min_points=5)[0].control) == 5
 
 

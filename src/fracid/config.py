@@ -1144,7 +1144,9 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
             h = built.length / built.n_elements
             key, default = _field_key(prefix, "n_elements", options, given)
             size = f"{key} = {built.n_elements}{default}: the element size length / n_elements = {h:.3g} mm"
-            advice = f"use n_elements >= {math.ceil(2.0 * built.length / length)} (h <= l/2)"
+            needed = 2.0 * built.length / length
+            advice = (f"use n_elements >= {math.ceil(needed)} (h <= l/2)" if needed <= MAX_BAR_ELEMENTS else
+                      f"that needs {needed:.3g} elements, beyond the limit {MAX_BAR_ELEMENTS}: is c in mm^2?")
         else:
             h = built.h_fine
             key, default = _field_key(prefix, "h_fine", options, given)

@@ -495,7 +495,7 @@ def read_curve_csv(
     wanted = [control_column, *names]
     indices = _column_indices(path, header, wanted, delimiter)
     if len(data) < min_points:
-        raise DataError(f"{path}: {len(data)} data rows, fewer than the minimum of {min_points} (min_points)")
+        raise DataError(f"{path}: {len(data)} data rows, fewer than the {min_points} a curve needs")
     values, lines = _parse_table(path, header, data, wanted, indices, decimal, delimiter)
 
     control = values[:, 0] * c_scale
@@ -506,7 +506,7 @@ def read_curve_csv(
     if keep.sum() < min_points:
         raise DataError(
             f"{path}: {int(keep.sum())} data rows left of {len(data)} after dropping backtracking rows, "
-            f"fewer than the minimum of {min_points} (min_points)"
+            f"fewer than the {min_points} a curve needs"
         )
     scale_notes = []
     if c_scale != 1.0:
