@@ -182,6 +182,7 @@ class _Linearizer:
                 self._fail(point, centre.error, where)
                 continue
             if accept is not None and not accept(point, centre.y):
+                self.result.runs += 1
                 self.last_error = "the objective does not decrease along the step"
                 continue
             try:
