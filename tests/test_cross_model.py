@@ -73,7 +73,7 @@ def _check_cross(cross, source_key, target_key):
 
 def test_cohesive_curve_is_fitted_by_gradient_damage(cohesive_to_gradient):
     fit, rms = _check_cross(cohesive_to_gradient, "cohesive-crack-hordijk", "gradient-damage")
-    assert rms < 0.05  # measured: 2.9 % of the peak force
+    assert rms < 0.06  # measured: 5.3 % with the Kalman filter kept inside the bounds (2.9 % when it left them)
     assert fit.params.E == COHESIVE.E and fit.params.alpha == 0.99  # fixed parameters kept
     # both dissipate about the same energy to the last point: measured ratio 0.994
     assert cohesive_to_gradient.energy_ratio == pytest.approx(1.0, abs=0.08)

@@ -491,7 +491,6 @@ INTERRUPTED = ["interrupted", "run the same command again"]
     pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", id="sigint"),
     pytest.param(signal.SIGTERM, 143, ["terminated (SIGTERM)", "run the same command again"], "1", False, "stored",
                  id="sigterm"),
-    pytest.param(signal.SIGINT, 130, INTERRUPTED, "2", True, "starting", id="ctrl-c-process-group-workers-starting"),
 ])
 def test_signal_during_identify(sig, status, words, workers, group, when, curve, tmp_path):
     """Ctrl-C or SIGTERM during the KNN stage (a population of 200 runs, longer than the wait), once a few runs

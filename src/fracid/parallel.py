@@ -231,25 +231,10 @@ class _SingleThreadSpawnProcess(multiprocessing.context.SpawnProcess):
 
     @staticmethod
     def _Popen(process_obj):
-        with _single_thread_environment(), _sigint_ignored():
+        with _single_thread_environment():
             return multiprocessing.context.SpawnProcess._Popen(process_obj)
 
 
-@contextlib.contextmanager
-def _sigint_ignored():
-    """SIGINT ignored while a worker is started: an ignored signal stays ignored across exec and Python
-    keeps it so, so Ctrl-C during the worker's imports does not print its traceback (the parent
-    stops the workers). The parent's own handler is back at once."""
-    import signal
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 class _SingleThreadSpawnContext(multiprocessing.context.SpawnContext):
