@@ -1,0 +1,228 @@
+"""The builders: pure functions of a validated :class:`~fracid.config.schema.Config` that make the
+model, its parameters, the specimens, the data, the forward operator, the parameter space and the
+keyword arguments of the identification, the study and a forward run."""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+
+from fracid.config.checker import _show
+from fracid.config.registry import _model_of, _specimen_class
+from fracid.config.schema import DEFAULT_KALMAN_GROUPS, Config, ConfigError, ExperimentConfig
+
+
+def _require(cfg: Config, section: str):
+    value = getattr(cfg, section)
+    if not value:
+        what = "[[experiments]] blocks" if section == "experiments" else f"an [{section}] section"
+        raise ConfigError(f"{cfg.path}: {section} is missing (no value given); identification needs {what}")
+    return value
+
+
+def build_model(cfg: Config):
+    """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
+    return _model_of(cfg.model.type)
+
+
+def build_parameters(cfg: Config):
+    """The model parameters, an instance of the model's parameter class (``DamageParameters`` for
+    the damage models, ``CohesiveParameters`` for the cohesive crack): those given in
+    ``[model.parameters]``, the rest the class's defaults."""
+    return build_model(cfg).parameters(**dict(cfg.model.parameters))
+
+
+def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
+    """The specimen object (NotchedBeam, DogBone or BarWithWeakZone) with the fields given; with an
+    experiment, its ``specimen`` overrides applied (e.g. the size of one specimen of a series)."""
+    options = dict(cfg.specimen.options)
+    if experiment is not None:
+        options.update(dict(experiment.specimen))
+    return _specimen_class(cfg.specimen.type)(**options)
+
+
+def _experiment_data(cfg: Config, exp: ExperimentConfig):
+    from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
+
+    if exp.kind == "envelope":
+        columns = [exp.mean_column, exp.lower_column, exp.upper_column]
+    else:
+        columns = list(exp.force_columns)
+    curves = read_curve_csv(exp.file, control_column=exp.control_column, force_columns=columns,
+                            control_unit_scale=exp.control_scale, force_unit_scale=exp.force_scale,
+                            delimiter=exp.delimiter, decimal=exp.decimal,
+                            backtrack_tolerance=exp.backtrack_tolerance_mm)
+    if exp.quantity == "force":
+        require_positive_force(curves)
+    _check_control_scale(cfg, exp, max(float(np.max(curve.control)) for curve in curves))
+    span = exp.control_range_mm
+    if exp.kind == "repeats":
+        return from_repeats(curves, exp.n_points, span, name=exp.name)
+    if exp.kind == "envelope":
+        return from_envelope(*curves, exp.n_points, span, name=exp.name)
+    if exp.std is not None:
+        return with_std(curves[0], exp.std * exp.force_scale, exp.n_points, span, name=exp.name)
+    return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True)
+
+
+def _stacked_data(cfg: Config, experiments):
+    from fracid.data import DataError, stack
+
+    blocks = []
+    for exp in experiments:
+        try:
+            block = _experiment_data(cfg, exp)
+            blocks.append(block.weighted({exp.name: exp.weight}) if exp.weight != 1.0 else block)
+        except DataError as err:
+            raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
+    return blocks[0] if len(blocks) == 1 else stack(*blocks)
+
+
+#: Data whose control values go further than this many times the specimen's default target (a point
+#: well past the peak for the configured parameters, the identified ones at their upper bounds), or
+#: stop before 1/CONTROL_SCALE_LIMIT^2 of it (deep in the elastic range), are refused: the control is
+#: almost surely in another unit (um declared as mm gives 1000 times, m as mm 1/1000), and every
+#: forward run would trace a far too long path (a bar identification took minutes to fail).
+CONTROL_SCALE_LIMIT = 30.0
+
+
+def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> None:
+    specimen = build_specimen(cfg, exp)
+    if not hasattr(specimen, "default_target"):
+        return
+    params = build_parameters(cfg)
+    candidates = [params]
+    if cfg.identify is not None:
+        for name, upper in zip(cfg.identify.parameters, cfg.identify.upper):
+            try:
+                candidates.append(params.replace(**{name: upper}))
+            except ValueError:
+                continue
+    try:
+        target = max(float(specimen.default_target(p)) for p in candidates)
+    except (AttributeError, ValueError, TypeError):
+        return
+    where = f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of {exp.file}"
+    if target > 0 and reach > CONTROL_SCALE_LIMIT * target:
+        raise ConfigError(
+            f"{where} reach {reach:.6g} mm, {reach / target:.0f} times the {target:.3g} mm at which this "
+            f"specimen has long failed with these parameters; check control_unit (values in um declared as mm "
+            f"are 1000 times too large) and control_range")
+    if target > 0 and reach < target / CONTROL_SCALE_LIMIT**2:
+        raise ConfigError(
+            f"{where} reach only {reach:.3g} mm, 1/{target / reach:.0f} of the {target:.3g} mm at which this "
+            f"specimen has long failed with these parameters, deep in its elastic range; check control_unit "
+            f"(values in m declared as mm are 1000 times too small)")
+
+
+def build_experiment_data(cfg: Config, experiment: ExperimentConfig):
+    """The data of one experiment (any role), weighted."""
+    return _stacked_data(cfg, [experiment])
+
+
+def build_data(cfg: Config):
+    """The calibration data: one block per ``[[experiments]]`` entry with role "calibration",
+    stacked in order, each block's covariance divided by its ``weight``.
+
+    Raises
+    ------
+    ConfigError
+        Wrapping any :class:`fracid.data.DataError` (bad rows, a range beyond the data, ...) with
+        ``experiments[i]`` and the file named.
+    """
+    _require(cfg, "experiments")
+    return _stacked_data(cfg, cfg.calibration)
+
+
+def _operator(cfg: Config, experiments, data):
+    from fracid.inverse.forward_operator import ForwardOperator, Observation
+
+    identify = _require(cfg, "identify")
+    if len(data.blocks) != len(experiments):
+        raise ConfigError(f"{cfg.path}: experiments: the data hold {len(data.blocks)} blocks but the configuration "
+                          f"has {len(experiments)} such [[experiments]] entries; build the data with build_data(cfg)")
+    observations = []
+    for exp, (name, start, stop) in zip(experiments, data.blocks):
+        try:
+            observations.append(Observation(build_specimen(cfg, exp), data.control[start:stop], quantity=exp.quantity,
+                                            control=cfg.specimen.control, name=name,
+                                            damage_threshold=exp.damage_threshold))
+        except ValueError as err:
+            raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
+                              f"{_show(exp.control_range and list(exp.control_range))}: {err}") from None
+    return ForwardOperator(observations, build_parameters(cfg), identify.parameters, model=build_model(cfg))
+
+
+def build_operator(cfg: Config, data):
+    """The forward operator: one Observation per calibration experiment, at the data's control points.
+
+    ``data`` is the result of :func:`build_data` (its blocks line up with the calibration
+    ``[[experiments]]``). Blocks of the same specimen share one forward run.
+    """
+    _require(cfg, "experiments")
+    return _operator(cfg, cfg.calibration, data)
+
+
+def build_held_out(cfg: Config) -> list:
+    """(operator, data) per experiment with role "prediction": data predicted, not calibrated on."""
+    held = [e for e in cfg.experiments if e.role == "prediction"]
+    out = []
+    for exp in held:
+        data = _stacked_data(cfg, [exp])
+        out.append((_operator(cfg, [exp], data), data))
+    return out
+
+
+def study_settings(cfg: Config) -> dict:
+    """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``."""
+    study = cfg.study
+    return {**identify_settings(cfg), "starts": study.starts, "replicates": study.replicates,
+            "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior}
+
+
+def build_space(cfg: Config):
+    """The parameter space of the KNN population: identified names, bounds, log flags."""
+    from fracid.inverse.knn import ParameterSpace
+
+    identify = _require(cfg, "identify")
+    return ParameterSpace(identify.parameters, lower=list(identify.lower), upper=list(identify.upper),
+                          log=tuple(name in identify.log for name in identify.parameters))
+
+
+def identify_settings(cfg: Config) -> dict:
+    """Keyword arguments of :func:`fracid.inverse.strategy.identify_data` (and ``identify``).
+
+    ``n``, ``method``, ``seed``, ``k``, ``groups`` (``groups`` consecutive index arrays covering
+    the n_y observations; :data:`DEFAULT_KALMAN_GROUPS` when not given), ``max_iterations``,
+    ``tol`` and ``restart`` (only when ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
+    (executor, store, progress) is not configuration: add it at the call.
+    """
+    from fracid.inverse.strategy import identify
+
+    settings = _require(cfg, "identify")
+    knn, kalman = settings.knn, settings.kalman
+    count = kalman.groups if kalman.groups is not None else min(DEFAULT_KALMAN_GROUPS, cfg.n_y)
+    groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), count)]
+    out = {"n": knn.n, "method": knn.method, "seed": knn.seed, "k": knn.k, "groups": groups,
+           "max_iterations": kalman.max_iterations, "tol": kalman.tol}
+    if "restart" in inspect.signature(identify).parameters:
+        out["restart"] = kalman.restart
+    elif kalman.restart != "linearize":
+        raise ConfigError(f"{cfg.path}: identify.kalman.restart = {kalman.restart!r}: this version of "
+                          "fracid.inverse.strategy.identify cannot forward it; only 'linearize' (the default) is available")
+    return out
+
+
+def simulate_settings(cfg: Config) -> dict:
+    """Keyword arguments of a forward run besides the specimen and parameters: ``control``,
+    ``target``, ``stop_force_fraction``, ``damage_threshold`` and ``field_steps`` (the VTK steps, or
+    ``"last"`` when none are listed), as taken by ``build_model(cfg).simulate``; for the damage
+    models also ``regularization``, so that they are those of :func:`fracid.forward.simulate` too
+    (drop it when calling the model's ``simulate``, which sets it itself)."""
+    sim = cfg.simulate
+    settings = {"control": cfg.specimen.control, "target": sim.target,
+                "stop_force_fraction": sim.stop_force_fraction, "damage_threshold": sim.damage_threshold,
+                "field_steps": list(cfg.output.vtk_steps) if cfg.output.vtk_steps else "last"}
+    regularization = cfg.model.regularization
+    return settings if regularization is None else {"regularization": regularization, **settings}

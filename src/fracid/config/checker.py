@@ -1,0 +1,119 @@
+"""Reading the TOML file and the generic value checks whose messages name the file, the dotted key,
+the value given and what is allowed."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+from fracid.config.schema import ConfigError
+
+
+def _bytes(n: float) -> str:
+    """A memory size in words: ``18.6 GiB``, ``195 MiB``, ``12 KiB``."""
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n:.0f} bytes"
+
+
+def _show(value) -> str:
+    if isinstance(value, dict):
+        text = "a table {" + ", ".join(value) + "}"
+    else:
+        text = repr(value)
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+class _Checker:
+    """Raises ConfigError messages naming the file, the dotted key, the value and what is allowed."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.warnings: list[str] = []
+
+    def fail(self, key: str, value, allowed: str):
+        raise ConfigError(f"{self.path}: {key} = {_show(value)}: {allowed}")
+
+    def warn(self, text: str) -> None:
+        """Record a warning (a valid value that is probably not what was meant), once."""
+        if text not in self.warnings:
+            self.warnings.append(text)
+
+    def missing(self, key: str, allowed: str):
+        raise ConfigError(f"{self.path}: {key} is missing (no value given); it is required: {allowed}")
+
+    def table(self, key: str, value, allowed_keys) -> dict:
+        if not isinstance(value, dict):
+            self.fail(key, value, f"must be a table (section) with keys {', '.join(allowed_keys)}")
+        prefix = f"{key}." if key else ""
+        for k, v in value.items():
+            if k not in allowed_keys:
+                self.fail(prefix + k, v, f"unknown key; allowed keys here: {', '.join(allowed_keys)}")
+        return value
+
+    def number(self, key, value, allowed="must be a number", ok=lambda v: True) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not ok(value):
+            self.fail(key, value, allowed)
+        return float(value)
+
+    def integer(self, key, value, allowed="must be an integer", ok=lambda v: True) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not ok(value):
+            self.fail(key, value, allowed)
+        return int(value)
+
+    def string(self, key, value, allowed="must be a string") -> str:
+        if not isinstance(value, str) or not value:
+            self.fail(key, value, allowed)
+        return value
+
+    def choice(self, key, value, choices) -> str:
+        text = "must be one of " + ", ".join(repr(c) for c in choices)
+        if not isinstance(value, str) or value not in choices:
+            self.fail(key, value, text)
+        return value
+
+    def pair(self, key, value, allowed) -> tuple[float, float]:
+        """Two finite numbers [a, b]; any defect names the whole list."""
+        if not (isinstance(value, list) and len(value) == 2):
+            self.fail(key, value, allowed)
+        for v in value:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                self.fail(key, value, allowed)
+        return float(value[0]), float(value[1])
+
+    def strings(self, key, value, what="column names") -> tuple:
+        if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+            self.fail(key, value, f"must be a list of {what} (strings)")
+        duplicates = sorted({v for v in value if value.count(v) > 1})
+        if duplicates:
+            self.fail(key, value, f"must not repeat a name; repeated: {', '.join(map(repr, duplicates))}")
+        return tuple(value)
+
+    def file(self, key, value, base: Path) -> Path:
+        self.string(key, value, "must be a file path (string)")
+        given = Path(value).expanduser()
+        resolved = (given if given.is_absolute() else base / given).resolve()
+        where = f"{resolved}" if given.is_absolute() else f"resolved relative to the config file: {resolved}"
+        if not resolved.exists():
+            self.fail(key, value, f"file not found ({where})")
+        if not resolved.is_file():
+            self.fail(key, value, f"not a file ({where})")
+        return resolved
+
+
+def _read_toml(path: Path) -> dict:
+    try:
+        with open(path, "rb") as handle:
+            raw = handle.read()
+        # a byte-order mark (Windows Notepad) is not TOML but says nothing wrong about the file
+        return tomllib.loads(raw.removeprefix(b"\xef\xbb\xbf").decode("utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: configuration file not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path}: is a directory, not a configuration file") from None
+    except UnicodeDecodeError as err:
+        raise ConfigError(f"{path}: not a UTF-8 text file ({err})") from None
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{path}: not valid TOML: {err}") from None

@@ -1,0 +1,214 @@
+"""Validation of the ``[[experiments]]`` blocks: keys, units, the data file's header and columns
+(read with the block's delimiter and decimal mark) and the size of the data."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+from pathlib import Path
+
+from fracid.config.checker import _bytes, _Checker
+from fracid.config.registry import _SPECIMENS, _specimen_class
+from fracid.config.schema import (
+    _CONTROL_UNITS,
+    _DECIMALS,
+    _DELIMITERS,
+    _EXPERIMENT_KEYS,
+    _FORCE_UNITS,
+    _KIND_KEYS,
+    _KINDS,
+    _LOCAL_UNITS,
+    _ROLES,
+    MAX_DATA_VALUES,
+    ExperimentConfig,
+    SpecimenConfig,
+)
+from fracid.config.sections import _check_specimen, _check_specimen_size, _specimen_options
+
+
+def _data_limit_text(n_y: int, what: str) -> str:
+    return (f"{what} n_y = {n_y:,} data values, whose covariance takes n_y^2 x 8 bytes = {_bytes(8.0 * n_y * n_y)}; "
+            f"at most {MAX_DATA_VALUES:,} are allowed ({_bytes(8.0 * MAX_DATA_VALUES**2)}), and 40 to 100 points "
+            "describe a curve: lower n_points")
+
+
+def _csv_header(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str) -> list[str]:
+    """The header cells of a data file, split by ``delimiter``; a header that is one cell holding
+    another separator, or a first data row with decimal commas read with ``decimal = "."``, is named
+    as such (instead of a missing column or a cell that is not a number)."""
+    from fracid.data.curves import decimal_comma_hint, delimiter_hint, iter_rows
+
+    header = first = None
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:
+            for _, cells in iter_rows(handle, delimiter):
+                if not any(cell.strip() for cell in cells):
+                    continue
+                if header is None:
+                    header = [cell.strip() for cell in cells]
+                else:
+                    first = cells
+                    break
+    except (UnicodeDecodeError, csv.Error) as err:
+        ck.fail(key, value, f"not a readable UTF-8 CSV file ({err})")
+    if header is None:
+        ck.fail(key, value, f"the file is empty (no header row): {path}")
+    guess = delimiter_hint(header, delimiter)
+    if guess is not None:
+        given = _toml_text(delimiter) + (" (the default)" if delimiter == "," else "")
+        ck.fail(key, value, f"the header is one cell {header[0]!r} when split by delimiter = {given}: the file seems "
+                            f"to be separated by {guess!r}; set delimiter = {_toml_text(guess)} (and decimal = \",\" "
+                            "for decimal commas)")
+    hint = first is not None and decimal_comma_hint(first, delimiter, decimal, len(header))
+    if hint:
+        row = ", ".join(repr(cell.strip()) for cell in first)
+        ck.fail(key, value, f"the first data row ({row}) cannot be read with delimiter = {_toml_text(delimiter)} and "
+                            f"decimal = {_toml_text(decimal)}: {hint}")
+    return header
+
+
+def _toml_text(text: str) -> str:
+    """A string as written in TOML: ``";"``, ``"\\t"``."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\t", "\\t") + '"'
+
+
+def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig) -> ExperimentConfig:
+    prefix = f"experiments[{i}]"
+    ck.table(prefix, raw, _EXPERIMENT_KEYS)
+
+    def required(name):
+        if name not in raw:
+            ck.missing(f"{prefix}.{name}", _REQUIRED_TEXT[name])
+        return raw[name]
+
+    _, observables = _SPECIMENS[specimen.type]
+    quantity = ck.choice(f"{prefix}.quantity", raw.get("quantity", "force"), ("force", *observables))
+    file = ck.file(f"{prefix}.file", required("file"), base)
+    control_column = ck.string(f"{prefix}.control_column", required("control_column"), "must be a column name")
+    control_unit = ck.choice(f"{prefix}.control_unit", required("control_unit"), tuple(_CONTROL_UNITS))
+    units = _FORCE_UNITS if quantity == "force" else _LOCAL_UNITS
+    if "force_unit" not in raw:
+        ck.missing(f"{prefix}.force_unit", f"the unit of {quantity!r}, one of " + ", ".join(map(repr, units)))
+    force_unit = ck.choice(f"{prefix}.force_unit", raw["force_unit"], tuple(units))
+    kind = ck.choice(f"{prefix}.kind", required("kind"), _KINDS)
+    for name in raw:
+        if name in {k for ks in _KIND_KEYS.values() for k in ks} and name not in _KIND_KEYS[kind]:
+            ck.fail(f"{prefix}.{name}", raw[name], f"not used by kind {kind!r}, which takes "
+                    + ", ".join(_KIND_KEYS[kind]))
+    n_points = ck.integer(f"{prefix}.n_points", required("n_points"), "must be an integer >= 3", lambda v: v >= 3)
+    if n_points > MAX_DATA_VALUES:
+        ck.fail(f"{prefix}.n_points", n_points, _data_limit_text(n_points, "this block alone has"))
+
+    delimiter = raw.get("delimiter", ",")
+    if not isinstance(delimiter, str) or delimiter not in _DELIMITERS:
+        ck.fail(f"{prefix}.delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run of '
+                                                 "spaces and tabs); the cell separator of the file")
+    delimiter = _DELIMITERS[delimiter]
+    decimal = ck.choice(f"{prefix}.decimal", raw.get("decimal", "."), _DECIMALS)
+    if decimal == delimiter:
+        ck.fail(f"{prefix}.decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
+                                              'default) a comma cannot also mark the decimals; files with decimal '
+                                              'commas are separated by ";" or tabs: set delimiter = ";" or "tab"')
+    backtrack = None
+    if "backtrack_tolerance" in raw:
+        backtrack = ck.number(f"{prefix}.backtrack_tolerance", raw["backtrack_tolerance"],
+                              f"must be a number >= 0 [{control_unit}] (the largest backtrack of the control column "
+                              "treated as noise)", lambda v: v >= 0)
+
+    header = _csv_header(ck, f"{prefix}.file", raw["file"], file, delimiter, decimal)
+    available = "available columns: " + ", ".join(repr(c) for c in header)
+
+    def column(name, value):
+        key = f"{prefix}.{name}"
+        ck.string(key, value, "must be a column name (string)")
+        if value not in header:
+            ck.fail(key, value, f"the file {file} has no such column; {available}")
+        return value
+
+    column("control_column", control_column)
+    options = {}
+    if kind in ("repeats", "single"):
+        key = f"{prefix}.force_columns"
+        names = ck.strings(key, required("force_columns"))
+        if kind == "repeats" and len(names) < 2:
+            ck.fail(key, raw["force_columns"], "kind 'repeats' needs at least 2 columns (one per repeated test)")
+        if kind == "single" and len(names) != 1:
+            ck.fail(key, raw["force_columns"], "kind 'single' takes exactly 1 column")
+        for name in names:
+            if name not in header:
+                ck.fail(key, raw["force_columns"], f"the file {file} has no column {name!r}; {available}")
+        options["force_columns"] = names
+    else:
+        for name in _KIND_KEYS["envelope"]:
+            options[name] = column(name, required(name))
+    if kind == "single":
+        given = [name for name in ("std", "relative_std") if name in raw]
+        if len(given) != 1:
+            key = f"{prefix}.{given[1] if given else 'std'}"
+            text = "kind 'single' needs exactly one of std (absolute, in force_unit, > 0) or relative_std (fraction of |y|, > 0)"
+            if not given:
+                ck.missing(key, text)
+            ck.fail(key, raw[given[1]], text)
+        name = given[0]
+        unit = f" [{force_unit}]" if name == "std" else " (fraction of |y|)"
+        options[name] = ck.number(f"{prefix}.{name}", raw[name], f"must be a number > 0{unit}", lambda v: v > 0)
+        value = options[name]
+        if name == "relative_std" and value > 1:
+            ck.warn(f"{prefix}.relative_std = {value:g} is more than 1, i.e. more than 100 % of the value; "
+                    f"if you meant {value:g} %, write {value / 100:g}")
+    control_range = None
+    if "control_range" in raw:
+        value = raw["control_range"]
+        allowed = f"must be [start, stop] with 0 < start < stop [{control_unit}]"
+        a, b = ck.pair(f"{prefix}.control_range", value, allowed)
+        if not 0 < a < b:
+            ck.fail(f"{prefix}.control_range", value, allowed)
+        control_range = (a, b)
+    default_name = "global" if quantity == "force" else quantity
+    name = ck.string(f"{prefix}.name", raw.get("name", default_name), "must be a non-empty string")
+    overrides = ()
+    if "specimen" in raw:
+        cls = _specimen_class(specimen.type)
+        fields = [f.name for f in dataclasses.fields(cls)]
+        given = _specimen_options(ck, f"{prefix}.specimen", ck.table(f"{prefix}.specimen", raw["specimen"], fields), cls)
+        _check_specimen(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)
+        _check_specimen_size(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)
+        overrides = tuple(given.items())
+    weight = ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0 (p in f = sum p_b f_b)",
+                       lambda v: v > 0)
+    threshold = 0.0
+    if "damage_threshold" in raw:
+        if quantity == "force":
+            ck.fail(f"{prefix}.damage_threshold", raw["damage_threshold"],
+                    "applies to a local quantity only (this block's quantity is 'force')")
+        threshold = ck.number(f"{prefix}.damage_threshold", raw["damage_threshold"],
+                              "must be a number with 0 <= t < 1 (damage counted in the width)", lambda v: 0 <= v < 1)
+    role = ck.choice(f"{prefix}.role", raw.get("role", "calibration"), _ROLES)
+    return ExperimentConfig(index=i, file=file, control_column=control_column, control_unit=control_unit,
+                            force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
+                            quantity=quantity, name=name, specimen=overrides, weight=weight,
+                            damage_threshold=threshold, role=role, delimiter=delimiter, decimal=decimal,
+                            backtrack_tolerance=backtrack, **options)
+
+
+_REQUIRED_TEXT = {
+    "file": "a CSV file path, relative to the config file",
+    "control_column": "the name of the control column",
+    "control_unit": "one of " + ", ".join(map(repr, _CONTROL_UNITS)),
+    "kind": "one of " + ", ".join(map(repr, _KINDS)),
+    "n_points": "an integer >= 3",
+    "force_columns": "a list of force column names",
+    "mean_column": "the name of the mean column (kind 'envelope')",
+    "lower_column": "the name of the lower-envelope column (kind 'envelope')",
+    "upper_column": "the name of the upper-envelope column (kind 'envelope')",
+}
+
+
+def _experiments(ck: _Checker, raw, base: Path, specimen: SpecimenConfig, needed: bool) -> tuple:
+    if raw is None:
+        if needed:
+            ck.missing("experiments", "one or more [[experiments]] blocks (data files) for identification")
+        return ()
+    if not isinstance(raw, list) or not raw:
+        ck.fail("experiments", raw, "must be one or more [[experiments]] tables")
+    return tuple(_experiment(ck, i, block, base, specimen) for i, block in enumerate(raw))

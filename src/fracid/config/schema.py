@@ -1,0 +1,368 @@
+"""The schema of a TOML configuration, its vocabularies and limits, and the frozen dataclasses of a
+validated one (:class:`Config` and its sections).
+
+Schema
+------
+The sections ``[[experiments]]`` and ``[identify]`` are required for identification
+(``purpose="identify"``) and optional for a forward analysis (``purpose="simulate"``); when
+present they are always validated. Every other key is optional unless marked *required*.
+
+.. code-block:: toml
+
+    [model]                             # optional; defaults: gradient damage, DamageParameters()
+    type = "gradient-damage"            # any name of fracid.models.MODEL_TYPES, read when the file is
+                                        #   validated: "gradient-damage" | "local-damage" (mesh-
+                                        #   dependent) | "cohesive-crack" (Hordijk crack on the beam's
+                                        #   ligament; parameters E nu ft Gf c1 c2) | models added later
+    [model.parameters]                  # any subset of the model's parameters (its parameter class's
+                                        # names(); checked by its own validation); the rest take the
+                                        # class's defaults. Gradient and local damage (DamageParameters):
+                                        # E 20000, nu 0.2, kappa_i 1e-4, alpha 0.99, beta 300, c 1, eta 10
+    E = 37000.0                         # MPa, E > 0
+    nu = 0.2                            # -, -1 < nu < 0.5
+    kappa_i = 6.6e-5                    # -, kappa_i > 0
+    alpha = 0.99                        # -, 0 <= alpha <= 1
+    beta = 600.0                        # -, beta >= 0
+    c = 9.0                             # mm^2, c > 0
+    eta = 10.0                          # -, eta >= 1
+
+    [specimen]                          # required
+    type = "notched-beam"               # required: "notched-beam" | "dogbone" | "bar"
+    control = "cmod"                    # the specimen's default if omitted:
+                                        #   notched-beam: "cmod" (default) | "deflection"
+                                        #   dogbone:      "elongation" (default) | "platen_displacement"
+                                        #   bar:          "end_displacement" (default) | "weak_zone_elongation"
+    # every other key is a field of the specimen class, type-checked (lengths in mm):
+    #   notched-beam (NotchedBeam): depth thickness length span notch_depth notch_width plate_width
+    #                               h_fine h_coarse fine_width
+    #   dogbone (DogBone):          size thickness gauge_length h_fine fine_height h_coarse
+    #                               notch_radius notch_width platens ("glued" | "hinged")
+    #                               platen_height platen_stiffness hinge_offset
+    #   bar (BarWithWeakZone):      length area (mm^2) weak_zone_width weak_zone_factor
+    #                               weakening ("modulus" | "area") profile ("step" | "hat")
+    #                               n_elements (integer)
+    h_fine = 1.0
+
+    [[experiments]]                     # one or more data blocks, stacked in this order into y_exp
+    file = "load_cmod.csv"              # required: CSV with a header row, relative to this file
+    control_column = "cmod_mm"          # required: column of the control quantity
+    control_unit = "mm"                 # required: "mm" | "um" | "m" (scaled to mm)
+    force_unit = "N"                    # required: quantity "force": "N" | "kN" | "MN" (scaled to N);
+                                        #   a local quantity: its unit, "mm" | "um" | "m" (scaled to mm)
+    kind = "envelope"                   # required: "repeats" | "envelope" | "single"
+    #   repeats:  force_columns = ["F1", "F2", ...]   (>= 2 columns: mean and sample std of the repeats)
+    #   envelope: mean_column, lower_column, upper_column   (std = (upper - lower) / 4)
+    #   single:   force_columns = ["F"]  (exactly 1) and either std (absolute, in force_unit, > 0)
+    #             or relative_std (fraction of |y|, > 0)
+    mean_column = "load_mean_N"
+    lower_column = "load_min_N"
+    upper_column = "load_max_N"
+    n_points = 40                       # required: integer >= 3, equally spaced control values
+    control_range = [0.001, 0.2]        # optional [start, stop], 0 < start < stop, in control_unit;
+                                        #   default: the range common to the columns
+    quantity = "force"                  # "force" (default) or a local observable of the specimen:
+                                        #   notched-beam, dogbone: "fpz_width"; bar: "damaged_zone_width"
+    name = "global"                     # block name; default "global" (force) or the quantity's name
+    specimen = { size = 200.0 }         # optional: fields of [specimen] overridden for this test (a size
+                                        #   series: one block per size); blocks of the same specimen
+                                        #   share one forward run
+    weight = 1.0                        # optional p_b > 0: f = sum p_b f_b (global p1, local p2); the
+                                        #   block's covariance is divided by p_b
+    damage_threshold = 0.5              # optional, local quantity only: 0 <= t < 1, damage counted in
+                                        #   the width (default 0: any damage)
+    role = "calibration"                # "calibration" (default) | "prediction": predicted at the
+                                        #   estimate by `fracid study`, not calibrated on
+    delimiter = ","                     # cell separator: "," (default) | ";" | "\\t" (or "tab") | " " (any
+                                        #   run of spaces and tabs)
+    decimal = "."                       # decimal mark: "." (default) | "," (0,001); "," needs another delimiter
+    backtrack_tolerance = 0.002         # optional number >= 0 in control_unit: the largest backtrack of the
+                                        #   control column dropped as noise (default 1 % of its range)
+
+    [identify]                          # required for identification
+    parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
+                                            #   no duplicates
+    [identify.bounds]                   # required: [lower, upper] for every identified parameter,
+                                        #   lower < upper, both inside the parameter's valid range
+    kappa_i = [4e-5, 1.2e-4]
+    beta = [100.0, 2000.0]
+    c = [1.0, 30.0]                     # mm^2
+    log = ["beta"]                      # optional: sampled uniformly in log(x); needs lower > 0
+    [identify.knn]                      # optional
+    n = 64                              # integer >= 2 (grid: points per parameter), default 64
+    method = "sobol"                    # "sobol" (default) | "lhs" | "grid"
+    k = 5                               # neighbours, 1 <= k <= population (n, or n**p for grid), default 5
+    seed = 0                            # integer >= 0, default 0
+    [identify.kalman]                   # optional
+    groups = 4                          # consecutive observation groups, 1 <= groups <= n_y (total
+                                        #   n_points); omitted: one observation per step
+    max_iterations = 10                 # integer >= 1, default 10
+    tol = 0.01                          # > 0, in standard deviations, default 0.01
+    restart = "linearize"               # "linearize" (default) | "prior-mean"
+
+    [study]                             # optional: the checks of `fracid study`
+    starts = 3                          # multi-start Kalman filters from distinct population points
+                                        #   (0 or 1: no check), default 3
+    replicates = 5                      # identifications on data with noise added (0: none; else >= 2)
+    seed = 0                            # seed of the replicates' noise, default 0
+    tolerance = 0.1                     # largest relative std called "identified", default 0.1
+    prior = "knn"                       # Kalman prior covariance: "knn" (neighbours' spread, default)
+                                        #   | "bounds" (uniform over the bounds: the data's information only)
+
+    [output]                            # optional
+    directory = "results"               # default "results", relative to this file unless absolute
+    vtk_steps = []                      # integers >= 0: steps whose fields go to VTK (simulate)
+
+    [simulate]                          # optional: settings of a forward analysis
+    target = 0.3                        # mm, > 0; default: the specimen's
+    stop_force_fraction = 0.1           # 0 < f < 1, default 0.1: stop below f x peak force
+    damage_threshold = 0.0              # 0 <= t < 1, default 0: damage counted in widths
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from fracid.config.registry import _model_of
+
+
+class ConfigError(ValueError):
+    """An invalid configuration: the message names the file, the dotted key, the value and what is allowed."""
+
+
+# ------------------------------------------------------------------------------------ vocabularies
+
+_CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
+#: ``delimiter`` values -> the cell separator ("tab" spells a tab; " " is any run of whitespace)
+_DELIMITERS = {",": ",", ";": ";", "\t": "\t", "tab": "\t", " ": " "}
+_DECIMALS = (".", ",")
+_FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
+_LOCAL_UNITS = dict(_CONTROL_UNITS)
+_KINDS = ("repeats", "envelope", "single")
+_METHODS = ("sobol", "lhs", "grid")
+_RESTARTS = ("linearize", "prior-mean")
+_PURPOSES = ("identify", "simulate")
+
+_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study")
+_MODEL_KEYS = ("type", "parameters")
+_EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
+                    "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
+                    "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
+                    "backtrack_tolerance")
+_KIND_KEYS = {
+    "repeats": ("force_columns",),
+    "envelope": ("mean_column", "lower_column", "upper_column"),
+    "single": ("force_columns", "std", "relative_std"),
+}
+_IDENTIFY_KEYS = ("parameters", "bounds", "knn", "kalman")
+_KNN_KEYS = ("n", "method", "k", "seed")
+_KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
+_OUTPUT_KEYS = ("directory", "vtk_steps")
+_SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
+_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
+_ROLES = ("calibration", "prediction")
+#: Kalman steps per pass when [identify.kalman] groups is not given. One observation per step costs
+#: 2 p + 1 partial runs per observation (a 30-point curve: over 100 full-run equivalents per pass);
+#: with linearised restarts the later passes use one linearisation each whatever the grouping.
+DEFAULT_KALMAN_GROUPS = 4
+
+
+# ------------------------------------------------------------------------------ size limits
+# A configuration asking for more than a workstation can hold is refused when it is loaded, with
+# the estimate, instead of failing (or swapping for hours) in the middle of a study.
+
+#: largest KNN population (n, or n**p for a grid): each member is one forward run (seconds to
+#: minutes each), so 1e5 is already days of computing; n = 1e9 allocated 23.5 GB before the first run
+MAX_POPULATION = 100_000
+
+#: largest number of bar elements: about 4 kB each in a forward run (measured), so 2e5 elements
+#: take about 1 GB; 1e8 elements hung the machine
+MAX_BAR_ELEMENTS = 200_000
+
+#: measured memory of a forward run of the bar per element [bytes]
+BAR_BYTES_PER_ELEMENT = 4_000
+
+#: largest number of unknowns (2 displacements per node + 1 nonlocal strain per vertex) of a 2D
+#: mesh: about 6 kB each in a forward run (measured, before the sparse factorisation's own
+#: memory), so 2e6 unknowns take about 12 GB, and every step factorises the matrix again
+MAX_UNKNOWNS = 2_000_000
+
+#: measured memory of a forward run of the 2D specimens per unknown [bytes]
+BYTES_PER_UNKNOWN = 6_000
+
+#: largest number of data values n_y (the n_points of the calibration blocks together, and of each
+#: prediction block): the covariance C_exp is a dense n_y x n_y matrix of 8-byte numbers (5000 ->
+#: 191 MiB, 50000 -> 18.6 GiB) factorised by every Kalman step; 40 to 100 points describe a curve
+MAX_DATA_VALUES = 5_000
+
+
+# ------------------------------------------------------------------------------ validated config
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """``[model]``: the model type and the parameter values given (the rest are defaults)."""
+
+    type: str = "gradient-damage"
+    parameters: tuple = ()  # ((name, value), ...) as given
+
+    @property
+    def regularization(self) -> str | None:
+        """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
+        (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
+        return getattr(_model_of(self.type), "regularization", None)
+
+
+@dataclass(frozen=True)
+class SpecimenConfig:
+    """``[specimen]``: type, control (resolved to the default when omitted) and the dataclass fields given."""
+
+    type: str
+    control: str
+    options: tuple = ()  # ((field, value), ...) as given, type-checked
+
+
+@dataclass(frozen=True)
+class ExperimentConfig:
+    """One ``[[experiments]]`` block (``index`` is its position, ``file`` an absolute path)."""
+
+    index: int
+    file: Path
+    control_column: str
+    control_unit: str
+    force_unit: str
+    kind: str
+    n_points: int
+    force_columns: tuple = ()
+    mean_column: str | None = None
+    lower_column: str | None = None
+    upper_column: str | None = None
+    std: float | None = None
+    relative_std: float | None = None
+    control_range: tuple | None = None  # in control_unit, as given
+    quantity: str = "force"
+    name: str = "global"
+    specimen: tuple = ()  # ((field, value), ...) overriding [specimen] for this test (e.g. its size)
+    weight: float = 1.0
+    damage_threshold: float = 0.0
+    role: str = "calibration"
+    delimiter: str = ","  # the cell separator itself ("tab" is stored as "\t"; " " is any whitespace)
+    decimal: str = "."
+    backtrack_tolerance: float | None = None  # in control_unit, as given; None: 1 % of the control range
+
+    @property
+    def control_scale(self) -> float:
+        """Multiplier from ``control_unit`` to mm."""
+        return _CONTROL_UNITS[self.control_unit]
+
+    @property
+    def force_scale(self) -> float:
+        """Multiplier from ``force_unit`` to N (force) or to mm (local quantity)."""
+        return (_FORCE_UNITS if self.quantity == "force" else _LOCAL_UNITS)[self.force_unit]
+
+    @property
+    def control_range_mm(self) -> tuple | None:
+        """``control_range`` in mm."""
+        if self.control_range is None:
+            return None
+        return tuple(v * self.control_scale for v in self.control_range)
+
+    @property
+    def backtrack_tolerance_mm(self) -> float | None:
+        """``backtrack_tolerance`` in mm (None: the reader's default, 1 % of the control range)."""
+        return None if self.backtrack_tolerance is None else self.backtrack_tolerance * self.control_scale
+
+
+@dataclass(frozen=True)
+class KnnConfig:
+    """``[identify.knn]``."""
+
+    n: int = 64
+    method: str = "sobol"
+    k: int = 5
+    seed: int = 0
+
+    def population(self, p: int) -> int:
+        """Number of forward runs for p parameters."""
+        return self.n**p if self.method == "grid" else self.n
+
+
+@dataclass(frozen=True)
+class KalmanConfig:
+    """``[identify.kalman]``; ``groups`` None = one observation per step."""
+
+    groups: int | None = None
+    max_iterations: int = 10
+    tol: float = 0.01
+    restart: str = "linearize"
+
+
+@dataclass(frozen=True)
+class IdentifyConfig:
+    """``[identify]``: identified parameters, their bounds and log flags, KNN and Kalman settings."""
+
+    parameters: tuple
+    lower: tuple
+    upper: tuple
+    log: tuple = ()  # names sampled in log scale
+    knn: KnnConfig = KnnConfig()
+    kalman: KalmanConfig = KalmanConfig()
+
+
+@dataclass(frozen=True)
+class OutputConfig:
+    """``[output]``: ``directory`` absolute (resolved against the config file)."""
+
+    directory: Path
+    vtk_steps: tuple = ()
+
+
+@dataclass(frozen=True)
+class SimulateConfig:
+    """``[simulate]``: target [mm] (None: the specimen's), stop_force_fraction, damage_threshold."""
+
+    target: float | None = None
+    stop_force_fraction: float = 0.1
+    damage_threshold: float = 0.0
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """``[study]``: multi-start points, noisy replicates, their seed, and the tolerance of the verdict."""
+
+    starts: int = 3
+    replicates: int = 5
+    seed: int = 0
+    tolerance: float = 0.1
+    prior: str = "knn"
+
+
+@dataclass(frozen=True)
+class Config:
+    """A validated configuration (see the module docstring for the schema)."""
+
+    path: Path
+    purpose: str
+    model: ModelConfig
+    specimen: SpecimenConfig
+    experiments: tuple  # of ExperimentConfig; empty if none given
+    identify: IdentifyConfig | None
+    output: OutputConfig
+    simulate: SimulateConfig
+    study: StudyConfig = StudyConfig()
+    warnings: tuple = ()  # of str: valid but probably unintended settings, for the user to read
+
+    @property
+    def base_dir(self) -> Path:
+        """Directory against which relative paths are resolved."""
+        return self.path.parent
+
+    @property
+    def calibration(self) -> tuple:
+        """The experiments used for calibration (role "calibration")."""
+        return tuple(e for e in self.experiments if e.role == "calibration")
+
+    @property
+    def n_y(self) -> int:
+        """Number of measured values used for calibration (sum of their blocks' n_points)."""
+        return sum(e.n_points for e in self.calibration)

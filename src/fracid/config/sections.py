@@ -1,0 +1,244 @@
+"""Validators of the sections ``[model]``, ``[specimen]``, ``[output]``, ``[simulate]`` and ``[study]``,
+and the specimen field checks the ``specimen`` overrides of ``[[experiments]]`` share.
+
+Each validator takes the :class:`~fracid.config.checker._Checker` of the file and the raw TOML table
+and returns the section's frozen dataclass (:mod:`fracid.config.schema`), or raises
+:class:`~fracid.config.schema.ConfigError`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+from fracid.config.checker import _bytes, _Checker, _show
+from fracid.config.registry import _SPECIMENS, _model_of, _model_types, _specimen_class
+from fracid.config.schema import (
+    _MODEL_KEYS,
+    _OUTPUT_KEYS,
+    _SIMULATE_KEYS,
+    _STUDY_KEYS,
+    BAR_BYTES_PER_ELEMENT,
+    BYTES_PER_UNKNOWN,
+    MAX_BAR_ELEMENTS,
+    MAX_UNKNOWNS,
+    ConfigError,
+    ModelConfig,
+    OutputConfig,
+    SimulateConfig,
+    SpecimenConfig,
+    StudyConfig,
+)
+
+
+def _range_text(cls, name: str) -> str:
+    """The valid range of parameter ``name`` of the parameter class ``cls`` in words (e.g. ``"0 < c"``,
+    ``"-1 < nu < 0.5"``): from its :class:`~fracid.model.ranges.ParameterRange` when it declares
+    ``ranges``, else the limits of ``valid_bounds`` (the interface every model's class has)."""
+    rng = getattr(cls, "ranges", {}).get(name)
+    if rng is not None:
+        return rng.describe(name)
+    lower, upper = cls.valid_bounds([name])
+    return f"{lower[0]:g} <= {name} <= {upper[0]:g}"
+
+
+def _parameter_allowed(cls, name: str) -> str:
+    return f"must be a number in the valid range {_range_text(cls, name)} [{cls.units().get(name, '-')}]"
+
+
+def _valid_parameter(cls, name: str, value: float) -> bool:
+    """Whether ``value`` lies in the valid range of ``name`` (its ``ParameterRange``, else the class's
+    ``valid_bounds``, whose open ends are moved inside). Conditions joining several parameters are
+    left to the class (see :func:`_model`)."""
+    rng = getattr(cls, "ranges", {}).get(name)
+    if rng is not None:
+        return rng.admits(value)
+    lower, upper = cls.valid_bounds([name])
+    return bool(lower[0] <= value <= upper[0])
+
+
+def _model(ck: _Checker, raw) -> ModelConfig:
+    if raw is None:
+        return ModelConfig()
+    ck.table("model", raw, _MODEL_KEYS)
+    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), _model_types())
+    cls = _model_of(kind).parameters
+    names = cls.names()
+    params = raw.get("parameters", {})
+    if not isinstance(params, dict):
+        ck.fail("model.parameters", params, f"must be a table (section) with keys among {', '.join(names)}")
+    values = {}
+    for name, value in params.items():
+        key = f"model.parameters.{name}"
+        if name not in names:
+            ck.fail(key, value, f"not a parameter of model.type = {kind!r} ({cls.__name__}); "
+                                f"allowed keys here: {', '.join(names)}")
+        values[name] = ck.number(key, value, _parameter_allowed(cls, name),
+                                 lambda v, name=name: _valid_parameter(cls, name, v))
+    try:  # conditions joining several parameters, e.g. the area of the cohesive law over c1, c2
+        cls(**values)
+    except ValueError as err:
+        ck.fail("model.parameters", params, f"rejected together by {cls.__name__} (model.type = {kind!r}): {err}")
+    return ModelConfig(type=kind, parameters=tuple(values.items()))
+
+
+def _check_model_runs_on(ck: _Checker, model: ModelConfig, specimen) -> None:
+    from fracid.models import runs_on
+
+    if not runs_on(_model_of(model.type), _specimen_class(specimen.type)):
+        fits = [kind for kind in _SPECIMENS if runs_on(_model_of(model.type), _specimen_class(kind))]
+        ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it; it runs on "
+                + (", ".join(repr(k) for k in fits) or "no built-in specimen"))
+
+
+def _field_kind(field: dataclasses.Field) -> str:
+    text = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", str(field.type))
+    return text.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
+
+
+def _specimen_error_key(message: str, fields, given) -> str | None:
+    """The specimen field a validation message is about: the first named one the user gave, else the first named."""
+    found = []
+    for name in fields:
+        match = re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", message)
+        if match:
+            found.append((match.start(), name))
+    found.sort()
+    for _, name in found:
+        if name in given:
+            return name
+    return found[0][1] if found else None
+
+
+def _specimen_options(ck: _Checker, prefix: str, raw: dict, cls) -> dict:
+    """Type-check specimen fields (``raw`` holds field names only)."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    options = {}
+    for name, value in raw.items():
+        key, ftype = f"{prefix}.{name}", _field_kind(fields[name])
+        if ftype == "float":
+            options[name] = ck.number(key, value, f"must be a number (field {name} of {cls.__name__})")
+        elif ftype == "int":
+            options[name] = ck.integer(key, value, f"must be an integer (field {name} of {cls.__name__})")
+        elif ftype == "str":
+            options[name] = ck.string(key, value, f"must be a string (field {name} of {cls.__name__})")
+        else:
+            options[name] = value
+    return options
+
+
+def _check_specimen(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+    """Build the specimen once so its own validation runs; errors name the key under ``prefix``."""
+    try:
+        cls(**options)
+    except (TypeError, ValueError) as err:
+        fields = {f.name: f for f in dataclasses.fields(cls)}
+        name = _specimen_error_key(str(err), fields, options)
+        if name is None:
+            raise ConfigError(f"{ck.path}: {prefix} ({kind}) is invalid: {err}") from None
+        value = options.get(name, getattr(cls, name, None))
+        where = f"{prefix}.{name}" if name in given else f"specimen.{name}"
+        default = "" if name in options else " (default)"
+        raise ConfigError(f"{ck.path}: {where} = {_show(value)}{default}: {err}") from None
+
+
+def _field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, str]:
+    """The dotted key of specimen field ``name`` (under ``prefix`` if given there, else ``specimen``)
+    and " (default)" when it was not given at all."""
+    return (f"{prefix}.{name}" if name in given else f"specimen.{name}"), ("" if name in options else " (default)")
+
+
+def _check_specimen_size(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+    """Refuse a mesh beyond :data:`MAX_BAR_ELEMENTS` or :data:`MAX_UNKNOWNS`, estimated from the
+    geometry without building it (the specimen is valid: :func:`_check_specimen` ran first)."""
+    specimen = cls(**options)
+    if kind == "bar":
+        n = specimen.n_elements
+        if n > MAX_BAR_ELEMENTS:
+            key, default = _field_key(prefix, "n_elements", options, given)
+            raise ConfigError(
+                f"{ck.path}: {key} = {n}{default}: a forward run of {n:,} bar elements needs about "
+                f"{_bytes(n * BAR_BYTES_PER_ELEMENT)} of memory ({BAR_BYTES_PER_ELEMENT:,} bytes per element, "
+                f"measured); at most {MAX_BAR_ELEMENTS:,} elements are allowed, and a few elements per internal length "
+                "l = sqrt(2 c) are enough")
+        return
+    elements, nodes, vertices = specimen.mesh_size()
+    unknowns = 2 * nodes + vertices
+    if unknowns > MAX_UNKNOWNS:
+        key, default = _field_key(prefix, "h_fine", options, given)
+        if prefix != "specimen" and "h_fine" not in given:  # the experiment's overrides make the mesh too large
+            default += f" with {prefix} = {{" + ", ".join(f"{k} = {_show(v)}" for k, v in given.items()) + "}"
+        shape = ", ".join(f"{name} = {value:g}" for name, value in options.items()
+                          if isinstance(value, float) and name != "h_fine")
+        raise ConfigError(
+            f"{ck.path}: {key} = {specimen.h_fine:g}{default}: the mesh of this {kind} would have about {elements:,} "
+            f"elements and {unknowns:,} unknowns (estimated from the geometry{': ' + shape if shape else ''}), "
+            f"needing about {_bytes(unknowns * BYTES_PER_UNKNOWN)} of memory in a forward run "
+            f"({BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most {MAX_UNKNOWNS:,} unknowns are allowed: "
+            "use a larger h_fine (a few elements per internal length l = sqrt(2 c) are enough)")
+
+
+def _specimen(ck: _Checker, raw) -> SpecimenConfig:
+    if raw is None:
+        ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in _SPECIMENS))
+    if not isinstance(raw, dict):
+        ck.fail("specimen", raw, "must be a table (section)")
+    if "type" not in raw:
+        ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in _SPECIMENS))
+    kind = ck.choice("specimen.type", raw["type"], tuple(_SPECIMENS))
+    cls = _specimen_class(kind)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    ck.table("specimen", raw, ("type", "control", *fields))
+    controls, _ = _SPECIMENS[kind]
+    control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
+    options = _specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
+    _check_specimen(ck, "specimen", kind, cls, options, options)
+    _check_specimen_size(ck, "specimen", kind, cls, options, options)
+    return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
+
+
+def _output(ck: _Checker, raw, base: Path) -> OutputConfig:
+    raw = ck.table("output", {} if raw is None else raw, _OUTPUT_KEYS)
+    directory = ck.string("output.directory", raw.get("directory", "results"), "must be a directory path (string)")
+    path = Path(directory).expanduser()
+    path = (path if path.is_absolute() else base / path).resolve()
+    steps = raw.get("vtk_steps", [])
+    allowed = "must be a list of step numbers (integers >= 0)"
+    if not isinstance(steps, list):
+        ck.fail("output.vtk_steps", steps, allowed)
+    for step in steps:
+        if isinstance(step, bool) or not isinstance(step, int) or step < 0:
+            ck.fail("output.vtk_steps", steps, allowed)
+    return OutputConfig(directory=path, vtk_steps=tuple(sorted(set(steps))))
+
+
+def _simulate(ck: _Checker, raw) -> SimulateConfig:
+    raw = ck.table("simulate", {} if raw is None else raw, _SIMULATE_KEYS)
+    target = None
+    if "target" in raw:
+        target = ck.number("simulate.target", raw["target"], "must be a number > 0 [mm] (final control value)",
+                           lambda v: v > 0)
+    return SimulateConfig(
+        target=target,
+        stop_force_fraction=ck.number("simulate.stop_force_fraction", raw.get("stop_force_fraction", 0.1),
+                                      "must be a number with 0 < f < 1 (fraction of the peak force)",
+                                      lambda v: 0 < v < 1),
+        damage_threshold=ck.number("simulate.damage_threshold", raw.get("damage_threshold", 0.0),
+                                   "must be a number with 0 <= t < 1 (damage)", lambda v: 0 <= v < 1),
+    )
+
+
+def _study(ck: _Checker, raw) -> StudyConfig:
+    raw = ck.table("study", {} if raw is None else raw, _STUDY_KEYS)
+    return StudyConfig(
+        starts=ck.integer("study.starts", raw.get("starts", 3), "must be an integer >= 0 (0 or 1: no multi-start check)",
+                          lambda v: v >= 0),
+        replicates=ck.integer("study.replicates", raw.get("replicates", 5),
+                              "must be 0 (no stability check) or an integer >= 2", lambda v: v == 0 or v >= 2),
+        seed=ck.integer("study.seed", raw.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0),
+        tolerance=ck.number("study.tolerance", raw.get("tolerance", 0.1),
+                            "must be a number with 0 < t < 1 (largest relative std called identified)",
+                            lambda v: 0 < v < 1),
+        prior=ck.choice("study.prior", raw.get("prior", "knn"), ("knn", "bounds")),
+    )
