@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.report import bar_mesh, write_vtk  # imports meshio only when writing
+from fracid.report import write_vtk  # imports meshio only when writing
 from fracid.report.vtk import corner_to_nodes
 
 meshio = pytest.importorskip("meshio")
@@ -24,7 +24,7 @@ def bar_state():
 
 def test_bar_round_trip(tmp_path, bar_state):
     bar, fields = bar_state
-    nodes, cells, cell_type = bar_mesh(bar.vertices())
+    nodes, cells, cell_type = bar.describe().output_mesh()
     assert nodes.shape == (41, 1) and cells.shape == (20, 3) and cell_type == "line3"
     path = write_vtk(tmp_path / "bar.vtu", nodes, cells, cell_type, fields, n_u_components=1)
     mesh = meshio.read(path)
@@ -53,7 +53,7 @@ def test_local_model_has_no_ebar(tmp_path):
     result = fracid.simulate(bar, fracid.DamageParameters(), regularization="local", target=0.005, stop_force_fraction=None)
     fields = result.fields[result.n_steps]
     assert "ebar" not in fields
-    mesh = meshio.read(write_vtk(tmp_path / "local.vtu", *bar_mesh(bar.vertices()), fields))
+    mesh = meshio.read(write_vtk(tmp_path / "local.vtu", *bar.describe().output_mesh(), fields))
     assert set(mesh.point_data) == {"displacement"}
     np.testing.assert_array_equal(mesh.point_data["displacement"][:, 0], fields["u"])
 
@@ -142,7 +142,7 @@ def test_missing_meshio_gives_a_clear_error(tmp_path, monkeypatch, bar_state):
     bar, fields = bar_state
     monkeypatch.setitem(sys.modules, "meshio", None)
     with pytest.raises(ImportError, match=r"pip install 'fracid\[vtk\]'"):
-        write_vtk(tmp_path / "bar.vtu", *bar_mesh(bar.vertices()), fields)
+        write_vtk(tmp_path / "bar.vtu", *bar.describe().output_mesh(), fields)
 
 
 def test_importing_the_report_package_does_not_import_meshio():
@@ -166,6 +166,6 @@ def test_write_result_vtk_writes_requested_steps(tmp_path, which):
     files = write_result_vtk(tmp_path / "out", specimen, result)
     assert [f.name for f in files] == ["step_0002.vtu", "step_0005.vtu", f"step_{result.n_steps:04d}.vtu"]
     last = meshio.read(files[-1])
-    nodes, cells, _ = specimen.output_mesh()
+    nodes, cells, _ = specimen.describe().output_mesh()
     assert last.points.shape[0] == len(nodes)
     assert last.cell_data["damage_max"][0].max() > 0.0  # past the peak: damaged cells

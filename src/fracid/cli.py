@@ -136,7 +136,7 @@ def run_simulate(args) -> int:
     settings = simulate_settings(cfg)
     settings.pop("regularization", None)  # the model carries its own
     if settings.get("target") is None:
-        settings["target"] = specimen.default_target(params)
+        settings["target"] = model.default_target(specimen, params)
     out = _out_dir(args, cfg)
     with _working_in(args, out), progress_bar(settings["target"], "forward analysis", _progress(args), unit="mm") as bar:
         result = model.simulate(specimen, params, callback=lambda step, tau, force: bar.update(tau - bar.n),
@@ -249,19 +249,19 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0}, "stability": {"sta
 
 def run_study_command(args) -> int:
     from fracid.config import build_data, build_held_out, build_operator, build_space, study_settings
-    from fracid.inverse.study import run_study
+    from fracid.inverse.study import StudySettings, run_study
     from fracid.report.study import write_study
 
     cfg = _load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
-    settings = {**study_settings(cfg), **_STUDY_PARTS[args.command]}
+    settings = StudySettings().replace(**{**study_settings(cfg), **_STUDY_PARTS[args.command]})
     held_out = build_held_out(cfg) if args.command == "study" else []
     out = _out_dir(args, cfg)
     with _working_in(args, out, store=True) as store, _executor(args) as executor:
-        study = run_study(operator, data, space, held_out=held_out, executor=executor, store=store,
+        study = run_study(operator, data, space, settings, held_out=held_out, executor=executor, store=store,
                           progress=_progress(args), log=lambda text: _say(args, text),
-                          retry_failed=args.retry_failed, **settings)
+                          retry_failed=args.retry_failed)
         size = None
         if args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
@@ -278,7 +278,7 @@ def run_study_command(args) -> int:
 
 def run_sensitivity_command(args) -> int:
     from fracid.config import build_data, build_operator, build_parameters, build_space
-    from fracid.inverse.analyses import sensitivity_history
+    from fracid.inverse.sensitivity import sensitivity_history
     from fracid.inverse.runs import StoredOperator
     from fracid.inverse.uniqueness import bounds_covariance
     from fracid.report.figures import sensitivity_figure, to_png

@@ -13,16 +13,24 @@ damage_threshold, observables)``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
     :class:`~fracid.model.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
 
-:class:`DamageModel` wraps the implicit gradient-enhanced damage model, its local variant and the
-integral-type nonlocal model.
+The models below build their problem from the specimen's
+:class:`~fracid.specimens.description.Description` (``specimen.describe()``): a formulation (gradient,
+local or integral damage; cohesive interface; crack band) with a material law
+(:mod:`fracid.model.laws`). :data:`MODEL_TYPES` is the registry the configuration reads.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
 
-from fracid.model.parameters import DamageParameters
+from fracid.model.crack_band_problem import CrackBandProblem, element_extent
+from fracid.model.cohesive_problem import CohesiveCrackProblem, crack_edges
+from fracid.model.fpz import zone_width_observer
+from fracid.model.laws import DamageLaw, HordijkLaw
+from fracid.model.path_following import StepOptions, follow_path
+from fracid.model.problem import FORMULATIONS
+from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
 class ForwardModel(Protocol):
@@ -33,97 +41,188 @@ class ForwardModel(Protocol):
 
 
 def runs_on(model, specimen) -> bool:
-    """Whether ``model`` can run on ``specimen`` (an instance or its class): the specimen offers the
-    builder the model names in ``specimen_builder`` (models without one run on every specimen)."""
-    builder = getattr(model, "specimen_builder", None)
-    return builder is None or hasattr(specimen, builder)
+    """Whether ``model`` can run on ``specimen`` (an instance or its class); models without a
+    ``runs_on`` method run on every specimen."""
+    check = getattr(model, "runs_on", None)
+    if check is None:
+        return True
+    return check(specimen() if isinstance(specimen, type) else specimen)  # a class: its default instance
+
+
+def _description(specimen):
+    return specimen if hasattr(specimen, "node_sets") else specimen.describe()
+
+
+def select_observers(observers: dict, names=None) -> dict:
+    """The observers named in ``names`` (all if None). Other names are left out: the energies and
+    the problem's functionals are recorded at every step anyway."""
+    if names is None:
+        return observers
+    return {name: fn for name, fn in observers.items() if name in set(names)}
+
+
+class _PathFollowing:
+    """``simulate`` of the models below: build the problem, follow the path with the specimen's
+    default control, target and steps."""
+
+    def scales(self, params) -> dict:
+        """Characteristic strain (and opening) a specimen sizes its default control with."""
+        return self.law.scales(params)
+
+    def default_target(self, specimen, params) -> float:
+        """The specimen's default final control value for this model with ``params`` [mm]."""
+        return specimen.default_target(self.scales(params))
+
+    def simulate(self, specimen, params, *, control=None, target=None, stop_force_fraction=0.1, steps=None,
+                 damage_threshold=0.0, observables=None, **options):
+        description = _description(specimen)  # described once: the mesh is built once per run
+        reason = self.why_not(description)
+        if reason is not None:
+            raise TypeError(f"the {self.key} model does not run on a {type(specimen).__name__}: {reason}")
+        problem = self.build(description, params)
+        target = target if target is not None else self.default_target(specimen, params)
+        if steps is None:
+            steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
+        observers = self.observers(description, params, damage_threshold)
+        return follow_path(problem, control or specimen.default_control, target, steps=steps,
+                           stop_force_fraction=stop_force_fraction,
+                           observers=select_observers(observers, observables), **options)
+
+    def runs_on(self, specimen) -> bool:
+        return self.why_not(specimen) is None
 
 
 @dataclass(frozen=True)
-class DamageModel:
-    """Continuum damage with exponential softening (SPEC 1): ``"gradient"`` (implicit gradient
-    enhancement), ``"local"`` (no regularisation; mesh-dependent, for comparison) or ``"integral"``
-    (Gaussian average of the equivalent strain, internal length l = sqrt(2 c): same parameters as
-    the gradient model)."""
+class DamageModel(_PathFollowing):
+    """Continuum damage: ``"gradient"`` (implicit gradient enhancement), ``"local"`` (no
+    regularisation; mesh-dependent, for comparison) or ``"integral"`` (Gaussian average of the
+    equivalent strain, internal length l = sqrt(2 c)), with a damage law (exponential softening and
+    the modified von Mises equivalent strain by default; see docs/theory.md, section 1).
+
+    Observable: the width of the damaged zone where the specimen measures it (``fpz_width`` or
+    ``damaged_zone_width`` [mm], the zone where omega exceeds ``damage_threshold``).
+    """
 
     regularization: str = "gradient"
-    parameters: ClassVar[type] = DamageParameters
+    law: DamageLaw = field(default_factory=DamageLaw)
 
     def __post_init__(self):
-        if self.regularization not in ("gradient", "local", "integral"):
+        if self.regularization not in FORMULATIONS:
             raise ValueError(f"regularization = {self.regularization!r}; choose 'gradient', 'local' or 'integral'")
 
     @property
-    def key(self) -> str:
-        return f"{self.regularization}-damage"
-
-    def simulate(self, specimen, params, **options):
-        from fracid.forward import simulate
-
-        return simulate(specimen, params, regularization=self.regularization, **options)
-
-
-class _HordijkModel:
-    """Models whose parameters are those of Hordijk's law and an elastic bulk."""
+    def parameters(self) -> type:
+        return self.law.parameters
 
     @property
-    def parameters(self):
-        from fracid.model.cohesive import CohesiveParameters
+    def key(self) -> str:
+        suffix = "" if self.law.name == "exponential" else f"-{self.law.name}"
+        return f"{self.regularization}-damage{suffix}"
 
-        return CohesiveParameters
+    def why_not(self, specimen):
+        d = _description(specimen)
+        if d.strength_factor is not uniform:
+            return "its imperfection is a reduced tensile strength, which a damage law does not read"
+        return None
+
+    def build(self, specimen, params):
+        """The problem of this formulation on ``specimen`` (a specimen or its description)."""
+        d = _description(specimen)
+        disc = discretize(d)
+        return FORMULATIONS[self.regularization](
+            disc, self.law, params, conditions(d), stiffness_factor=at_points(d.stiffness_factor, disc),
+            damageable=at_points(d.damageable, disc), symmetry_planes=d.symmetry_planes)
+
+    def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
+        zone = description.zone
+        if zone is None:
+            return {}
+        return {zone.name: zone_width_observer(zone, self.law.softening.kappa_at_damage(damage_threshold, params))}
 
 
 @dataclass(frozen=True)
-class CohesiveCrackModel(_HordijkModel):
-    """Discrete cohesive crack with Hordijk's law along the ligament, elastic bulk (SPEC 5).
-
-    Specimens must offer ``build_cohesive_problem(params)`` (the notched beam does). Observable:
-    ``crack_length`` [mm], the length of the ligament whose faces have separated.
+class CohesiveCrackModel(_PathFollowing):
+    """Discrete cohesive crack with Hordijk's law along the specimen's crack path (a symmetry line of
+    the model), elastic bulk (docs/theory.md, section 5). The faces are tied by a penalty
+    ``penalty_factor * E / h`` [MPa/mm] (h the finest element size along the path) until the traction
+    reaches ft. Observable: ``crack_length`` [mm], the length of the path whose faces have separated.
     """
 
     penalty_factor: float = 1000.0
+    law: HordijkLaw = HordijkLaw()
     key: ClassVar[str] = "cohesive-crack-hordijk"
-    specimen_builder: ClassVar[str] = "build_cohesive_problem"
 
-    def simulate(self, specimen, params, **options):
-        if not runs_on(self, specimen):
-            raise TypeError(f"{type(specimen).__name__} has no cohesive crack (build_cohesive_problem)")
-        problem = specimen.build_cohesive_problem(params, self.penalty_factor)
-        observers = {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
-        return _follow(problem, specimen, params, observers, **options)
+    @property
+    def parameters(self) -> type:
+        return self.law.parameters
+
+    def why_not(self, specimen):
+        d = _description(specimen)
+        if d.dim != 2:
+            return "it is a plane-stress model"
+        if d.crack is None or d.crack.nodes is None or not d.crack.mirrored:
+            return "the specimen has no crack path on a symmetry line"
+        return None
+
+    def build(self, specimen, params):
+        d = _description(specimen)
+        disc = discretize(d)
+        path = d.nodes_of(d.crack.nodes)
+        edges = crack_edges(d.nodes, d.cells, disc.u_dofs, path, d.crack.normal)
+        h = d.crack.element_size or float((edges[2][:, 2] - edges[2][:, 0]).min())
+        return CohesiveCrackProblem(disc, self.law, params, conditions(d, open_crack=True, discrete_crack=True), edges,
+                                    float(d.section), self.penalty_factor * params.E / h,
+                                    stiffness_factor=at_points(d.stiffness_factor, disc))
+
+    def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
+        return {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
 
 
 @dataclass(frozen=True)
-class CrackBandModel(_HordijkModel):
-    """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width (SPEC 5).
-
-    Same parameters as the cohesive crack (:class:`~fracid.model.cohesive.CohesiveParameters`), so the
-    two are directly comparable. Specimens must offer ``build_crack_band_problem(params)`` (the notched
-    beam and the tension strip do).
+class CrackBandModel(_PathFollowing):
+    """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width
+    (docs/theory.md, section 5). Same parameters as the cohesive crack, so the two are directly
+    comparable. The band is confined to the elements along the specimen's crack path (in a half
+    model a band elsewhere would be mirrored into two cracks), or free where the specimen has no path.
     """
 
+    law: HordijkLaw = HordijkLaw()
     key: ClassVar[str] = "crack-band-hordijk"
-    specimen_builder: ClassVar[str] = "build_crack_band_problem"
 
-    def simulate(self, specimen, params, **options):
-        if not runs_on(self, specimen):
-            raise TypeError(f"{type(specimen).__name__} has no crack band model (build_crack_band_problem)")
-        return _follow(specimen.build_crack_band_problem(params), specimen, params, {}, **options)
+    @property
+    def parameters(self) -> type:
+        return self.law.parameters
+
+    def why_not(self, specimen):
+        d = _description(specimen)
+        if d.dim != 2:
+            return "it is a plane-stress model"
+        if d.crack is None:
+            return "the specimen says nothing of where the crack runs"
+        return None
+
+    def build(self, specimen, params):
+        d = _description(specimen)
+        disc = discretize(d)
+        direction = [0.0, 0.0]
+        direction[d.crack.normal] = 1.0
+        width = element_extent(d.nodes, d.cells, direction)
+        crackable = 1.0
+        if d.crack.nodes is not None:
+            on_path = (d.nodes_of(d.crack.nodes)[None, None, :] == d.cells[:, :4, None]).any(axis=2).sum(axis=1) >= 2
+            crackable = at_points(lambda points: on_path[:, None] * _ones(points), disc)
+        if d.crack.mirrored:
+            width = 2.0 * width
+        return CrackBandProblem(disc, self.law, params, conditions(d, open_crack=True), width,
+                                strength_factor=at_points(d.strength_factor, disc), crackable=crackable,
+                                stiffness_factor=at_points(d.stiffness_factor, disc))
+
+    def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
+        return {}
 
 
-def _follow(problem, specimen, params, observers, *, control=None, target=None, stop_force_fraction=0.1,
-            steps=None, damage_threshold=0.0, observables=None, **options):
-    """Path following of a specimen's problem with the specimen's default control, target and steps
-    (``damage_threshold`` concerns the damage models' FPZ width only)."""
-    from fracid.forward import select_observers
-    from fracid.model.path_following import StepOptions, follow_path
-
-    target = target if target is not None else specimen.default_target(params)
-    if steps is None:
-        steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
-    return follow_path(problem, control or specimen.default_control, target, steps=steps,
-                       stop_force_fraction=stop_force_fraction,
-                       observers=select_observers(observers, observables), **options)
+def _ones(points):
+    return 1.0 + 0.0 * points[..., 0]
 
 
 def parameter_units(model_or_params) -> dict:

@@ -88,8 +88,8 @@ CONTROL_SCALE_LIMIT = 30.0
 
 
 def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> None:
-    specimen = build_specimen(cfg, exp)
-    if not hasattr(specimen, "default_target"):
+    specimen, model = build_specimen(cfg, exp), build_model(cfg)
+    if not hasattr(model, "default_target"):
         return
     params = build_parameters(cfg)
     candidates = [params]
@@ -100,7 +100,7 @@ def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> No
             except ValueError:
                 continue
     try:
-        target = max(float(specimen.default_target(p)) for p in candidates)
+        target = max(float(model.default_target(specimen, p)) for p in candidates)
     except (AttributeError, ValueError, TypeError):
         return
     where = f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of {exp.file}"

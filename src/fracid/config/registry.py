@@ -1,16 +1,17 @@
 """The model and specimen types a configuration may name.
 
-The model types are read from :data:`fracid.models.MODEL_TYPES` at each call (a model registered
-there needs no change here); the specimen classes are imported from :mod:`fracid.specimens` when
-first asked for.
+The model types are read from :data:`fracid.models.MODEL_TYPES` at each call, the specimen types and
+their controls and observables from :data:`fracid.specimens.SPECIMENS`: a model or specimen registered
+there needs no change here.
 """
 
 from __future__ import annotations
 
+from fracid.specimens import SPECIMENS
+
 
 def _model_types() -> tuple:
-    """The ``[model] type`` names: those of :data:`fracid.models.MODEL_TYPES` at the time of the call,
-    so that a model registered there needs no change here."""
+    """The ``[model] type`` names: those of :data:`fracid.models.MODEL_TYPES` at the time of the call."""
     from fracid.models import MODEL_TYPES
 
     return tuple(MODEL_TYPES)
@@ -23,22 +24,8 @@ def _model_of(kind: str):
 
 
 def _specimen_class(kind: str):
-    if kind == "notched-beam":
-        from fracid.specimens.beam import NotchedBeam
-
-        return NotchedBeam
-    if kind == "dogbone":
-        from fracid.specimens.dogbone import DogBone
-
-        return DogBone
-    from fracid.specimens.bar import BarWithWeakZone
-
-    return BarWithWeakZone
+    return SPECIMENS[kind]
 
 
 #: specimen type -> (controls, the first being the default; local observables [mm])
-_SPECIMENS = {
-    "notched-beam": (("cmod", "deflection"), ("fpz_width",)),
-    "dogbone": (("elongation", "platen_displacement"), ("fpz_width",)),
-    "bar": (("end_displacement", "weak_zone_elongation"), ("damaged_zone_width",)),
-}
+_SPECIMENS = {kind: (cls.controls, cls.observables) for kind, cls in SPECIMENS.items()}

@@ -21,9 +21,6 @@ from scipy.optimize import least_squares
 
 from fracid.model.path_following import ConvergenceError
 from fracid.parallel import run_batch
-from fracid.specimens.bar import BarWithWeakZone
-from fracid.specimens.beam import NotchedBeam
-from fracid.specimens.dogbone import DogBone
 
 __all__ = [
     "SizeEffectComparison",
@@ -241,17 +238,13 @@ def _covariance(J: np.ndarray) -> np.ndarray:
 
 
 def _size_and_section(specimen) -> tuple[float, float]:
-    """Characteristic size D [mm] and the area A_N [mm^2] with sigma_N = F / A_N."""
-    if isinstance(specimen, DogBone):
-        return specimen.size, specimen.ligament_area
-    if isinstance(specimen, NotchedBeam):
-        # sigma_N = 3 F S / (2 b D^2): the elastic bending stress of the unnotched beam
-        D, b, S = specimen.depth, specimen.thickness, specimen.span
-        return D, 2.0 * b * D**2 / (3.0 * S)
-    if isinstance(specimen, BarWithWeakZone):
-        return specimen.length, specimen.area
-    raise TypeError(f"no nominal strength is defined for a {type(specimen).__name__}; "
-                    "use a DogBone, a NotchedBeam or a BarWithWeakZone")
+    """Characteristic size D [mm] and the area A_N [mm^2] with sigma_N = F / A_N, as the specimen
+    declares them (``characteristic_size``, ``nominal_section``)."""
+    try:
+        return float(specimen.characteristic_size), float(specimen.nominal_section)
+    except AttributeError:
+        raise TypeError(f"no nominal strength is defined for a {type(specimen).__name__} (it declares no "
+                        "characteristic_size and nominal_section); use a DogBone, a NotchedBeam or a BarWithWeakZone") from None
 
 
 def specimen_size(specimen) -> float:

@@ -7,8 +7,7 @@ import numpy as np
 from fracid.model.assembly import assemble_vector, norm2
 from fracid.model.crack_band import crack_band_stress, crack_direction_stress, snap_back_limit
 from fracid.model.forms import ElementArrays, _btdb
-from fracid.model.parameters import DamageParameters
-from fracid.model.problem import DamageProblem
+from fracid.model.problem import ContinuumProblem
 
 
 def element_extent(nodes, cells, direction) -> np.ndarray:
@@ -18,16 +17,17 @@ def element_extent(nodes, cells, direction) -> np.ndarray:
     return projected.max(axis=1) - projected.min(axis=1)
 
 
-class CrackBandProblem(DamageProblem):
+class CrackBandProblem(ContinuumProblem):
     """Smeared crack band (rotating crack, Hordijk softening) on a plane-stress discretisation.
 
-    The boundary conditions, load pattern, functionals and dof numbering are those of
-    :class:`~fracid.model.problem.DamageProblem` (displacements only); the material law is replaced.
+    Displacement unknowns only (:class:`~fracid.model.problem.ContinuumProblem`); the material is the
+    crack band's.
 
     Parameters
     ----------
     disc : MixedDiscretization
         Plane stress.
+    law : HordijkLaw
     params : CohesiveParameters
         E, nu of the bulk and ft, Gf, c1, c2 of the crack law.
     band_width : array_like, shape (n_el,)
@@ -38,16 +38,17 @@ class CrackBandProblem(DamageProblem):
         factor): an imperfection that fixes where the band forms without changing Gf [-].
     crackable : float or ndarray, shape (n_el, n_q)
         1 where a crack may form, 0 where the material stays elastic [-].
-    **conditions
-        ``fixed_dofs``, ``load``, ``functionals``, ``tied``, ``symmetry_factor``, ``stiffness_factor``
-        as for :class:`~fracid.model.problem.DamageProblem`.
+    conditions : Conditions
+    stiffness_factor : float or ndarray
+        Young's modulus relative to ``params.E`` at the integration points [-].
     """
 
-    def __init__(self, disc, params, band_width, *, strength_factor=1.0, crackable=1.0, **conditions):
+    def __init__(self, disc, law, params, conditions, band_width, *, strength_factor=1.0, crackable=1.0,
+                 stiffness_factor=1.0):
         if disc.strain_state.n_components != 3:
             raise ValueError("the crack band model is written for plane stress (3 strain components)")
-        super().__init__(disc, DamageParameters(E=params.E, nu=params.nu), regularization="local", **conditions)
-        self.crack = params  # self.params: the elastic bulk
+        super().__init__(disc, params, conditions, stiffness_factor=stiffness_factor)
+        self.law = law
         h = np.asarray(band_width, dtype=float)
         if h.shape != (disc.n_elements,) or not np.all(h > 0):
             raise ValueError(f"band_width must be {disc.n_elements} positive element widths [mm]")
@@ -69,7 +70,7 @@ class CrackBandProblem(DamageProblem):
 
     def _stress(self, ue, kappa_old):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
-        _, wc, c1, c2 = self.crack.law()
+        _, wc, c1, c2 = self.params.law()
         law = (wc / self.strength, c1, c2)
         return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu, self.ft,
                                  law, self.crackable)
@@ -87,7 +88,7 @@ class CrackBandProblem(DamageProblem):
         arrays = ElementArrays(forces, self._tangent, {"u": forces}, kappa, omega)
         return residual, arrays, {"u": norm2(residual)}
 
-    def elastic_energy(self, q, omega):
+    def elastic_energy(self, q, kappa, omega):
         """Energy recovered on unloading to zero stress, 1/2 int eps . sigma dV (secant unloading) [N mm]."""
         ue = self.gather(q)
         eps = np.einsum("eqsi,ei->eqs", self.disc.strain_operator, ue)

@@ -1,4 +1,7 @@
-"""Strain states: the unit elastic matrix (E = 1) and the matching equivalent strain."""
+"""Strain states (kinematic assumptions): the number of strain components and the unit elastic matrix (E = 1).
+
+The equivalent strain that drives damage is a material law (:mod:`fracid.model.laws`), not part of the
+kinematics."""
 
 from __future__ import annotations
 
@@ -6,8 +9,6 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-
-from fracid.model.equivalent_strain import modified_von_mises_plane_stress, modified_von_mises_uniaxial
 
 
 def uniaxial_matrix(nu: float) -> np.ndarray:
@@ -22,13 +23,12 @@ def plane_stress_matrix(nu: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class StrainState:
-    """A kinematic assumption: number of strain components, unit elastic matrix and equivalent strain."""
+    """A kinematic assumption: its name, number of strain components and unit elastic matrix."""
 
     name: str
     n_components: int
     unit_elastic_matrix: Callable[[float], np.ndarray]
-    equivalent_strain: Callable
 
 
-UNIAXIAL = StrainState("uniaxial", 1, uniaxial_matrix, modified_von_mises_uniaxial)
-PLANE_STRESS = StrainState("plane stress", 3, plane_stress_matrix, modified_von_mises_plane_stress)
+UNIAXIAL = StrainState("uniaxial", 1, uniaxial_matrix)
+PLANE_STRESS = StrainState("plane stress", 3, plane_stress_matrix)

@@ -1,8 +1,9 @@
 """Element residuals and consistent tangents of the damage models, for all elements at once.
 
 Pure functions over the arrays of a :class:`~fracid.model.discretization.MixedDiscretization`:
-the material law enters only through :func:`~fracid.model.damage.exponential_damage`,
-:func:`~fracid.model.damage.update_history` and the equivalent strain of the strain state.
+the material law enters only through a :class:`~fracid.model.laws.DamageLaw` (its softening law and
+equivalent strain, values and derivatives) and the history update
+:func:`~fracid.model.damage.update_history`.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from fracid.model.damage import exponential_damage, update_history
+from fracid.model.damage import update_history
 from fracid.model.nonlocal_average import NonlocalAveraging, softening_coupling
 
 
@@ -39,18 +40,19 @@ class ModelConstants(NamedTuple):
     E: np.ndarray  # Young's modulus at every integration point [MPa], (n_el, n_q)
     D: np.ndarray  # unit elastic matrix (n_strain, n_strain)
     DB: np.ndarray  # D times the strain operator, (n_el, n_q, n_strain, n_u)
-    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant
+    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant (None without ebar)
     damageable: np.ndarray  # 1 where the material can damage, 0 in elastic parts (platens), (n_el, n_q)
 
 
-def model_constants(disc, params, stiffness_factor, damageable=1.0) -> ModelConstants:
-    """Precompute the parts of the tangent that do not change during a computation."""
+def model_constants(disc, params, stiffness_factor, damageable=1.0, ebar: bool = True) -> ModelConstants:
+    """Precompute the parts of the tangent that do not change during a computation (``ebar``: also
+    the matrix of the gradient model's diffusion equation, which needs ``params.c``)."""
     E = params.E * np.broadcast_to(stiffness_factor, disc.weights.shape)
     mask = np.broadcast_to(np.asarray(damageable, dtype=float), disc.weights.shape)
     D = disc.strain_state.unit_elastic_matrix(params.nu)
     DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
     N, G, w = disc.ebar_shape, disc.ebar_gradient, disc.weights
-    M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
+    M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G) if ebar else None
     return ModelConstants(E, D, DB, M, mask)
 
 
@@ -65,8 +67,8 @@ def _bt(vector, B):
     return np.matmul(vector[..., None, :], B)[..., 0, :]
 
 
-def _damage(params, const, kappa):
-    omega, d_omega = exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
+def _damage(law, params, const, kappa):
+    omega, d_omega = law.damage(kappa, params)
     return omega * const.damageable, d_omega * const.damageable
 
 
@@ -78,11 +80,14 @@ def _secant_equilibrium(B, const, w, ue, omega):
     return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), _btdb(B * w_sec[..., None, None], const.DB)
 
 
-def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
+def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
     """Implicit gradient-enhanced damage: residuals of equilibrium and of the diffusion equation.
 
     Parameters
     ----------
+    law : DamageLaw
+    params
+        The law's parameters (``E``, ``nu`` and ``c`` besides the law's own).
     ue, ee : ndarray, shape (n_el, n_u) and (n_el, n_e)
         Element displacements [mm] and nonlocal strains [-].
     kappa_old : ndarray, shape (n_el, n_q)
@@ -94,9 +99,9 @@ def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_
     nu = B.shape[-1]
     eps = np.einsum("eqsi,ei->eqs", B, ue)
     ebar = ee @ N.T
-    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, ebar)
-    omega, d_omega = _damage(params, const, kappa)
+    omega, d_omega = _damage(law, params, const, kappa)
     bt_sigma, f_u, out_tangent[:, :nu, :nu] = _secant_equilibrium(B, const, w, ue, omega)
     f_eq = (w * eq) @ N
     f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
@@ -106,20 +111,20 @@ def gradient_damage(disc, params, const: ModelConstants, ue, ee, kappa_old, out_
     return ElementArrays(np.concatenate([f_u, f_e], axis=1), out_tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
 
 
-def local_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
+def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
     """Local damage (no regularisation): kappa follows the local equivalent strain; mesh-dependent."""
     B, w = disc.strain_operator, disc.weights
     eps = np.einsum("eqsi,ei->eqs", B, ue)
-    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, eq)
-    omega, d_omega = _damage(params, const, kappa)
+    omega, d_omega = _damage(law, params, const, kappa)
     bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
     softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1), _bt(d_eq, B))
     out_tangent[:] = secant - softening
     return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)
 
 
-def integral_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
+def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
     """Integral-type nonlocal damage: kappa follows the Gaussian average ebar = A eps_eq of the
     local equivalent strain (see :mod:`fracid.model.nonlocal_average`).
 
@@ -143,10 +148,10 @@ def integral_damage(disc, params, const: ModelConstants, ue, kappa_old, out_tang
     """
     B, w = disc.strain_operator, disc.weights
     eps = np.einsum("eqsi,ei->eqs", B, ue)
-    eq, d_eq = disc.strain_state.equivalent_strain(eps, params.nu, params.eta)
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
     kappa, loading = update_history(kappa_old, ebar)
-    omega, d_omega = _damage(params, const, kappa)
+    omega, d_omega = _damage(law, params, const, kappa)
     bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
     g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
     h = _bt(d_eq, B)  # d eps_eq / d u at each point
@@ -160,3 +165,9 @@ def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
     eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
     return 0.5 * float(np.sum(disc.weights * (1.0 - omega) * const.E * np.sum(eps * sigma_eff, axis=-1)))
+
+
+def elastic_bulk(disc, const: ModelConstants, ue, out_tangent) -> ElementArrays:
+    """Linear elastic material (the bulk of a discrete-crack model): internal forces and stiffness."""
+    _, f_u, out_tangent[:] = _secant_equilibrium(disc.strain_operator, const, disc.weights, ue, np.zeros(disc.weights.shape))
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, np.zeros(disc.weights.shape), np.zeros(disc.weights.shape))

@@ -268,7 +268,7 @@ class _Recorder:
         rec["tau"].append(tau)
         rec["force"].append(force)
         rec["load_point"].append(displacement)
-        rec["elastic"].append(problem.elastic_energy(q, arrays.omega))
+        rec["elastic"].append(problem.elastic_energy(q, arrays.kappa, arrays.omega))
         for name, vec in problem.functionals.items():
             rec[name].append(dot(vec, q))
         for name, fn in self.observers.items():

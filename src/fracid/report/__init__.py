@@ -2,6 +2,6 @@
 optional dependencies imported when used)."""
 
 from fracid.report.html import fit_metrics, write_report
-from fracid.report.vtk import bar_mesh, write_result_vtk, write_vtk
+from fracid.report.vtk import write_result_vtk, write_vtk
 
-__all__ = ["bar_mesh", "fit_metrics", "write_report", "write_result_vtk", "write_vtk"]
+__all__ = ["fit_metrics", "write_report", "write_result_vtk", "write_vtk"]

@@ -22,24 +22,6 @@ _CELL_TYPES = {
 }
 
 
-def bar_mesh(vertices):
-    """Nodes, cells and cell type of the quadratic bar elements of
-    :func:`~fracid.model.discretization.bar_discretization` (vertex i is node 2 i, mid-points odd).
-
-    Returns
-    -------
-    nodes : ndarray, shape (2 n_el + 1, 1)
-    cells : ndarray of int, shape (n_el, 3)
-        End, end, mid-point (VTK order of "line3").
-    cell_type : str
-    """
-    x = np.asarray(vertices, dtype=float)
-    nodes = np.empty(2 * x.size - 1)
-    nodes[0::2], nodes[1::2] = x, 0.5 * (x[:-1] + x[1:])
-    el = np.arange(x.size - 1)
-    return nodes[:, None], np.stack([2 * el, 2 * el + 2, 2 * el + 1], axis=1), "line3"
-
-
 def corner_to_nodes(values, cells, cell_type: str, n_nodes: int, corner_nodes=None) -> np.ndarray:
     """Extend a field known at the corner nodes to all nodes (higher-order nodes: mean of their corners).
 
@@ -176,7 +158,7 @@ def write_result_vtk(directory, specimen, result, stem: str = "step") -> list:
     directory : str or Path
         Created if missing.
     specimen
-        The specimen the result comes from (it provides ``output_mesh()``).
+        The specimen the result comes from (its description provides ``output_mesh()``).
     result : PathResult
         Steps written are those in ``result.fields`` (see ``field_steps`` of ``simulate``).
 
@@ -189,7 +171,7 @@ def write_result_vtk(directory, specimen, result, stem: str = "step") -> list:
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    nodes, cells, cell_type = specimen.output_mesh()
+    nodes, cells, cell_type = specimen.describe().output_mesh()
     return [
         write_vtk(directory / f"{stem}_{step:04d}.vtu", nodes, cells, cell_type, result.fields[step])
         for step in sorted(result.fields)

@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from fracid.model.damage import kappa_at_damage
-from fracid.model.discretization import bar_discretization
-from fracid.model.problem import DamageProblem
 from fracid.specimens.checks import require_positive
-from fracid.specimens.observables import superlevel_length
+from fracid.specimens.description import Description, Load, Measure, Support, ZoneWidth
 
 _WEAKENINGS = ("modulus", "area")
 _PROFILES = ("step", "hat")
@@ -40,9 +38,9 @@ class BarWithWeakZone:
     n_elements : int
         Number of elements (uniform mesh; the zone edges fall on element boundaries).
 
-    Controls (``problem.functionals``): ``end_displacement`` (plain displacement control) and
-    ``weak_zone_elongation`` (elongation over the weak zone, for snap-back).
-    Observer: ``damaged_zone_width`` [mm], the length where the damage exceeds a threshold.
+    Controls: ``end_displacement`` (plain displacement control) and ``weak_zone_elongation``
+    (elongation over the weak zone, for snap-back). Observable of the damage models:
+    ``damaged_zone_width`` [mm], the length where the damage exceeds a threshold.
     """
 
     length: float = 100.0
@@ -54,6 +52,8 @@ class BarWithWeakZone:
     n_elements: int = 200
 
     default_control = "end_displacement"
+    controls: ClassVar[tuple] = ("end_displacement", "weak_zone_elongation")
+    observables: ClassVar[tuple] = ("damaged_zone_width",)
 
     def __post_init__(self):
         require_positive(self, ("length", "area", "weak_zone_width"), " [mm or mm^2]")
@@ -67,6 +67,16 @@ class BarWithWeakZone:
             raise ValueError(f"profile = {self.profile!r}; choose one of {_PROFILES}")
         if int(self.n_elements) != self.n_elements or self.n_elements < 3:
             raise ValueError(f"n_elements = {self.n_elements!r}; it must be an integer >= 3")
+
+    @property
+    def characteristic_size(self) -> float:
+        """L, the length [mm]."""
+        return self.length
+
+    @property
+    def nominal_section(self) -> float:
+        """The cross-section outside the weak zone [mm^2] (sigma_N = F / area)."""
+        return self.area
 
     def vertices(self) -> np.ndarray:
         """Element end coordinates [mm]: as uniform as possible, with nodes at the weak-zone edges."""
@@ -86,44 +96,29 @@ class BarWithWeakZone:
             return np.where(distance < 1.0, self.weak_zone_factor, 1.0)
         return 1.0 - (1.0 - self.weak_zone_factor) * np.clip(1.0 - distance, 0.0, 1.0)
 
-    def build_problem(self, params, regularization: str = "gradient") -> DamageProblem:
-        """The discretised bar: u(0) = 0, unit force pattern at x = L."""
+    def describe(self) -> Description:
+        """The discretised bar: u(0) = 0, a unit force at x = L, the weak zone as a reduced modulus (or
+        cross-section), the damaged-zone length measured along the whole bar."""
         x = self.vertices()
         n = x.size - 1
-        mid = 0.5 * (x[:-1] + x[1:])
+        nodes = np.empty(2 * n + 1)
+        nodes[0::2], nodes[1::2] = x, 0.5 * (x[:-1] + x[1:])  # vertex i is node 2 i
         by_area = self.weakening == "area"
-        areas = self.area * (self.weakness(mid) if by_area else 1.0)
-        disc = bar_discretization(x, areas)
-        factor = 1.0 if by_area else self.weakness(disc.points[..., 0])
-        node = {xv: 2 * i for i, xv in enumerate(x)}
         a, b = 0.5 * (self.length - self.weak_zone_width), 0.5 * (self.length + self.weak_zone_width)
-        left, right = node[min(node, key=lambda v: abs(v - a))], node[min(node, key=lambda v: abs(v - b))]
-        functionals = {"end_displacement": {2 * n: 1.0}, "weak_zone_elongation": {right: 1.0, left: -1.0}}
-        return DamageProblem(
-            disc,
-            params,
-            regularization=regularization,
-            stiffness_factor=factor,
-            fixed_dofs=[0],
-            load={2 * n: 1.0},
-            functionals=functionals,
+        sets = {"start": np.array([0]), "end": np.array([2 * n]),
+                "weak_zone_start": np.array([2 * int(np.argmin(np.abs(x - a)))]),
+                "weak_zone_end": np.array([2 * int(np.argmin(np.abs(x - b)))])}
+        return Description(
+            nodes=nodes[:, None], cells=np.stack([np.arange(n), np.arange(1, n + 1)], axis=1), node_sets=sets,
+            section=self.area * (self.weakness(0.5 * (x[:-1] + x[1:])) if by_area else 1.0),
+            supports=(Support("start", 0),), loads=(Load("end", 0, 1.0),),
+            functionals={"end_displacement": (Measure("end", 0),),
+                         "weak_zone_elongation": (Measure("weak_zone_end", 0), Measure("weak_zone_start", 0, -1.0))},
+            stiffness_factor=(lambda points: np.ones(points.shape[:-1])) if by_area else (lambda points: self.weakness(points[..., 0])),
+            zone=ZoneWidth("damaged_zone_width", along_range=(0.0, self.length)), cell_type="line3",
         )
 
-    def output_mesh(self):
-        """Nodes, cells and VTK cell type of the mesh, for :func:`fracid.report.write_result_vtk`."""
-        from fracid.report.vtk import bar_mesh
-
-        return bar_mesh(self.vertices())
-
-    def observers(self, params, damage_threshold: float = 0.0) -> dict:
-        """``damaged_zone_width``: length [mm] where omega > damage_threshold (kappa-level, interpolated)."""
-        kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
-
-        def damaged_zone_width(problem, q, arrays):
-            return superlevel_length(problem.disc.points[..., 0].ravel(), arrays.kappa.ravel(), kappa_t, 0.0, self.length)
-
-        return {"damaged_zone_width": damaged_zone_width}
-
-    def default_target(self, params) -> float:
-        """A control value well past the peak: 50 times the elastic-limit elongation [mm]."""
-        return 50.0 * params.kappa_i * self.length
+    def default_target(self, scales) -> float:
+        """A control value well past the peak: 50 times the bar's elongation at the model's
+        characteristic strain ``scales["strain"]`` (the strain at damage onset) [mm]."""
+        return 50.0 * scales["strain"] * self.length

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from fracid.model.discretization import plane_stress_discretization
-from fracid.model.problem import DamageProblem
 from fracid.specimens.checks import require_positive
-from fracid.specimens.fpz import fpz_width_observer
+from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
 
@@ -40,7 +39,7 @@ class NotchedBeam:
         Half-width of the refined band around the crack path [mm].
 
     Controls: ``cmod`` (default; passes snap-back) and ``deflection`` (plain displacement control
-    of the loading plate). Observer: ``fpz_width`` [mm].
+    of the loading plate). Observable of the damage models: ``fpz_width`` [mm].
     """
 
     depth: float = 50.0
@@ -55,6 +54,8 @@ class NotchedBeam:
     fine_width: float = 10.0
 
     default_control = "cmod"
+    controls: ClassVar[tuple] = ("cmod", "deflection")
+    observables: ClassVar[tuple] = ("fpz_width",)
 
     def __post_init__(self):
         require_positive(self, ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
@@ -65,6 +66,16 @@ class NotchedBeam:
             raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
         if not self.notch_width / 2 < self.fine_width < self.span / 2 - self.plate_width / 2:
             raise ValueError(f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
+
+    @property
+    def characteristic_size(self) -> float:
+        """D, the depth [mm] (the size of a size-effect series)."""
+        return self.depth
+
+    @property
+    def nominal_section(self) -> float:
+        """A_N with sigma_N = F / A_N = 3 F S / (2 b D^2), the elastic bending stress of the unnotched beam [mm^2]."""
+        return 2.0 * self.thickness * self.depth**2 / (3.0 * self.span)
 
     def refined(self, factor: float = 2.0, everywhere: bool = False) -> "NotchedBeam":
         """The same beam with the process-zone elements (or all elements) divided by ``factor``."""
@@ -100,87 +111,33 @@ class NotchedBeam:
         notch = (graded_count(in_notch, x_size), graded_count([0.0, self.notch_depth], y_size))
         return quad8_grid_size(graded_count(x_keys, x_size), graded_count(y_keys, y_size), notch)
 
-    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
+    def describe(self, mesh: QuadMesh | None = None) -> Description:
+        """The half beam: symmetry u_x = 0 on the ligament, the support plate at x = S/2 (a roller at
+        its centre for the models of an open crack), the loading plate at mid-span carrying half the
+        force (rigid; an even pressure for the models of an open crack, since rigid plates would clamp
+        the rotation of the cracked halves and carry load by frame action), the crack path along the
+        ligament and the FPZ width measured across it."""
         mesh = mesh or self.mesh()
-        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        return DamageProblem(disc, params, regularization=regularization, symmetry_planes=[(0, 0.0)],
-                             **self._conditions(mesh))
-
-    def _conditions(self, mesh: QuadMesh, crack_free: bool = False, rigid_plates: bool = True) -> dict:
-        """Supports, load pattern and functionals of the half beam (keyword arguments of the problems).
-
-        ``crack_free``: no symmetry condition on the ligament (a discrete crack lies there);
-        ``rigid_plates``: the loading plate moves as one and the support holds its nodes, else an
-        even pressure loads the beam and the support is a point.
-        """
         x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
-        ligament = np.flatnonzero((np.abs(x) < 1e-9) & (y >= self.notch_depth - 1e-9))
-        support = np.flatnonzero((np.abs(y) < 1e-9) & (np.abs(x - self.span / 2) <= self.plate_width / 2 + 1e-9))
         plate = np.flatnonzero((np.abs(y - self.depth) < 1e-9) & (x <= self.plate_width / 2 + 1e-9))
-        mouth = mesh.closest_node((self.notch_width / 2, 0.0))
-        master = int(plate[np.argmin(x[plate])])
-        symmetry = [] if crack_free else [2 * ligament]
-        if rigid_plates:
-            tied = [2 * plate + 1]
-            load = {2 * master + 1: -0.5}  # the half model carries half the force: lambda = total force [N]
-            deflection = {2 * master + 1: -1.0}
-        else:
-            # an even pressure under the plate and a point support: once a crack has opened, rigid
-            # plates would clamp the halves' rotation and carry load by frame action
-            tied = []
-            support = np.array([mesh.closest_node((self.span / 2, 0.0))])
-            load = {2 * n + 1: -0.5 / plate.size for n in plate}
-            deflection = {2 * n + 1: -1.0 / plate.size for n in plate}
-        return dict(
-            fixed_dofs=np.concatenate(symmetry + [2 * support + 1]),
-            tied=tied,
-            load=load,
-            functionals={"cmod": {2 * mouth: 2.0}, "deflection": deflection},
-            symmetry_factor=2.0,
+        sets = {
+            "ligament": np.flatnonzero((np.abs(x) < 1e-9) & (y >= self.notch_depth - 1e-9)),
+            "support": np.flatnonzero((np.abs(y) < 1e-9) & (np.abs(x - self.span / 2) <= self.plate_width / 2 + 1e-9)),
+            "support_point": np.array([mesh.closest_node((self.span / 2, 0.0))]),
+            "loading_plate": plate[np.argsort(x[plate], kind="stable")],
+            "mouth": np.array([mesh.closest_node((self.notch_width / 2, 0.0))]),
+        }
+        return Description(
+            nodes=mesh.nodes, cells=mesh.cells, n_vertices=mesh.n_vertices, section=self.thickness, node_sets=sets,
+            symmetry=(("ligament", 0),),
+            supports=(Support("support", 1, point="support_point"),),
+            # the half model carries half the force: lambda = total force [N]
+            loads=(Load("loading_plate", 1, -0.5, rigid=True, rigid_under_open_crack=False),),
+            functionals={"cmod": (Measure("mouth", 0, 2.0),), "deflection": (Measure("loading_plate", 1, -1.0),)},
+            symmetry_factor=2.0, symmetry_planes=((0, 0.0),),
+            crack=CrackPath("ligament", normal=0, mirrored=True, element_size=self.h_fine),
+            zone=ZoneWidth("fpz_width", axis=0, mirror=True, along_range=(self.notch_depth, self.depth)),
         )
-
-    def build_cohesive_problem(self, params, penalty_factor: float = 1000.0):
-        """Elastic half beam with a Hordijk cohesive crack along the ligament (SPEC 5, discrete crack).
-
-        ``params`` is a :class:`~fracid.model.cohesive.CohesiveParameters`; the faces are tied by a
-        penalty ``penalty_factor * E / h_fine`` [MPa/mm] until the traction reaches ft.
-        """
-        from fracid.model.cohesive_problem import CohesiveCrackProblem, ligament_edges
-
-        mesh = self.mesh()
-        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        edges = ligament_edges(mesh.nodes, mesh.cells, disc.u_dofs, self.notch_depth)
-        return CohesiveCrackProblem(disc, params, edges, self.thickness, penalty_factor * params.E / self.h_fine,
-                                    **self._conditions(mesh, crack_free=True, rigid_plates=False))
-
-    def build_crack_band_problem(self, params):
-        """Half beam with a rotating crack band (Hordijk, :class:`~fracid.model.cohesive.CohesiveParameters`)
-        in the element column on the symmetry line above the notch (SPEC 5, smeared crack).
-
-        The crack is confined to that column, as the cohesive crack is to the ligament: in a half model
-        a band anywhere else would be mirrored into two cracks. The column is half of a band centred on
-        the symmetry line, so its band width is twice its width.
-        """
-        from fracid.model.crack_band_problem import CrackBandProblem, element_extent
-
-        mesh = self.mesh()
-        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        corners = mesh.nodes[mesh.cells[:, :4]]
-        on_ligament = (corners[..., 0].min(axis=1) < 1e-9) & (corners[..., 1].min(axis=1) >= self.notch_depth - 1e-9)
-        return CrackBandProblem(disc, params, 2.0 * element_extent(mesh.nodes, mesh.cells, (1.0, 0.0)),
-                                crackable=np.repeat(on_ligament[:, None], disc.weights.shape[1], axis=1).astype(float),
-                                **self._conditions(mesh, rigid_plates=False))
-
-    def output_mesh(self):
-        """Nodes, cells and VTK cell type of the (half) mesh, for :func:`fracid.report.write_result_vtk`."""
-        mesh = self.mesh()
-        return mesh.nodes, mesh.cells, "quad8"
-
-    def observers(self, params, damage_threshold: float = 0.0) -> dict:
-        """``fpz_width``: width across the crack path (horizontal) of the zone where omega > threshold,
-        over the ligament [mm]."""
-        ligament = (self.notch_depth, self.depth)
-        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=0, mirror=True, along_range=ligament)}
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
@@ -188,5 +145,6 @@ class NotchedBeam:
 
         return StepOptions(maximum=target / 60)
 
-    def default_target(self, params) -> float:
-        return 0.3  # CMOD [mm]
+    def default_target(self, scales) -> float:
+        """CMOD 0.3 mm, whatever the model (``scales``: its characteristic strain and opening)."""
+        return 0.3

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
-from fracid.model.discretization import plane_stress_discretization
-from fracid.model.problem import DamageProblem
 from fracid.specimens.checks import require_positive
-from fracid.specimens.fpz import fpz_width_observer
+from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
 
@@ -70,6 +69,8 @@ class DogBone:
     hinge_offset: float = 0.0
 
     default_control = "elongation"
+    controls: ClassVar[tuple] = ("elongation", "platen_displacement")
+    observables: ClassVar[tuple] = ("fpz_width",)
 
     def __post_init__(self):
         optional = ("gauge_length", "fine_height", "h_coarse")  # None: derived from the size
@@ -142,65 +143,47 @@ class DogBone:
         across = 2 * n_s if self.platens == "hinged" else n_s
         return quad8_grid_size(across, graded_count(keys, size) + n_platen)
 
-    def build_problem(self, params, regularization: str = "gradient", mesh: QuadMesh | None = None) -> DamageProblem:
+    def describe(self, mesh: QuadMesh | None = None) -> Description:
+        """Glued platens: the quarter x, y >= 0 with symmetry on both axes, the top edge held
+        horizontally and moving as one, carrying half the force. Hinged platens: the upper half with
+        a stiff elastic platen (no damage) loaded at the hinge, symmetry about y = 0. The crack path
+        is the mid-height section; the FPZ width is measured across it."""
         mesh = mesh or self.mesh()
-        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        if self.platens == "hinged":
-            return self._hinged_problem(params, regularization, mesh, disc)
-        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]
-        top = np.flatnonzero(np.abs(y - 0.75 * self.size) < 1e-9)
-        axis = np.flatnonzero(np.abs(x) < 1e-9)
-        section = np.flatnonzero(np.abs(y) < 1e-9)
-        gauge = mesh.closest_node((float(self.half_width(self._gauge / 2)), self._gauge / 2))
-        master = int(top[0])
-        return DamageProblem(
-            disc,
-            params,
-            regularization=regularization,
-            fixed_dofs=np.concatenate([2 * axis, 2 * section + 1, 2 * top]),
-            tied=[2 * top + 1],
-            load={2 * master + 1: 0.5},  # the quarter carries half the force: lambda = total force [N]
-            functionals={"elongation": {2 * gauge + 1: 2.0}, "platen_displacement": {2 * master + 1: 2.0}},
-            symmetry_factor=4.0,
-            symmetry_planes=[(0, 0.0), (1, 0.0)],
-        )
-
-    def _hinged_problem(self, params, regularization, mesh, disc) -> DamageProblem:
-        D, y = self.size, mesh.nodes[:, 1]
-        hinge = mesh.closest_node((self.hinge_offset, 0.75 * D + self.platen_height * D))
-        section = np.flatnonzero(np.abs(y) < 1e-9)
+        D, x, y = self.size, mesh.nodes[:, 0], mesh.nodes[:, 1]
         g = self._gauge / 2
-        right, left = (mesh.closest_node((sign * float(self.half_width(g)), g)) for sign in (1.0, -1.0))
-        corners = [mesh.closest_node((sign * 0.5 * D, 0.75 * D)) for sign in (1.0, -1.0)]
-        in_platen = disc.points[..., 1] > 0.75 * D
-        return DamageProblem(
-            disc,
-            params,
-            regularization=regularization,
-            stiffness_factor=np.where(in_platen, self.platen_stiffness, 1.0),
-            damageable=np.where(in_platen, 0.0, 1.0),
-            fixed_dofs=np.concatenate([2 * section + 1, [2 * hinge]]),
-            load={2 * hinge + 1: 1.0},  # the upper half carries the whole force
-            functionals={
-                # mean of the elongations on both sides: (2 u_R + 2 u_L) / 2
-                "elongation": {2 * right + 1: 1.0, 2 * left + 1: 1.0},
-                "platen_displacement": {2 * hinge + 1: 2.0},
-                "platen_tilt": {2 * corners[0] + 1: 1.0, 2 * corners[1] + 1: -1.0},
-            },
-            symmetry_factor=2.0,
-            symmetry_planes=[(1, 0.0)],
-        )
-
-    def output_mesh(self):
-        """Nodes, cells and VTK cell type of the (quarter) mesh, for :func:`fracid.report.write_result_vtk`."""
-        mesh = self.mesh()
-        return mesh.nodes, mesh.cells, "quad8"
-
-    def observers(self, params, damage_threshold: float = 0.0) -> dict:
-        """``fpz_width``: height of the zone where omega > threshold across the mid-height section [mm]."""
         half = float(self.half_width(0.0))
-        section = (-half if self.platens == "hinged" else 0.0, half)
-        return {"fpz_width": fpz_width_observer(params, damage_threshold, axis=1, mirror=True, along_range=section)}
+        sets = {"section": np.flatnonzero(np.abs(y) < 1e-9)}
+        common = dict(nodes=mesh.nodes, cells=mesh.cells, n_vertices=mesh.n_vertices, section=self.thickness,
+                      crack=CrackPath("section", normal=1, mirrored=True))
+        if self.platens == "hinged":
+            hinge = mesh.closest_node((self.hinge_offset, 0.75 * D + self.platen_height * D))
+            sets.update(hinge=np.array([hinge]),
+                        **{f"gauge_{side}": np.array([mesh.closest_node((sign * float(self.half_width(g)), g))])
+                           for side, sign in (("right", 1.0), ("left", -1.0))},
+                        **{f"corner_{side}": np.array([mesh.closest_node((sign * 0.5 * D, 0.75 * D))])
+                           for side, sign in (("right", 1.0), ("left", -1.0))})
+            in_platen = lambda points: points[..., 1] > 0.75 * D  # noqa: E731
+            return Description(
+                node_sets=sets, symmetry=(("section", 1),), supports=(Support("hinge", 0),),
+                loads=(Load("hinge", 1, 1.0),),  # the upper half carries the whole force
+                functionals={
+                    # mean of the elongations on both sides: (2 u_R + 2 u_L) / 2
+                    "elongation": (Measure("gauge_right", 1, 1.0), Measure("gauge_left", 1, 1.0)),
+                    "platen_displacement": (Measure("hinge", 1, 2.0),),
+                    "platen_tilt": (Measure("corner_right", 1, 1.0), Measure("corner_left", 1, -1.0)),
+                },
+                symmetry_factor=2.0, symmetry_planes=((1, 0.0),),
+                stiffness_factor=lambda points: np.where(in_platen(points), self.platen_stiffness, 1.0),
+                damageable=lambda points: np.where(in_platen(points), 0.0, 1.0),
+                zone=ZoneWidth("fpz_width", axis=1, mirror=True, along_range=(-half, half)), **common)
+        sets.update(axis=np.flatnonzero(np.abs(x) < 1e-9), top=np.flatnonzero(np.abs(y - 0.75 * D) < 1e-9),
+                    gauge=np.array([mesh.closest_node((float(self.half_width(g)), g))]))
+        return Description(
+            node_sets=sets, symmetry=(("axis", 0), ("section", 1)), supports=(Support("top", 0),),
+            loads=(Load("top", 1, 0.5),),  # the quarter carries half the force: lambda = total force [N]
+            functionals={"elongation": (Measure("gauge", 1, 2.0),), "platen_displacement": (Measure("top", 1, 2.0),)},
+            symmetry_factor=4.0, symmetry_planes=((0, 0.0), (1, 0.0)),
+            zone=ZoneWidth("fpz_width", axis=1, mirror=True, along_range=(0.0, half)), **common)
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
@@ -208,11 +191,22 @@ class DogBone:
 
         return StepOptions(maximum=target / 60)
 
-    def default_target(self, params) -> float:
-        """Elongation well past the peak: 20 times the elastic elongation of the gauge at damage onset [mm]."""
-        return 20.0 * params.kappa_i * self._gauge
+    def default_target(self, scales) -> float:
+        """Elongation well past the peak: 20 times the gauge length times the model's characteristic
+        strain ``scales["strain"]`` (the strain at damage onset) [mm]."""
+        return 20.0 * scales["strain"] * self._gauge
 
     @property
     def ligament_area(self) -> float:
         """Area of the notched section [mm^2], for the nominal strength F / (0.6 D t)."""
         return self.notch_width * self.size * self.thickness
+
+    @property
+    def characteristic_size(self) -> float:
+        """D, the width [mm] (the size of a size-effect series)."""
+        return self.size
+
+    @property
+    def nominal_section(self) -> float:
+        """A_N with sigma_N = F / A_N: the notched section [mm^2]."""
+        return self.ligament_area

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from fracid.model.discretization import plane_stress_discretization
 from fracid.specimens.checks import require_positive
+from fracid.specimens.description import CrackPath, Description, Load, Measure, Support
 from fracid.specimens.meshing import structured_quad8
 
 
@@ -39,6 +40,8 @@ class TensionStrip:
     weak_factor: float = 0.98
 
     default_control = "band_opening"
+    controls: ClassVar[tuple] = ("band_opening", "elongation")
+    observables: ClassVar[tuple] = ()
 
     def __post_init__(self):
         require_positive(self, ("length", "height", "thickness"), " [mm]")
@@ -56,31 +59,23 @@ class TensionStrip:
         rows = max(1, round(self.height / self.element_size))
         return structured_quad8(np.linspace(0.0, self.length, self.n_elements + 1), np.linspace(0.0, self.height, rows + 1))
 
-    def build_crack_band_problem(self, params, band_width: float | None = None):
-        """The strip with the rotating crack band of ``params`` (:class:`~fracid.model.cohesive.CohesiveParameters`).
-
-        ``band_width`` [mm] overrides the element widths the law is scaled by (to see what an
-        unscaled softening law does to the energy)."""
-        from fracid.model.crack_band_problem import CrackBandProblem, element_extent
-
+    def describe(self) -> Description:
+        """The strip held at x = 0 (one node also vertically), pulled by a rigid platen at x = L, the
+        middle column weaker; a crack may form anywhere across x."""
         mesh = self.mesh()
-        disc = plane_stress_discretization(mesh.nodes, mesh.cells, mesh.n_vertices, self.thickness)
-        left, right = mesh.nodes_near(x=0.0), mesh.nodes_near(x=self.length)
         h = self.element_size
-        band_left = mesh.nodes_near(x=(self.n_elements // 2) * h)
-        band_right = mesh.nodes_near(x=(self.n_elements // 2 + 1) * h)
-        centre = np.abs(disc.points[..., 0] - 0.5 * self.length) < 0.5 * h
-        opening = {2 * n: 1.0 / band_right.size for n in band_right}
-        opening.update({2 * n: -1.0 / band_left.size for n in band_left})
-        return CrackBandProblem(
-            disc,
-            params,
-            element_extent(mesh.nodes, mesh.cells, (1.0, 0.0)) if band_width is None else np.full(len(mesh.cells), band_width),
-            strength_factor=np.where(centre, self.weak_factor, 1.0),
-            fixed_dofs=np.concatenate([2 * left, [2 * mesh.closest_node((0.0, 0.0)) + 1]]),
-            tied=[2 * right],
-            load={2 * int(right[0]): 1.0},
-            functionals={"elongation": {2 * int(right[0]): 1.0}, "band_opening": opening},
+        sets = {"left": mesh.nodes_near(x=0.0), "right": mesh.nodes_near(x=self.length),
+                "corner": np.array([mesh.closest_node((0.0, 0.0))]),
+                "band_left": mesh.nodes_near(x=(self.n_elements // 2) * h),
+                "band_right": mesh.nodes_near(x=(self.n_elements // 2 + 1) * h)}
+        centre = lambda points: np.abs(points[..., 0] - 0.5 * self.length) < 0.5 * h  # noqa: E731
+        return Description(
+            nodes=mesh.nodes, cells=mesh.cells, n_vertices=mesh.n_vertices, section=self.thickness, node_sets=sets,
+            supports=(Support("left", 0), Support("corner", 1)), loads=(Load("right", 0, 1.0),),
+            functionals={"elongation": (Measure("right", 0),),
+                         "band_opening": (Measure("band_right", 0), Measure("band_left", 0, -1.0))},
+            strength_factor=lambda points: np.where(centre(points), self.weak_factor, 1.0),
+            crack=CrackPath(None, normal=0, mirrored=False),
         )
 
     def default_steps(self, target: float):
@@ -89,8 +84,10 @@ class TensionStrip:
 
         return StepOptions(maximum=target / 50)
 
-    def default_target(self, params) -> float:
-        """Band opening 0.99 wc [mm] (wc of the weak column, which keeps Gf at a lower strength): the crack
-        is then all but free of stress (the area of Hordijk's law beyond 0.99 wc is 1e-5 Gf). At wc the
+    def default_target(self, scales) -> float:
+        """Band opening 0.99 wc [mm] (wc = ``scales["opening"]`` of the weak column, which keeps Gf at a
+        lower strength): the crack is then all but free of stress (the area of Hordijk's law beyond 0.99 wc is 1e-5 Gf). At wc the
         strip is cut in two and has no stiffness left."""
-        return 0.99 * params.wc / self.weak_factor
+        if "opening" not in scales:
+            raise ValueError("the tension strip's default target is a crack opening: give target= for this model")
+        return 0.99 * scales["opening"] / self.weak_factor

@@ -1,4 +1,4 @@
-"""Observables computed from the fields of a forward run."""
+"""Measures of level sets of fields sampled along lines (the extent of a damaged or opened zone)."""
 
 from __future__ import annotations
 

@@ -15,8 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from fracid.model.damage import kappa_at_damage
-from fracid.specimens.observables import superlevel_length
+from fracid.model.level_sets import superlevel_length
 
 
 @dataclass(frozen=True)
@@ -105,15 +104,19 @@ def cached_sampler(points, axis: int, along_range) -> AcrossSampler:
     return _SAMPLERS[key]
 
 
-def fpz_width_observer(params, damage_threshold: float, axis: int, mirror: bool, along_range=(-np.inf, np.inf)):
-    """Observer f(problem, q, arrays) -> FPZ width [mm] for :func:`~fracid.model.path_following.follow_path`."""
-    kappa_t = kappa_at_damage(damage_threshold, params.kappa_i, params.alpha, params.beta)
-
+def zone_width_observer(zone, kappa_threshold: float):
+    """Observer f(problem, q, arrays) -> width [mm] of the zone where kappa > ``kappa_threshold``, for
+    :func:`~fracid.model.path_following.follow_path`: across the crack path in 2D (see :func:`fpz_width`;
+    ``zone`` a :class:`~fracid.specimens.description.ZoneWidth`), along a bar in 1D."""
     current = {}  # the problem of this run and its sampler: the mesh is looked up once per run, not per step
 
     def observe(problem, q, arrays):
+        points = problem.disc.points
+        if points.shape[-1] == 1:
+            start, end = zone.along_range
+            return superlevel_length(points[..., 0].ravel(), arrays.kappa.ravel(), kappa_threshold, start, end)
         if current.get("problem") is not problem:
-            current.update(problem=problem, sampler=cached_sampler(problem.disc.points.reshape(-1, 2), axis, along_range))
-        return fpz_width(current["sampler"], arrays.kappa.ravel(), kappa_t, mirror)
+            current.update(problem=problem, sampler=cached_sampler(points.reshape(-1, 2), zone.axis, zone.along_range))
+        return fpz_width(current["sampler"], arrays.kappa.ravel(), kappa_threshold, zone.mirror)
 
     return observe

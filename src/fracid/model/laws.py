@@ -1,0 +1,120 @@
+"""Material laws as small objects: values and derivatives at all integration points at once.
+
+A formulation (gradient, local or integral damage; the crack band; the cohesive interface) takes a
+law and asks it for values and derivatives; it never names the law's parameters. A new law is a new
+object with the same methods (see :class:`DamageLaw`), nothing else changes. The parameter
+derivatives of the laws (for sensitivities computed inside the analysis) belong here too.
+
+Units: strains [-], stresses [MPa], openings [mm].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Protocol
+
+import numpy as np
+
+from fracid.model.damage import exponential_damage, kappa_at_damage
+from fracid.model.equivalent_strain import modified_von_mises_plane_stress, modified_von_mises_uniaxial
+from fracid.model.parameters import DamageParameters
+
+
+class SofteningLaw(Protocol):
+    """Damage omega(kappa) of the history variable kappa.
+
+    ``damage(kappa, params) -> (omega, d omega / d kappa)`` at every point; ``kappa_at_damage(omega,
+    params)`` its inverse (the FPZ width's level); ``onset(params)`` the kappa at which damage starts.
+    """
+
+    def damage(self, kappa, params): ...
+
+    def kappa_at_damage(self, omega: float, params) -> float: ...
+
+    def onset(self, params) -> float: ...
+
+
+class EquivalentStrain(Protocol):
+    """Scalar strain measure driving damage: ``(strain_state, strain, params) -> (eps_eq, d eps_eq / d strain)``."""
+
+    def __call__(self, strain_state, strain, params): ...
+
+
+@dataclass(frozen=True)
+class ExponentialSoftening:
+    """omega = 1 - kappa_i / kappa (1 - alpha + alpha exp(-beta (kappa - kappa_i))) beyond kappa_i
+    (parameters ``kappa_i``, ``alpha``, ``beta``; see :func:`~fracid.model.damage.exponential_damage`)."""
+
+    def damage(self, kappa, params):
+        return exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
+
+    def kappa_at_damage(self, omega: float, params) -> float:
+        return kappa_at_damage(omega, params.kappa_i, params.alpha, params.beta)
+
+    def onset(self, params) -> float:
+        return params.kappa_i
+
+
+_MODIFIED_VON_MISES = {"uniaxial": modified_von_mises_uniaxial, "plane stress": modified_von_mises_plane_stress}
+
+
+@dataclass(frozen=True)
+class ModifiedVonMises:
+    """De Vree's modified von Mises equivalent strain (parameters ``nu`` and ``eta``, the ratio of
+    compressive to tensile strength), for the uniaxial and plane-stress strain states."""
+
+    def __call__(self, strain_state, strain, params):
+        try:
+            function = _MODIFIED_VON_MISES[strain_state.name]
+        except KeyError:
+            raise ValueError(f"no modified von Mises strain for the {strain_state.name!r} strain state") from None
+        return function(strain, params.nu, params.eta)
+
+
+@dataclass(frozen=True)
+class DamageLaw:
+    """A continuum damage law: a softening law of kappa, the equivalent strain that drives it, and
+    the parameter class holding their parameters and the elastic ones (``E``, ``nu``; ``c`` for
+    the regularised formulations).
+
+    Examples
+    --------
+    >>> law = DamageLaw()
+    >>> float(law.softening.damage(2e-4, DamageParameters())[0]) > 0
+    True
+    """
+
+    softening: SofteningLaw = ExponentialSoftening()
+    equivalent_strain: EquivalentStrain = ModifiedVonMises()
+    parameters: type = DamageParameters
+    name: str = "exponential"
+
+    def damage(self, kappa, params):
+        return self.softening.damage(kappa, params)
+
+    def scales(self, params) -> dict:
+        """Characteristic values a specimen sizes its default control with: ``strain`` [-]."""
+        return {"strain": self.softening.onset(params)}
+
+
+@dataclass(frozen=True)
+class HordijkLaw:
+    """Hordijk's traction-opening law, for the cohesive crack and the crack band (parameters of
+    :class:`~fracid.model.cohesive.CohesiveParameters`: ft, Gf, c1, c2 and the elastic E, nu)."""
+
+    name: ClassVar[str] = "hordijk"
+
+    @property
+    def parameters(self) -> type:
+        from fracid.model.cohesive import CohesiveParameters
+
+        return CohesiveParameters
+
+    def scales(self, params) -> dict:
+        """``strain`` = ft / E [-] and ``opening`` = wc, the opening of zero traction [mm]."""
+        return {"strain": params.ft / params.E, "opening": params.wc}
+
+
+def as_array(value, shape) -> np.ndarray:
+    """``value`` (a number or an array) broadcast to ``shape``, as floats."""
+    return np.broadcast_to(np.asarray(value, dtype=float), shape)
