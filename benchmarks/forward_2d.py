@@ -14,6 +14,7 @@ import resource
 import time
 
 import fracid
+from fracid.models import DamageModel
 from fracid.model.linear_solvers import linear_solver
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
@@ -43,7 +44,7 @@ def run(name, solver_name):
     result = fracid.simulate(specimen, params, target=target, stop_force_fraction=0.2, linear_solver=solver)
     wall = time.perf_counter() - start
     s = result.stats
-    n = specimen.build_problem(params).n_free + 1
+    n = DamageModel().build(specimen, params).n_free + 1
     print(f"{name:8s} {solver_name:8s} unknowns {n:6d}  steps {s.steps:4d}  iterations {s.iterations:4d}  "
           f"wall {wall:7.1f} s  linear {s.time_linear:7.1f} s  ratio {wall / s.time_linear:5.2f}  "
           f"peak RSS {peak_rss_mib():7.0f} MiB  peak force {result.peak_force:9.1f} N  ({result.status})")

@@ -12,6 +12,7 @@ import argparse
 import statistics
 
 import fracid
+from fracid.models import DamageModel
 
 
 def main(argv=None):
@@ -30,7 +31,7 @@ def main(argv=None):
         totals.append(result.stats.time_total)
         shares.append(result.stats.time_linear / result.stats.time_total)
     s = result.stats
-    print(f"bar, {args.elements} elements, {bar.build_problem(params).n_free + 1} unknowns, solver {args.solver}")
+    print(f"bar, {args.elements} elements, {DamageModel().build(bar, params).n_free + 1} unknowns, solver {args.solver}")
     print(f"steps {s.steps}, Newton iterations {s.iterations}, failed increments {s.failed_increments}")
     print(f"peak force {result.peak_force:.4f} N, final force {result.force[-1]:.4f} N ({result.status})")
     print(f"wall time per analysis: median {statistics.median(totals) * 1e3:.1f} ms, min {min(totals) * 1e3:.1f} ms over {args.repeats} runs")

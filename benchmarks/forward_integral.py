@@ -15,6 +15,7 @@ import statistics
 import time
 
 import fracid
+from fracid.models import DamageModel
 from fracid.model import forms
 from fracid.model.nonlocal_average import internal_length, nonlocal_averaging
 
@@ -65,7 +66,7 @@ def main(argv=None):
     wall = {k: statistics.median(r[0] for r in v) for k, v in runs.items()}
     iterations = {k: v[0][1] for k, v in runs.items()}
     coupling = statistics.median(r[2] for r in runs["integral"])
-    problem = bar.build_problem(params, "integral")
+    problem = DamageModel("integral").build(bar, params)
     builds = []
     for _ in range(args.repeats):
         t0 = time.perf_counter()

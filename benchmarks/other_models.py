@@ -43,8 +43,8 @@ def strip_energies():
     for n in (11, 21, 41):
         for band in (None, 4.8):
             strip = TensionStrip(n_elements=n)
-            problem = strip.build_crack_band_problem(COHESIVE, band)
-            target = strip.default_target(COHESIVE) * (1.0 if band is None else strip.element_size / band)
+            problem = CrackBandModel(band).build(strip, COHESIVE)
+            target = CrackBandModel().default_target(strip, COHESIVE) * (1.0 if band is None else strip.element_size / band)
             result, wall = _timed(lambda: follow_path(problem, "band_opening", target, steps=strip.default_steps(target),
                                                       stop_force_fraction=None))
             energy = result.observables["dissipated_energy"][-1]

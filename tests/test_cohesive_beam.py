@@ -28,7 +28,7 @@ def test_crack_traction_tangent_matches_finite_differences():
 @pytest.fixture(scope="module")
 def separated():
     beam = NotchedBeam(h_fine=2.0, h_coarse=6.0)
-    problem = beam.build_cohesive_problem(PARAMS)
+    problem = CohesiveCrackModel().build(beam, PARAMS)
     result = CohesiveCrackModel().simulate(beam, PARAMS, target=7.0, stop_force_fraction=None, field_steps="last")
     return beam, problem, result
 

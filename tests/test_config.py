@@ -27,8 +27,10 @@ from fracid.inverse.forward_operator import ForwardOperator
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.strategy import identify, identify_data
 from fracid.model.parameters import DamageParameters
+from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
 from fracid.specimens.beam import NotchedBeam
+from fracid.specimens.description import conditions
 
 CONFIGS = Path(__file__).parent / "configs"
 
@@ -264,8 +266,8 @@ def test_specimen_maps_match_the_specimens():
     for kind, (controls, observables) in _SPECIMENS.items():
         cls = _specimen_class(kind)
         assert cls.default_control == controls[0]
-        assert set(cls().observers(params)) == set(observables)
-    problem = BarWithWeakZone(n_elements=20).build_problem(params)
+        assert set(DamageModel().observers(cls().describe(), params)) == set(observables)
+    problem = DamageModel().build(BarWithWeakZone(n_elements=20), params)
     assert set(problem.functionals) == set(_SPECIMENS["bar"][0])
 
 
@@ -748,7 +750,7 @@ def test_beam_supported_at_its_ends():
     ends, usual = (NotchedBeam(span=span, length=175.0, h_fine=5.0) for span in (175.0, 125.0))
     mesh = ends.mesh()
     assert mesh.nodes[:, 0].max() == pytest.approx(87.5)  # nothing meshed beyond the end
-    fixed = ends._conditions(mesh)["fixed_dofs"]
+    fixed = np.asarray(conditions(ends.describe(mesh)).fixed_dofs)
     support = mesh.nodes[fixed[fixed % 2 == 1] // 2]
     assert np.all(support[:, 1] == 0.0) and support[:, 0].min() == pytest.approx(85.0)
     assert support[:, 0].max() == pytest.approx(87.5)  # the end node holds the beam

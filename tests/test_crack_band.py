@@ -79,15 +79,15 @@ def test_band_wider_than_the_snap_back_limit_is_refused():
     brittle = PARAMS.replace(Gf=0.002)
     limit = snap_back_limit(brittle.E, brittle.ft, *brittle.law()[1:])
     with pytest.raises(ValueError, match="snap-back limit"):
-        TensionStrip(n_elements=3, length=3 * 1.2 * limit / (1 - 0.04), height=10.0).build_crack_band_problem(brittle)
+        CrackBandModel().build(TensionStrip(n_elements=3, length=3 * 1.2 * limit / (1 - 0.04), height=10.0), brittle)
 
 
 def _dissipated(strip, band_width=None):
     from fracid.model.path_following import follow_path
 
-    problem = strip.build_crack_band_problem(PARAMS, band_width)
+    problem = CrackBandModel(band_width).build(strip, PARAMS)
     # the crack opens to 0.99 wc: the column's elongation is the opening times element size / band width
-    target = strip.default_target(PARAMS) * (1.0 if band_width is None else strip.element_size / band_width)
+    target = CrackBandModel().default_target(strip, PARAMS) * (1.0 if band_width is None else strip.element_size / band_width)
     result = follow_path(problem, "band_opening", target, steps=strip.default_steps(target), stop_force_fraction=None)
     return result.observables["dissipated_energy"][-1]
 
@@ -106,7 +106,7 @@ def test_dissipated_energy_in_tension_is_gf_times_the_crack_area_for_three_eleme
 def test_assembled_tangent_matches_finite_differences_after_the_peak():
     beam = NotchedBeam(h_fine=5.0, h_coarse=10.0)
     result = CrackBandModel().simulate(beam, PARAMS, target=0.08, stop_force_fraction=None, field_steps="all")
-    problem = beam.build_crack_band_problem(PARAMS)
+    problem = CrackBandModel().build(beam, PARAMS)
     k = result.n_steps - 2
     assert result.force[k] < 0.9 * result.peak_force
     kappa_old = result.fields[k]["kappa"]

@@ -39,7 +39,7 @@ def test_uniform_strain_is_reproduced_everywhere_1d_and_2d():
     x, w = bar_points(np.linspace(0.0, 100.0, 201))
     plate, w2 = plate_points(np.linspace(0.0, 40.0, 21), np.linspace(0.0, 20.0, 11))
     params = fracid.DamageParameters(c=4.0)
-    dogbone = DogBone(size=50.0, h_fine=2.5).build_problem(params, "integral").averaging.matrix  # quarter, mirrored
+    dogbone = DamageModel("integral").build(DogBone(size=50.0, h_fine=2.5), params).averaging.matrix  # quarter, mirrored
     for A, n in ((averaging_matrix(x, w, L_INT), x.shape[0]), (averaging_matrix(plate, w2, 2.0), plate.shape[0]),
                  (dogbone, dogbone.shape[0])):
         np.testing.assert_allclose(A @ np.ones(n), 1.0, rtol=1e-13)
@@ -107,7 +107,7 @@ def test_mirror_planes_give_the_average_of_the_whole_specimen():
 ])
 def test_half_and_quarter_specimens_mirror_the_average(specimen, planes):
     params = fracid.DamageParameters(c=4.0)
-    problem = specimen.build_problem(params, "integral")
+    problem = DamageModel("integral").build(specimen, params)
     n_el, n_q = problem.disc.weights.shape
     points, w = problem.disc.points.reshape(n_el * n_q, -1), problem.disc.weights.ravel()
     expected = averaging_matrix(points, w, internal_length(params.c), mirror=planes)
@@ -204,7 +204,7 @@ def test_twin_experiment_recovers_c_and_beta_noise_free():
 def test_integral_problem_has_displacement_unknowns_only():
     params = fracid.DamageParameters(c=1.0)
     bar = fracid.BarWithWeakZone(n_elements=20)
-    integral, local = bar.build_problem(params, "integral"), bar.build_problem(params, "local")
+    integral, local = DamageModel("integral").build(bar, params), DamageModel("local").build(bar, params)
     assert integral.n_free == local.n_free and set(integral.blocks) == {"u"}
     assert isinstance(integral, DamageProblem) and integral.averaging.matrix.shape == (60, 60)
     assert "ebar" not in integral.fields(np.zeros(integral.n_free), integral.initial_history(), integral.initial_history())

@@ -5,7 +5,9 @@ import pytest
 
 import fracid
 from fracid.model.discretization import plane_stress_discretization
-from fracid.model.problem import DamageProblem
+from fracid.model.dofs import Conditions
+from fracid.model.laws import DamageLaw
+from fracid.model.problem import GradientDamageProblem
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 from fracid.specimens.meshing import structured_quad8
@@ -38,8 +40,8 @@ def test_patch_test_uniform_tension_on_distorted_mesh():
                     load[2 * node] = load.get(2 * node, 0.0) + w * length / 10.0  # total 1: lambda = force [N]
     corner = mesh.closest_node((0.0, 0.0))
     top_right = mesh.closest_node((10.0, 10.0))
-    problem = DamageProblem(disc, params, fixed_dofs=np.concatenate([2 * left, [2 * corner + 1]]), load=load,
-                            functionals={"u": {2 * top_right: 1.0}})
+    problem = GradientDamageProblem(disc, DamageLaw(), params, Conditions(
+        load=load, functionals={"u": {2 * top_right: 1.0}}, fixed_dofs=np.concatenate([2 * left, [2 * corner + 1]])))
     result = fracid.follow_path(problem, "u", 1e-3)
     force = result.force[-1]
     sigma = force / (10.0 * thickness)

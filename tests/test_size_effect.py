@@ -191,14 +191,14 @@ class Cylinder:
 class RejectingBar(fracid.BarWithWeakZone):
     """A bar whose problem cannot be built (as for parameters the model rejects)."""
 
-    def build_problem(self, params, regularization="gradient"):
+    def describe(self):
         raise ValueError("this bar rejects every parameter set")
 
 
 class DivergingBar(fracid.BarWithWeakZone):
     """A bar whose analysis stops after one converged step."""
 
-    def build_problem(self, params, regularization="gradient"):
+    def describe(self):
         partial = PathResult("end_displacement", np.array([0.0, 1e-3]), np.array([0.0, 0.5]), {})
         raise ConvergenceError("no convergence even with the smallest step", partial)
 

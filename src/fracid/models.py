@@ -24,13 +24,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
 
+import numpy as np
+
 from fracid.model.crack_band_problem import CrackBandProblem, element_extent
 from fracid.model.cohesive_problem import CohesiveCrackProblem, crack_edges
 from fracid.model.fpz import zone_width_observer
 from fracid.model.laws import DamageLaw, HordijkLaw
-from fracid.model.path_following import StepOptions, follow_path
+from fracid.model.path_following import ConvergenceError, PathResult, StepOptions, follow_path
 from fracid.model.problem import FORMULATIONS
 from fracid.specimens.description import uniform, at_points, conditions, discretize
+
+
+__all__ = ["MODEL_TYPES", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel", "DamageModel", "ForwardModel",
+           "PathResult", "StepOptions", "model_from_type", "parameter_units", "runs_on"]
 
 
 class ForwardModel(Protocol):
@@ -184,10 +190,17 @@ class CrackBandModel(_PathFollowing):
     (docs/theory.md, section 5). Same parameters as the cohesive crack, so the two are directly
     comparable. The band is confined to the elements along the specimen's crack path (in a half
     model a band elsewhere would be mirrored into two cracks), or free where the specimen has no path.
+
+    ``band_width`` [mm] overrides the element widths the law is scaled by (to see what an unscaled
+    softening law does to the energy).
     """
 
+    band_width: float | None = None
     law: HordijkLaw = HordijkLaw()
-    key: ClassVar[str] = "crack-band-hordijk"
+
+    @property
+    def key(self) -> str:
+        return "crack-band-hordijk" + ("" if self.band_width is None else f"-band-{self.band_width:g}")
 
     @property
     def parameters(self) -> type:
@@ -207,11 +220,13 @@ class CrackBandModel(_PathFollowing):
         direction = [0.0, 0.0]
         direction[d.crack.normal] = 1.0
         width = element_extent(d.nodes, d.cells, direction)
+        if self.band_width is not None:
+            width = np.full(len(d.cells), float(self.band_width))
         crackable = 1.0
         if d.crack.nodes is not None:
             on_path = (d.nodes_of(d.crack.nodes)[None, None, :] == d.cells[:, :4, None]).any(axis=2).sum(axis=1) >= 2
             crackable = at_points(lambda points: on_path[:, None] * _ones(points), disc)
-        if d.crack.mirrored:
+        if d.crack.mirrored and self.band_width is None:
             width = 2.0 * width
         return CrackBandProblem(disc, self.law, params, conditions(d, open_crack=True), width,
                                 strength_factor=at_points(d.strength_factor, disc), crackable=crackable,

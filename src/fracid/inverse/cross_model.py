@@ -35,7 +35,7 @@ from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.sensitivity import ForwardRunError
 from fracid.inverse.strategy import IdentificationResult, identify_data
-from fracid.model.path_following import ConvergenceError
+from fracid.models import ConvergenceError
 
 __all__ = [
     "Candidate",
@@ -304,7 +304,7 @@ def fit_model(data: ExperimentalData, candidate: Candidate, specimen=None, *, co
         label=candidate.label, model_key=candidate.model.key, identification=result, params=params,
         control=np.asarray(run.control, float), force=np.asarray(run.force, float),
         rms_relative=relative_rms(result.y_fit, data.y), peak_force=float(np.max(run.force)),
-        dissipated_energy=energy, forward_runs=int(result.runs["knn"] + result.runs["kalman"]),
+        dissipated_energy=energy, forward_runs=result.forward_runs,
         seconds=time.perf_counter() - start,
     )
 

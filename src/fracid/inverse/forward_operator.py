@@ -15,8 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fracid.models import DamageModel
-from fracid.model.path_following import ConvergenceError, StepOptions
+from fracid.models import ConvergenceError, DamageModel, StepOptions
 
 
 @dataclass(frozen=True, eq=False)

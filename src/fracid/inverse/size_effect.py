@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from fracid.model.path_following import ConvergenceError
+from fracid.models import ConvergenceError
 from fracid.parallel import run_batch
 
 __all__ = [

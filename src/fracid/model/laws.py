@@ -10,7 +10,7 @@ Units: strains [-], stresses [MPa], openings [mm].
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
 
 import numpy as np
@@ -86,7 +86,7 @@ class DamageLaw:
 
     softening: SofteningLaw = ExponentialSoftening()
     equivalent_strain: EquivalentStrain = ModifiedVonMises()
-    parameters: type = DamageParameters
+    parameters: type = field(default=DamageParameters, compare=False)  # named by the parameters' own fields
     name: str = "exponential"
 
     def damage(self, kappa, params):
