@@ -1,7 +1,7 @@
 """The measured vector y_exp and its covariance C_exp, built from curves by documented rules.
 
-y_exp holds forces [N] at n_y equally spaced values of the control quantity [mm] (the thesis's
-choice), optionally followed by local data (e.g. FPZ width [mm]). Its covariance is diagonal per
+y_exp holds forces [N] at n_y equally spaced values of the control quantity [mm] (the thesis's choice,
+docs/theory.md, section 3.1), optionally followed by local data (e.g. FPZ width [mm]). Its covariance is diagonal per
 block, from the scatter of repeated tests, from a min/max envelope, or from a standard deviation
 the user gives; several blocks (specimens, local data) are stacked block-diagonally.
 
@@ -107,7 +107,7 @@ class ExperimentalData:
         return np.sqrt(np.diag(self.covariance))
 
     def weighted(self, weights: dict) -> "ExperimentalData":
-        """The data with block weights p_b: f = sum_b p_b f_b (SPEC 3, e.g. p1 global, p2 local).
+        """The data with block weights p_b: f = sum_b p_b f_b (docs/theory.md, section 3.3, e.g. p1 global, p2 local).
 
         The objective f = r^T C^-1 r of a block times p_b is the objective with its covariance
         divided by p_b, so the Kalman filter and KNN see the same weighting.

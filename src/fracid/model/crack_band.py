@@ -1,4 +1,4 @@
-"""Smeared crack band with Hordijk softening: a rotating crack in plane stress (SPEC 5).
+"""Smeared crack band with Hordijk softening: a rotating crack in plane stress (docs/theory.md, section 5.3).
 
 **Choice: rotating crack.** The crack normal follows the major principal direction of the
 (effective) stress, which is that of the strain for an isotropic bulk: the crack is coaxial. A fixed

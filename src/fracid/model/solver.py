@@ -28,6 +28,10 @@ class IncrementFailed(RuntimeError):
 class NewtonOptions:
     """Convergence settings of the Newton-Raphson iterations.
 
+    The solver checks the residual of every field a problem declares (its ``blocks``: ``"u"``, and
+    ``"ebar"`` for the gradient model, or any other name a new formulation gives) against
+    :meth:`tolerance` of that field.
+
     Parameters
     ----------
     rtol_u : float
@@ -37,22 +41,30 @@ class NewtonOptions:
         equivalent-strain source.
     max_iterations : int
         Iterations before an increment counts as failed.
+    field_rtol : mapping {field: float}
+        Relative tolerances of other fields (or overriding the two above); a field named nowhere
+        gets ``rtol_u``.
     """
 
     rtol_u: float = 1e-8
     rtol_ebar: float = 1e-8
     max_iterations: int = 12
+    field_rtol: tuple = ()
 
     def __post_init__(self):
-        for name in ("rtol_u", "rtol_ebar"):
-            value = getattr(self, name)
+        named = dict(self.field_rtol.items() if hasattr(self.field_rtol, "items") else self.field_rtol)
+        object.__setattr__(self, "field_rtol", tuple(sorted(named.items())))
+        for name, value in [("rtol_u", self.rtol_u), ("rtol_ebar", self.rtol_ebar)] + [
+                (f"field_rtol[{field!r}]", v) for field, v in self.field_rtol]:
             if not (0.0 < value < 1.0):
                 raise ValueError(f"NewtonOptions.{name} = {value!r}; it must be in (0, 1)")
         if int(self.max_iterations) != self.max_iterations or self.max_iterations < 1:
             raise ValueError(f"NewtonOptions.max_iterations = {self.max_iterations!r}; it must be a positive integer")
 
     def tolerance(self, field_name: str) -> float:
-        return {"u": self.rtol_u, "ebar": self.rtol_ebar}[field_name]
+        """Relative tolerance of the residual of field ``field_name``."""
+        named = dict(self.field_rtol)
+        return named.get(field_name, self.rtol_ebar if field_name == "ebar" else self.rtol_u)
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Bar with a weak zone (SPEC section 2), the 1D specimen of the gradient damage model."""
+"""Bar with a weak zone (docs/theory.md, section 2.1), the 1D specimen of the gradient damage model."""
 
 from __future__ import annotations
 

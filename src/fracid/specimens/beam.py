@@ -1,4 +1,4 @@
-"""Notched three-point bending beam (SPEC section 2), modelled as a symmetric half."""
+"""Notched three-point bending beam (docs/theory.md, section 2.2), modelled as a symmetric half."""
 
 from __future__ import annotations
 
