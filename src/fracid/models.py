@@ -146,8 +146,27 @@ class DamageModel(_PathFollowing):
         return {zone.name: zone_width_observer(zone, self.law.softening.kappa_at_damage(damage_threshold, params))}
 
 
+class _CrackModel(_PathFollowing):
+    """The models of one crack with Hordijk's law: plane stress, where the specimen says the crack runs."""
+
+    @property
+    def parameters(self) -> type:
+        return self.law.parameters
+
+    def why_not(self, specimen):
+        d = _description(specimen)
+        if d.dim != 2:
+            return "it is a plane-stress model"
+        if d.crack is None:
+            return "the specimen says nothing of where the crack runs"
+        return self._path_problem(d.crack)
+
+    def _path_problem(self, crack):
+        return None
+
+
 @dataclass(frozen=True)
-class CohesiveCrackModel(_PathFollowing):
+class CohesiveCrackModel(_CrackModel):
     """Discrete cohesive crack with Hordijk's law along the specimen's crack path (a symmetry line of
     the model), elastic bulk (docs/theory.md, section 5). The faces are tied by a penalty
     ``penalty_factor * E / h`` [MPa/mm] (h the finest element size along the path) until the traction
@@ -158,15 +177,8 @@ class CohesiveCrackModel(_PathFollowing):
     law: HordijkLaw = HordijkLaw()
     key: ClassVar[str] = "cohesive-crack-hordijk"
 
-    @property
-    def parameters(self) -> type:
-        return self.law.parameters
-
-    def why_not(self, specimen):
-        d = _description(specimen)
-        if d.dim != 2:
-            return "it is a plane-stress model"
-        if d.crack is None or d.crack.nodes is None or not d.crack.mirrored:
+    def _path_problem(self, crack):
+        if crack.nodes is None or not crack.mirrored:
             return "the specimen has no crack path on a symmetry line"
         return None
 
@@ -185,7 +197,7 @@ class CohesiveCrackModel(_PathFollowing):
 
 
 @dataclass(frozen=True)
-class CrackBandModel(_PathFollowing):
+class CrackBandModel(_CrackModel):
     """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width
     (docs/theory.md, section 5). Same parameters as the cohesive crack, so the two are directly
     comparable. The band is confined to the elements along the specimen's crack path (in a half
@@ -201,18 +213,6 @@ class CrackBandModel(_PathFollowing):
     @property
     def key(self) -> str:
         return "crack-band-hordijk" + ("" if self.band_width is None else f"-band-{self.band_width:g}")
-
-    @property
-    def parameters(self) -> type:
-        return self.law.parameters
-
-    def why_not(self, specimen):
-        d = _description(specimen)
-        if d.dim != 2:
-            return "it is a plane-stress model"
-        if d.crack is None:
-            return "the specimen says nothing of where the crack runs"
-        return None
 
     def build(self, specimen, params):
         d = _description(specimen)
