@@ -78,12 +78,13 @@ def test_failed_forward_runs_are_recorded_and_do_not_stop_the_study(bar_operator
 def test_study_counts_failed_runs_and_stays_in_the_bounds(bar_operator, bar_data):
     """A population with failing corners: the study goes on and states the failures in its summary (verdict.txt)."""
     from fracid.data import ExperimentalData
-    from fracid.inverse.study import run_study
+    from fracid.inverse.study import StudySettings, run_study
 
     y, std = bar_data
     data = ExperimentalData(control=POINTS, y=y, covariance=np.eye(y.size) * std**2, blocks=[("global", 0, y.size)])
     space = ParameterSpace(("c", "beta"), [0.01, 100.0], [4.0, 20000.0], log=(True, True))
-    study = run_study(bar_operator, data, space, starts=0, replicates=0, n=16, k=3, groups=GROUPS)
+    settings = StudySettings().replace(starts=0, replicates=0, n=16, k=3, groups=GROUPS)
+    study = run_study(bar_operator, data, space, settings)
     total, failed = study.runs["KNN"]
     assert total == 16 and failed > 0 and f"KNN 16 ({failed} failed)" in study.summary()
     assert f"{failed} of 16 KNN runs failed" in study.summary()

@@ -12,7 +12,7 @@ import fracid
 from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.strategy import identify
-from fracid.inverse.study import run_study
+from fracid.inverse.study import StudySettings, run_study
 from fracid.inverse.twin import synthetic_data
 from fracid.models import DamageModel, parameter_units
 
@@ -82,7 +82,7 @@ def test_a_new_model_is_identified_by_the_unchanged_inverse_code():
     result = identify(op, data.y, data.covariance, space, n=32, k=4, groups=[np.arange(20)])
     np.testing.assert_allclose(result.x, TRUTH, rtol=0.01)
     assert "N/mm" in result.summary()
-    study = run_study(op, data, space, n=32, k=4, groups="all", starts=0, replicates=0)
+    study = run_study(op, data, space, StudySettings().replace(n=32, k=4, groups="all", starts=0, replicates=0))
     assert study.verdict["ft"].status == "identified" and study.verdict["Gf"].status == "identified"
 
 

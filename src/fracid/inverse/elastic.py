@@ -3,14 +3,14 @@
 Before damage the model is linear in E: force / control = E * k1, with k1 the specimen's elastic
 stiffness per unit modulus. The measured initial slope is the least-squares slope through the origin
 of the points before the peak whose force is below a fraction of the peak. One elastic forward run
-gives k1, so E = slope / k1.
+gives k1, so E = slope / k1. The run goes through the forward-model interface (:mod:`fracid.models`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from fracid.forward import simulate
+from fracid.models import DamageModel
 
 
 def initial_slope(control, force, fraction: float = 0.3) -> float:
@@ -26,8 +26,13 @@ def initial_slope(control, force, fraction: float = 0.3) -> float:
     return float(np.sum(control[use] * force[use]) / np.sum(control[use] ** 2))
 
 
-def modulus_from_initial_slope(specimen, params, control, force, *, control_name=None, fraction: float = 0.3):
+def modulus_from_initial_slope(specimen, params, control, force, *, control_name=None, fraction: float = 0.3,
+                               model=None):
     """E [MPa] that makes the model's elastic stiffness equal the measured initial slope.
+
+    ``model`` is the forward model (:mod:`fracid.models`; ``DamageModel("gradient")`` when None); its
+    parameters ``params`` have ``E`` and the damage threshold ``kappa_i``, raised here so that the
+    run stays elastic.
 
     Returns
     -------
@@ -40,6 +45,7 @@ def modulus_from_initial_slope(specimen, params, control, force, *, control_name
     slope = initial_slope(control, force, fraction)
     elastic = params.replace(kappa_i=1.0)  # no damage: a linear run
     probe = float(np.asarray(control)[np.argmax(force)]) * 1e-3
-    run = simulate(specimen, elastic, control=control_name, target=probe, stop_force_fraction=None)
+    model = DamageModel("gradient") if model is None else model
+    run = model.simulate(specimen, elastic, control=control_name, target=probe, stop_force_fraction=None)
     stiffness = float(run.force[-1] / run.control[-1])
     return params.E * slope / stiffness, slope, stiffness

@@ -1,140 +1,184 @@
-"""The identification strategy: KNN population search, then the Kalman filter (SPEC section 4)."""
+"""The identification strategy: KNN population search, then the Kalman filter (docs/theory.md, sections 4.2 to 4.4).
+
+:class:`KnnKalman` is the default :class:`~fracid.inverse.method.InverseMethod` of :func:`identify`;
+another method is passed as ``identify(..., method=...)``.
+"""
 
 from __future__ import annotations
 
-import json
-import math
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass, field, fields
+from typing import ClassVar
 
 import numpy as np
 
-from fracid.inverse.kalman import GaussianEstimate, kalman_filter
-
-#: RMS fit error [% of the measured peak] above which a fit is reported as poor
-POOR_FIT_PERCENT = 10.0
+from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.knn import ParameterSpace, knn_search
+from fracid.inverse.method import InverseMethod, MethodResult, identification_bounds, result_fields
 from fracid.inverse.runs import StoredOperator
 from fracid.parallel import BatchStats
 
 
+def _knn_kalman_stages() -> dict:
+    return {"knn": "KNN", "kalman": "Kalman filter"}
+
+
 @dataclass
-class IdentificationResult(GaussianEstimate):
-    """Identified parameters with their uncertainty, the fit and how it was obtained.
+class IdentificationResult(MethodResult):
+    """The result of :class:`KnnKalman`: a :class:`~fracid.inverse.method.MethodResult` with the
+    records of its two stages.
 
     Attributes
     ----------
-    names : list of str
-    x, C : ndarray
-        Estimate and covariance (units of the parameters).
-    y_exp, y_fit, std_exp : ndarray
-        Measured values, values computed at the estimate, and the measurement standard deviations.
-    blocks : list of (name, start, stop)
-        Data blocks in y.
     history : list of dict
         Kalman estimate and covariance after every step of every global iteration.
     knn : dict
         Population, objective values, statuses, ranking, k, x0, C0.
-    runs : dict
-        Forward runs: KNN population, Kalman filter, failures; wall time [s].
-    notes : list of str
-        Rules applied to the data and the methods' settings.
+
+    ``runs`` holds ``knn`` (population), ``knn_failed``, ``knn_computed``, ``knn_reused``,
+    ``kalman`` (forward runs of the filter), ``kalman_failed``, ``kalman_computed``,
+    ``kalman_reused``, ``kalman_run_equivalents``, ``kalman_iterations`` and ``wall_seconds`` [s].
     """
 
-    names: list
-    x: np.ndarray
-    C: np.ndarray
-    y_exp: np.ndarray
-    y_fit: np.ndarray
-    std_exp: np.ndarray
-    blocks: list = field(default_factory=list)
     history: list = field(default_factory=list)
     knn: dict = field(default_factory=dict)
-    runs: dict = field(default_factory=dict)
-    notes: list = field(default_factory=list)
-    converged: bool = False
-    units: dict = field(default_factory=dict)
-    status: str = ""
-    at_bound: list = field(default_factory=list)
-    bounds: tuple = ()
+    method: str = "knn-kalman"
+    stages: dict = field(default_factory=_knn_kalman_stages)
 
-    @property
-    def rms_percent(self) -> float:
-        """RMS of (measured - computed) in per cent of the largest |measured| value (NaN if not computed)."""
-        y_exp, y_fit = np.asarray(self.y_exp, float), np.asarray(self.y_fit, float)
-        scale = np.max(np.abs(y_exp)) if y_exp.size else 0.0
-        rms = np.sqrt(np.mean((y_fit - y_exp) ** 2))
-        return float(100 * rms / scale) if scale > 0 else float("nan")
-
-    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT) -> list[str]:
-        """What a user must know before trusting the result: a non-finite or poor fit, estimates at a
-        bound, a filter that did not converge or stopped, failed forward runs."""
-        out = []
-        rms = self.rms_percent
-        if not np.all(np.isfinite(np.asarray(self.x, float))) or not math.isfinite(rms):
-            out.append("the result is not finite: no forward run succeeded at the estimate")
-        elif rms > poor_fit_percent:
-            out.append(f"the fit is poor: RMS error {rms:.3g} % of the measured peak (above {poor_fit_percent:g} %). "
-                       "Check the data's units (force_unit, control_unit) and sign, the bounds and the model")
-        if self.at_bound:
-            where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.names, self.x) if n in self.at_bound)
-            out.append(f"estimate at a bound of [identify.bounds]: {where}; the data pull it outside the bounds "
-                       "(widen them if that is physical); its std is the curvature there, not a spread")
-        if self.status and not self.converged:
-            out.append(f"Kalman filter {self.status}")
-        failed = {k: (self.runs or {}).get(k, 0) for k in ("knn_failed", "kalman_failed")}
-        if any(failed.values()):
-            out.append(f"failed forward runs: {failed['knn_failed']} of {self.runs.get('knn', 0)} KNN, "
-                       f"{failed['kalman_failed']} in the Kalman stage (recorded; see report.html)")
-        return out
-
-    def summary(self) -> str:
-        units = self.units
-        lines = []
-        for name, v, s in zip(self.names, self.x, self.std):
-            flag = "  (at a bound: the std is not a spread)" if name in self.at_bound else ""
-            lines.append(f"{name:>8} = {v:.6g} +- {s:.3g} {units.get(name, '')}{flag}".rstrip())
-        lines.append("correlation:\n" + np.array2string(self.correlation, precision=3))
-        if self.status:
-            lines.append(f"Kalman filter: {self.status}")
-        return "\n".join(lines)
-
-    def to_dict(self) -> dict:
-        def plain(v):
-            if isinstance(v, np.ndarray):
-                return v.tolist()
-            if isinstance(v, dict):
-                return {k: plain(w) for k, w in v.items()}
-            if isinstance(v, (list, tuple)):
-                return [plain(w) for w in v]
-            if isinstance(v, (np.floating, np.integer)):
-                return v.item()
-            return v
-
-        d = {k: plain(getattr(self, k)) for k in self.__dataclass_fields__}
-        d["std"], d["correlation"] = self.std.tolist(), self.correlation.tolist()
-        d["f_fit"] = float(np.sum(((self.y_exp - self.y_fit) / self.std_exp) ** 2))
-        return json.loads(json.dumps(d, allow_nan=True).replace("Infinity", "null"))
-
-    def save(self, path) -> Path:
-        """Write the result as JSON."""
-        path = Path(path)
-        path.write_text(json.dumps(self.to_dict(), indent=1))
-        return path
+    def failed_runs_text(self) -> str:
+        runs = self.runs or {}
+        return (f"{runs.get('knn_failed', 0)} of {runs.get('knn', 0)} KNN, "
+                f"{runs.get('kalman_failed', 0)} in the Kalman stage")
 
 
-def identification_bounds(operator, space: ParameterSpace) -> tuple[np.ndarray, np.ndarray]:
-    """The box the Kalman filter keeps its estimates in: the space's bounds within the parameters' valid ranges."""
-    lower, upper = operator.valid_bounds()
-    return np.maximum(space.lower, lower), np.minimum(space.upper, upper)
+@dataclass(frozen=True)
+class KnnSettings:
+    """The KNN population search (:func:`~fracid.inverse.knn.knn_search`).
+
+    Attributes
+    ----------
+    n : int
+        Population size (for ``method="grid"``: points per parameter).
+    method : {"sobol", "lhs", "grid"}
+        Design of the population over the parameter space (:func:`~fracid.inverse.knn.design`).
+    seed : int
+        Seed of the design.
+    k : int
+        Nearest neighbours whose mean and spread are the Kalman filter's prior.
+    """
+
+    n: int = 64
+    method: str = "sobol"
+    seed: int = 0
+    k: int = 5
 
 
-def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sobol", seed=0, k=5,
-             groups=None, max_iterations=10, tol=0.01, restart="linearize", executor=None, store=None, blocks=(), notes=(),
-             progress=None, retry_failed=False) -> IdentificationResult:
-    """KNN over a population for a global overview and the prior, then the Kalman filter to refine.
+@dataclass(frozen=True)
+class KalmanSettings:
+    """The Kalman filter (:func:`~fracid.inverse.kalman.kalman_filter`).
+
+    Attributes
+    ----------
+    groups : None, sequence of index arrays, "blocks" or "all"
+        The observation sequence: one observation per step (None), the given index arrays, one
+        step per data block (``"blocks"``) or one step with every observation (``"all"``: the batch
+        filter).
+    max_iterations : int
+        Global iterations (passes over the observations) at most.
+    tol : float
+        Convergence: no parameter moves by more than ``tol`` of its standard deviation [-].
+    restart : {"linearize", "prior-mean"}
+        How a global iteration starts again (see :func:`~fracid.inverse.kalman.kalman_filter`).
+    """
+
+    groups: object = None
+    max_iterations: int = 10
+    tol: float = 0.01
+    restart: str = "linearize"
+
+    def options(self, n_y: int, blocks=()) -> dict:
+        """Keyword arguments of :func:`~fracid.inverse.kalman.kalman_filter` for ``n_y`` observations in
+        ``blocks`` (``(name, start, stop)``; a named ``groups`` is resolved with them)."""
+        return {"groups": named_groups(self.groups, n_y, blocks), "max_iterations": self.max_iterations,
+                "tol": self.tol, "restart": self.restart}
+
+
+def named_groups(groups, n_y: int, blocks=()):
+    """``groups`` as index arrays: ``"all"`` is one group of the ``n_y`` observations, ``"blocks"`` one per
+    data block ``(name, start, stop)``; anything else is returned as it is."""
+    if not isinstance(groups, str):
+        return groups
+    if groups == "all":
+        return [np.arange(n_y)]
+    if groups == "blocks":
+        return [np.arange(start, stop) for _, start, stop in blocks or [("all", 0, n_y)]]
+    raise ValueError(f"groups = {groups!r}; give index arrays, None, 'blocks' or 'all'")
+
+
+@dataclass(frozen=True)
+class KnnKalman:
+    """The default inverse method: KNN over a population for a global overview and the prior, then
+    the bounded step-by-step Kalman filter from that prior (the thesis's cascade, docs/theory.md, section 4.4).
+
+    Its stages are ``"knn"`` and ``"kalman"`` (the keys of their counters in ``runs``); it returns an
+    :class:`IdentificationResult`.
+
+    Attributes
+    ----------
+    knn : KnnSettings
+    kalman : KalmanSettings
+    """
+
+    knn: KnnSettings = KnnSettings()
+    kalman: KalmanSettings = KalmanSettings()
+    name: ClassVar[str] = "knn-kalman"
+
+    def search(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
+               stats=None, retry_failed=False):
+        """The KNN stage: a :class:`~fracid.inverse.knn.KnnResult` (population, ranking, prior x0, C0)."""
+        knn = self.knn
+        return knn_search(operator, y_exp, C_exp, space, n=knn.n, method=knn.method, seed=knn.seed, k=knn.k,
+                          executor=executor, store=store, progress=progress, stats=stats, retry_failed=retry_failed)
+
+    def refine(self, operator, y_exp, C_exp, knn, *, C0=None, executor=None, blocks=(), notes=(), started=None,
+               progress=False) -> IdentificationResult:
+        """The Kalman stage from the prior of ``knn``: :func:`refine` with these settings."""
+        return refine(operator, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes,
+                      method=self.knn.method, seed=self.knn.seed, started=started, C0=C0, progress=progress,
+                      **self.kalman.options(np.size(y_exp), blocks))
+
+    def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
+                 retry_failed=False, blocks=(), notes=()) -> IdentificationResult:
+        """Both stages (see :class:`~fracid.inverse.method.InverseMethod`).
+
+        Raises
+        ------
+        AllRunsFailed
+            When fewer than k population runs succeeded. A failed run of the Kalman stage never
+            raises: see :func:`refine`.
+        """
+        start = time.perf_counter()
+        stats = BatchStats()
+        knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+                          stats=stats, retry_failed=retry_failed)
+        evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
+        result = self.refine(evaluate, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes,
+                             started=start, progress=progress)
+        result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
+        return result
+
+
+#: the keywords of :func:`identify` that build the default method, with their defaults
+_DEFAULT_METHOD_KEYWORDS = {**{f.name: f.default for f in fields(KnnSettings)},
+                            **{f.name: f.default for f in fields(KalmanSettings)}}
+
+
+def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMethod | str | None = None, n=64,
+             seed=0, k=5, groups=None, max_iterations=10, tol=0.01, restart="linearize", executor=None, store=None,
+             blocks=(), notes=(), progress=None, retry_failed=False) -> MethodResult:
+    """Identify the parameters of ``space`` from the data with an inverse method (by default KNN over a
+    population for a global overview and the prior, then the Kalman filter to refine).
 
     Parameters
     ----------
@@ -142,45 +186,72 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="sob
     y_exp, C_exp : ndarray
         Measured data and covariance (e.g. from :mod:`fracid.data`).
     space : ParameterSpace
-        Bounds of the population and of the Kalman filter's estimates (:func:`identification_bounds`).
-    n, method, seed, k
-        KNN population and neighbours (:func:`~fracid.inverse.knn.knn_search`).
+        Bounds of the estimates (:func:`~fracid.inverse.method.identification_bounds`) and, for the
+        default method, of the population.
+    method : InverseMethod, str or None
+        The inverse method (:class:`~fracid.inverse.method.InverseMethod`). None or a str: the default,
+        :class:`KnnKalman` with the settings below; the str is then the design of its population
+        (``"sobol"`` when None, ``"lhs"``, ``"grid"``).
+    n, seed, k
+        KNN population and neighbours of the default method (:class:`KnnSettings`).
     groups, max_iterations, tol, restart
-        Kalman filter settings (:func:`~fracid.inverse.kalman.kalman_filter`).
+        Kalman filter settings of the default method (:class:`KalmanSettings`); ``groups`` may be
+        ``"blocks"`` or ``"all"``.
     executor, store
-        Parallel execution and the persistent run store (KNN and Kalman runs are stored).
+        Parallel execution and the persistent run store.
     progress : None, bool
-        Progress bars of both stages (None: on a terminal).
+        Progress bars (None: on a terminal).
     retry_failed : bool
         Run again the runs stored as failed.
+
+    Returns
+    -------
+    MethodResult
+        An :class:`IdentificationResult` for the default method; ``runs["wall_seconds"]`` is the wall
+        time of the call [s].
 
     Raises
     ------
     AllRunsFailed
-        When fewer than k population runs succeeded. A failed run of the Kalman stage never raises:
-        see :func:`refine`.
+        Default method: when fewer than k population runs succeeded. A failed run of the Kalman stage
+        never raises: see :func:`refine`.
+    ValueError
+        When ``method`` is an inverse method and settings of the default method are given too.
     """
     start = time.perf_counter()
     y_exp, C_exp = np.asarray(y_exp, float), np.asarray(C_exp, float)
-    stats = BatchStats()
-    knn = knn_search(operator, y_exp, C_exp, space, n=n, method=method, seed=seed, k=k, executor=executor,
-                     store=store, progress=progress, stats=stats, retry_failed=retry_failed)
-    evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
-    result = refine(evaluate, y_exp, C_exp, knn, groups=groups, max_iterations=max_iterations, tol=tol,
-                    restart=restart, executor=executor, blocks=blocks, notes=notes, method=method, seed=seed,
-                    started=start, progress=progress)
-    result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
+    given = {"n": n, "seed": seed, "k": k, "groups": groups, "max_iterations": max_iterations, "tol": tol,
+             "restart": restart}
+    if method is None or isinstance(method, str):
+        design = {} if method is None else {"method": method}
+        method = KnnKalman(KnnSettings(n=n, seed=seed, k=k, **design),
+                           KalmanSettings(groups=groups, max_iterations=max_iterations, tol=tol, restart=restart))
+    else:
+        changed = [name for name, value in given.items() if not _is_default(value, _DEFAULT_METHOD_KEYWORDS[name])]
+        if changed:
+            raise ValueError(f"{', '.join(changed)}: settings of the default method (KNN -> Kalman filter), "
+                             f"not of the method {getattr(method, 'name', method)!r} given; give them to the method")
+    result = method(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+                    retry_failed=retry_failed, blocks=blocks, notes=notes)
+    result.runs["wall_seconds"] = time.perf_counter() - start
     return result
+
+
+def _is_default(value, default) -> bool:
+    if value is default:
+        return True
+    return isinstance(value, (int, float, str)) and type(value) is type(default) and value == default
 
 
 def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0.01, restart="linearize",
            executor=None, blocks=(), notes=(), method="", seed=0, started=None, C0=None,
            progress=False) -> IdentificationResult:
-    """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :func:`identify`.
+    """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :class:`KnnKalman`.
 
     ``C0`` replaces the KNN covariance as the prior's (e.g. the bounds' covariance, so that the
     posterior holds the information of the data alone). ``operator`` may be a
-    :class:`~fracid.inverse.runs.StoredOperator` (its runs are then stored and counted).
+    :class:`~fracid.inverse.runs.StoredOperator` (its runs are then stored and counted). ``method``
+    and ``seed`` are the population's design, recorded in the result.
 
     The filter stays inside the KNN space's bounds and does not raise on failed forward runs. When
     it could not evaluate any estimate of its own (every run near its points failed), the result is
@@ -207,18 +278,12 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
             "kalman_iterations": kalman.iterations, "wall_seconds": time.perf_counter() - start}
     if after is not None:
         runs.update(kalman_computed=after[0] - before[0], kalman_reused=after[1] - before[1])
-    lower, upper = bounds
-    span = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
-    at_bound = [n for n, v, lo, hi, w in zip(knn.space.names, x, lower, upper, span)
-                if min(v - lo, hi - v) <= 1e-9 * w]
+    notes = list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {knn.k}",
+                           f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std; "
+                           f"{status}"]
     return IdentificationResult(
-        names=list(knn.space.names), x=x, C=C, y_exp=y_exp, y_fit=y_fit,
-        std_exp=np.sqrt(np.diag(C_exp)), blocks=list(blocks), history=kalman.history, knn=knn_summary, runs=runs,
-        notes=list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {knn.k}",
-                             f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std; "
-                             f"{status}"],
-        converged=kalman.converged, units=dict(operator.units), status=status, at_bound=at_bound,
-        bounds=(lower.tolist(), upper.tolist()),
+        x=x, C=C, y_fit=y_fit, history=kalman.history, knn=knn_summary, runs=runs, converged=kalman.converged,
+        status=status, **result_fields(operator, knn.space, x, y_exp, C_exp, blocks=blocks, notes=notes),
     )
 
 
@@ -234,7 +299,7 @@ def _counters(operator):
     return None
 
 
-def identify_data(operator, data, space: ParameterSpace, **settings) -> IdentificationResult:
+def identify_data(operator, data, space: ParameterSpace, **settings) -> MethodResult:
     """:func:`identify` with measured data from :mod:`fracid.data` (its blocks and notes are kept).
 
     ``data`` is an :class:`~fracid.data.ExperimentalData`; its blocks must line up with the

@@ -1,10 +1,10 @@
-"""The identification strategy as one study (SPEC 4), ending in a verdict per parameter.
+"""The identification strategy as one study (docs/theory.md, section 4.4), ending in a verdict per parameter.
 
 KNN over a population (overview, prior) -> sensitivity along the load history at the KNN estimate
 (which stage of the test informs which parameter) -> uniqueness (valley of the objective over the
 population) -> Kalman filter -> multi-start check -> stability under noise -> prediction of data not
 used for calibration -> verdict. The sensitivities need a point, which is why they follow the KNN
-search rather than precede it; every other stage runs in the order of the thesis's strategy.
+search rather than precede it; every other stage runs in the order of the thesis's strategy (docs/theory.md, section 4.4).
 """
 
 from __future__ import annotations
@@ -12,17 +12,16 @@ from __future__ import annotations
 import json
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.analyses import sensitivity_history
-from fracid.inverse.knn import knn_search
-from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError
+from fracid.inverse.method import identification_bounds
+from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError, sensitivity_history
 from fracid.inverse.stability import stability as stability_check
 from fracid.inverse.runs import StoredOperator
-from fracid.inverse.strategy import identification_bounds, refine
+from fracid.inverse.strategy import KalmanSettings, KnnKalman, KnnSettings
 from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
 from fracid.inverse.verdict import DataDescription, parameter_verdicts
 
@@ -110,7 +109,7 @@ class StudyResult:
             lines.append(self.runs_text())
         ident = self.identification
         if getattr(ident, "status", ""):
-            lines.append(f"Kalman filter: {ident.status}")
+            lines.append(f"{ident.status_label}: {ident.status}")
         lines += [f"Note: {note}" for note in self.notes]
         if self.predictions:
             lines.append("Predictions of data not used for calibration:")
@@ -156,8 +155,10 @@ class StudyResult:
         (directory / "verdict.txt").write_text(self.summary() + "\n")
         header = ",".join(self.names)
         ident = self.identification
-        population = np.column_stack([np.asarray(ident.knn["points"], float), np.asarray(ident.knn["f"], float)])
-        np.savetxt(directory / "population.csv", population, delimiter=",", header=header + ",f", comments="")
+        population = getattr(ident, "knn", None) or {}
+        if population.get("points") is not None:
+            table = np.column_stack([np.asarray(population["points"], float), np.asarray(population["f"], float)])
+            np.savetxt(directory / "population.csv", table, delimiter=",", header=header + ",f", comments="")
         if self.sensitivity is not None:
             table = np.column_stack([self.sensitivity.normalised, self.sensitivity.variance_share])
             cols = [f"S_{n}" for n in self.names] + [f"variance_removed_{n}" for n in self.names]
@@ -167,10 +168,75 @@ class StudyResult:
         return directory
 
 
-def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates: int = 5, noise_seed: int = 0,
-              tolerance: float = 0.1, n=64, method="sobol", seed=0, k=5, groups=None, max_iterations=10, tol=0.01,
-              restart="linearize", prior="knn", executor=None, store=None, progress=None, log=None,
-              retry_failed=False) -> StudyResult:
+@dataclass(frozen=True)
+class StudySettings:
+    """What :func:`run_study` computes. Execution (executor, store, progress, log) is not a setting.
+
+    Attributes
+    ----------
+    knn : KnnSettings
+        The population search: overview, prior mean, objective maps and the starting points of the
+        multi-start check.
+    kalman : KalmanSettings
+        The Kalman filter of the identification, of every multi-start filter and of every noisy
+        replicate; its ``groups`` may also be ``"blocks"`` (one filter step per data block) or
+        ``"all"`` (one step: the batch filter).
+    prior : {"knn", "bounds"}
+        Covariance of the Kalman filter's prior (mean: the KNN estimate): the spread of the k
+        nearest neighbours (the thesis's cascade, docs/theory.md, section 4.4), or the bounds' uniform covariance. The
+        neighbours were ranked with the same data, so "bounds" keeps the posterior to what the
+        data say, which comparisons of data sets (twin matrices) need.
+    starts : int
+        Starting points of the multi-start check (0 or 1: skipped).
+    replicates : int
+        Noisy replicates of the stability check (0: skipped).
+    noise_seed : int
+        Seed of the replicates' noise.
+    tolerance : float
+        Largest relative standard deviation std / |estimate| called identified [-] (0.1: 10 %).
+    """
+
+    knn: KnnSettings = KnnSettings()
+    kalman: KalmanSettings = KalmanSettings()
+    prior: str = "knn"
+    starts: int = 3
+    replicates: int = 5
+    noise_seed: int = 0
+    tolerance: float = 0.1
+
+    def __post_init__(self):
+        if self.prior not in ("knn", "bounds"):
+            raise ValueError(f"prior = {self.prior!r}; choose 'knn' or 'bounds'")
+
+    @property
+    def identification(self) -> KnnKalman:
+        """The inverse method of the identification: :class:`~fracid.inverse.strategy.KnnKalman`."""
+        return KnnKalman(self.knn, self.kalman)
+
+    def replace(self, **changes) -> StudySettings:
+        """A copy with ``changes``: fields of this class, or settings of its ``knn`` (``n``, ``method``,
+        ``seed``, ``k``) and ``kalman`` (``groups``, ``max_iterations``, ``tol``, ``restart``) by
+        their own names.
+
+        Raises
+        ------
+        TypeError
+            For a name that is none of these.
+        """
+        nested = {"knn": {f.name for f in fields(KnnSettings)}, "kalman": {f.name for f in fields(KalmanSettings)}}
+        known = {f.name for f in fields(self)}.union(*nested.values())
+        unknown = sorted(set(changes) - known)
+        if unknown:
+            raise TypeError(f"unknown study setting(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+        for part, names in nested.items():
+            own = {name: changes.pop(name) for name in list(changes) if name in names}
+            if own:
+                changes[part] = replace(changes.get(part, getattr(self, part)), **own)
+        return replace(self, **changes)
+
+
+def run_study(operator, data, space, settings: StudySettings = StudySettings(), *, held_out=(), executor=None,
+              store=None, progress=None, log=None, retry_failed=False) -> StudyResult:
     """Run the identification strategy with its checks and return the verdict.
 
     Parameters
@@ -182,24 +248,14 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     space : ParameterSpace
         Bounds of the population; also the prior of the multi-start filters and the reference of
         the variance removed.
+    settings : StudySettings
+        The methods' settings and the checks to make (``StudySettings().replace(n=32, starts=0)``).
     held_out : sequence of (ForwardOperator, ExperimentalData)
         Data not used for calibration, predicted at the estimate.
-    starts : int
-        Starting points of the multi-start check (0 or 1: skipped).
-    replicates : int
-        Noisy replicates of the stability check (0: skipped).
-    noise_seed : int
-        Seed of the replicates' noise.
-    tolerance : float
-        Largest relative standard deviation called identified.
-    prior : {"knn", "bounds"}
-        Covariance of the Kalman filter's prior (mean: the KNN estimate): the spread of the k
-        nearest neighbours (the thesis's cascade), or the bounds' uniform covariance. The
-        neighbours were ranked with the same data, so "bounds" keeps the posterior to what the
-        data say, which comparisons of data sets (twin matrices) need.
-    n, method, seed, k, groups, max_iterations, tol, restart
-        KNN and Kalman settings, as in :func:`~fracid.inverse.strategy.identify`; ``groups`` may also
-        be ``"blocks"`` (one filter step per data block) or ``"all"`` (one step: the batch filter).
+    executor, store
+        Parallel execution and the persistent run store.
+    progress : None, bool
+        Progress bars (None: on a terminal).
     log : callable(str), optional
         Receives one line per stage (the command line prints them); silent if None.
     retry_failed : bool
@@ -221,13 +277,10 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         clock = now
 
     y, C = data.y, data.covariance
-    if isinstance(groups, str):
-        groups = _named_groups(groups, data)
-    kalman = {"groups": groups, "max_iterations": max_iterations, "tol": tol, "restart": restart}
+    method = settings.identification
+    kalman = settings.kalman.options(data.n_y, data.blocks)
     bounds = identification_bounds(operator, space)
     C_bounds = bounds_covariance(space)
-    if prior not in ("knn", "bounds"):
-        raise ValueError(f"prior = {prior!r}; choose 'knn' or 'bounds'")
     evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
     runs, notes = {}, []
 
@@ -235,12 +288,12 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         runs[name] = (evaluate.computed + evaluate.reused - before[0], evaluate.failed - before[1])
         stage(name)
 
-    log(f"KNN: population of {n} ({method})")
-    knn = knn_search(operator, y, C, space, n=n, method=method, seed=seed, k=k, executor=executor, store=store,
-                     progress=progress, retry_failed=retry_failed)
+    log(f"KNN: population of {settings.knn.n} ({settings.knn.method})")
+    knn = method.search(operator, y, C, space, executor=executor, store=store, progress=progress,
+                        retry_failed=retry_failed)
     runs["KNN"] = (len(knn.points), knn.n_failed)
     stage("knn")
-    C0 = knn.C0 if prior == "knn" else C_bounds
+    C0 = knn.C0 if settings.prior == "knn" else C_bounds
     log("sensitivity along the load history at the KNN estimate")
     mark = (evaluate.computed + evaluate.reused, evaluate.failed)
     try:
@@ -253,10 +306,11 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     maps, extent = objective_maps(knn), valley_extent(knn)
     log("Kalman filter from the KNN prior")
     mark = (evaluate.computed + evaluate.reused, evaluate.failed)
-    ident = refine(evaluate, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
-                   method=method, seed=seed, C0=C0, progress=progress, **kalman)
+    ident = method.refine(evaluate, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
+                          C0=C0, progress=progress)
     count("Kalman", mark)
     ms = None
+    starts, replicates = settings.starts, settings.replicates
     if starts > 1:
         points = starting_points(knn, starts)
         log(f"multi-start check from {len(points)} starting points")
@@ -276,8 +330,8 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
         log(f"stability check: {replicates} noisy replicates")
         mark = (evaluate.computed + evaluate.reused, evaluate.failed)
         with stage_bar(progress, replicates, "noisy replicates") as tick:
-            st = stability_check(evaluate, y, C, knn.x0, C0, replicates=replicates, seed=noise_seed, bounds=bounds,
-                                 executor=executor, progress=tick, **kalman)
+            st = stability_check(evaluate, y, C, knn.x0, C0, replicates=replicates, seed=settings.noise_seed,
+                                 bounds=bounds, executor=executor, progress=tick, **kalman)
         failed_replicates = sum(bool(e) for e in st.errors)
         if failed_replicates:
             notes.append(f"stability: {failed_replicates} of {replicates} replicates failed")
@@ -292,7 +346,7 @@ def run_study(operator, data, space, *, held_out=(), starts: int = 3, replicates
     if runs["KNN"][1]:
         notes.insert(0, f"{runs['KNN'][1]} of {runs['KNN'][0]} KNN runs failed (they rank last; see population.csv)")
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
-                                 tolerance=tolerance, multi_start=ms, stability=st)
+                                 tolerance=settings.tolerance, multi_start=ms, stability=st)
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes)
 
 
@@ -305,12 +359,4 @@ def stage_bar(progress, total, description):
         yield batch_progress(bar)
 
 
-def _named_groups(name, data):
-    if name == "all":
-        return [np.arange(data.n_y)]
-    if name == "blocks":
-        return [np.arange(start, stop) for _, start, stop in data.blocks]
-    raise ValueError(f"groups = {name!r}; give index arrays, None, 'blocks' or 'all'")
-
-
-__all__ = ["Prediction", "StudyResult", "describe_data", "predict", "run_study"]
+__all__ = ["Prediction", "StudyResult", "StudySettings", "describe_data", "predict", "run_study"]

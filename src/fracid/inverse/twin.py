@@ -112,7 +112,8 @@ class TwinOutcome:
         return out
 
 
-def twin_matrix(cases: dict, x_true, std, space, *, seed: int | None = 1, log=None, **settings) -> dict:
+def twin_matrix(cases: dict, x_true, std, space, settings=None, *, seed: int | None = 1, log=None, executor=None,
+                store=None, progress=None, retry_failed=False, **changes) -> dict:
     """Twin experiments over several data sets: synthetic data per case, then the study.
 
     Parameters
@@ -124,31 +125,37 @@ def twin_matrix(cases: dict, x_true, std, space, *, seed: int | None = 1, log=No
     std : dict or float
         Noise per block, see :func:`synthetic_data`.
     space : ParameterSpace
+    settings : StudySettings, optional
+        Settings of every study (:class:`~fracid.inverse.study.StudySettings`; its defaults if None).
     seed : int or None
         Noise seed, the same for every case.
-    settings
-        Keyword arguments of :func:`fracid.inverse.study.run_study`.
+    executor, store, progress, retry_failed
+        Execution of the studies, as in :func:`~fracid.inverse.study.run_study`.
+    changes
+        Changes to ``settings`` by name (:meth:`StudySettings.replace`, e.g. ``n=16, starts=0``).
 
     Returns
     -------
     dict of str -> TwinOutcome
     """
-    from fracid.inverse.study import run_study
+    from fracid.inverse.study import StudySettings, run_study
 
+    settings = (StudySettings() if settings is None else settings).replace(**changes)
     x_true = np.asarray(x_true, float)
     outcomes = {}
     for name, operator in cases.items():
         if log is not None:
             log(f"twin case {name!r}")
         data = synthetic_data(operator, x_true, std, seed=seed)
-        study = run_study(operator, data, space, **settings)
+        study = run_study(operator, data, space, settings, executor=executor, store=store, progress=progress,
+                          retry_failed=retry_failed)
         outcomes[name] = TwinOutcome(name, study, x_true, data)
     return outcomes
 
 
 def dogbone_cases(params, names=("c", "beta"), *, sizes=(50.0, 100.0, 200.0), reference=100.0, h_fine=2.5,
-                  n_points=15, damage_threshold=0.5, regularization="gradient") -> dict:
-    """The four data sets of the thesis's identifiability study on dog-bones (van Vliet & van Mier).
+                  n_points=15, damage_threshold=0.5, model=None) -> dict:
+    """The four data sets of the thesis's identifiability study on dog-bones (van Vliet & van Mier; docs/theory.md, section 4.9).
 
     ``one size``: the force-elongation curve of the ``reference`` size; ``three sizes``: the curves
     of all ``sizes``; ``local only``: the FPZ width (damage above ``damage_threshold``) of the
@@ -157,17 +164,22 @@ def dogbone_cases(params, names=("c", "beta"), *, sizes=(50.0, 100.0, 200.0), re
 
     Each curve is sampled at ``n_points`` elongations from 1/n_points of the range to where the
     force at ``params`` has fallen to 20 % of its peak (or the specimen's default target).
+
+    ``model`` is the forward model (:mod:`fracid.models`) of the curves and of every case's operator;
+    ``DamageModel("gradient")`` when None.
     """
-    from fracid.forward import simulate
     from fracid.inverse.forward_operator import ForwardOperator, Observation
+    from fracid.models import DamageModel
     from fracid.specimens.dogbone import DogBone
+
+    model = DamageModel("gradient") if model is None else model
 
     if reference not in sizes:
         raise ValueError(f"the reference size {reference} must be one of the sizes {sizes}")
     curves, local = {}, {}
     for D in sizes:
         specimen = DogBone(size=float(D), h_fine=h_fine)
-        run = simulate(specimen, params, regularization=regularization, stop_force_fraction=0.2)
+        run = model.simulate(specimen, params, stop_force_fraction=0.2)
         points = np.linspace(run.control[-1] / n_points, run.control[-1], n_points)
         curves[D] = Observation(specimen, points, name=f"force D{D:g}")
         local[D] = Observation(specimen, points, quantity="fpz_width", name=f"fpz D{D:g}",
@@ -177,4 +189,4 @@ def dogbone_cases(params, names=("c", "beta"), *, sizes=(50.0, 100.0, 200.0), re
             "local only": [local[reference]],
             "one size + local": [curves[reference], local[reference]],
             "all": [curves[D] for D in sizes] + [local[reference]]}
-    return {name: ForwardOperator(obs, params, names, regularization=regularization) for name, obs in sets.items()}
+    return {name: ForwardOperator(obs, params, names, model=model) for name, obs in sets.items()}

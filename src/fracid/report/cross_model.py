@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fracid.report.figures import _COMPUTED, _MEASURED, _NEIGHBOUR, _new_figure, to_png
-from fracid.report.html import (_e, _fit_section, _image, _kalman_section, _parameter_section, _runs_section, _table,
+from fracid.report.html import (_e, _fit_section, _image, _parameter_section, _runs_section, _stage_sections, _table,
                                 generated_now, write_document)
 
 #: line colours of the fitted models, in the order of the fits of a panel
@@ -157,8 +157,8 @@ def _fit_details(fit, control) -> str:
     from fracid.report import figures
 
     result = fit.identification
-    sections = [_parameter_section(result), _fit_section(result, control, figures), _kalman_section(result, figures),
-                _runs_section(result)]
+    final_stage = _stage_sections(result, figures, limit=1)  # the stage that gave the estimate
+    sections = [_parameter_section(result), _fit_section(result, control, figures), *final_stage, _runs_section(result)]
     return (f"<details><summary>{_e(fit.label)} ({_e(fit.model_key)}): identification details</summary>\n"
             + "\n".join(sections) + "\n</details>")
 

@@ -99,7 +99,7 @@ def result_blocks(result) -> list[tuple[str, int, int]]:
 def knn_arrays(result):
     """Population ``points`` (N, p), objective ``f`` (inf where failed), boolean ``failed``,
     ranking ``order`` and ``k`` of the result's KNN search; ``None`` without a population."""
-    knn = result.knn or {}
+    knn = getattr(result, "knn", None) or {}
     points = knn.get("points")
     if points is None or np.size(points) == 0:
         return None
@@ -217,7 +217,7 @@ def kalman_figure(result) -> Figure | None:
     x axis: cumulative step index over the global iterations (0 = the prior from KNN when known);
     dotted vertical lines separate the global iterations; the horizontal line is the final value.
     """
-    history = list(result.history or [])
+    history = list(getattr(result, "history", None) or [])
     if not history:
         return None
     names = list(result.names)
@@ -225,7 +225,7 @@ def kalman_figure(result) -> Figure | None:
     xs = np.array([_float_array(h["x"], np.nan).reshape(p) for h in history])
     stds = np.array([np.sqrt(np.maximum(np.diag(_float_array(h["C"], np.nan).reshape(p, p)), 0.0)) for h in history])
     index = np.arange(1, len(history) + 1)
-    knn = result.knn or {}
+    knn = getattr(result, "knn", None) or {}
     if knn.get("x0") is not None and knn.get("C0") is not None:
         x0 = _float_array(knn["x0"], np.nan).reshape(p)
         s0 = np.sqrt(np.maximum(np.diag(_float_array(knn["C0"], np.nan).reshape(p, p)), 0.0))
@@ -323,7 +323,7 @@ def knn_map_figure(result) -> Figure | None:
     x = _float_array(result.x, np.nan)
     C = _float_array(result.C, np.nan).reshape(len(names), len(names))
     sub = np.ix_([i, j], [i, j])
-    knn = result.knn or {}
+    knn = getattr(result, "knn", None) or {}
     if knn.get("x0") is not None and knn.get("C0") is not None:
         x0 = _float_array(knn["x0"], np.nan)
         C0 = _float_array(knn["C0"], np.nan).reshape(len(names), len(names))

@@ -175,7 +175,7 @@ def _parameter_section(result) -> str:
     shown = "".join(f'<li><span class="warn">warning</span>: {_e(w)}</li>' for w in warnings)
     rms = getattr(result, "rms_percent", float("nan"))
     return (f"<h2>Identified parameters</h2>\n{table}\n"
-            f"<p>Kalman filter: {status}. Fit: RMS error {_num(rms, 3)} % of the measured peak. Standard "
+            f"<p>{_e(_status_label(result))}: {status}. Fit: RMS error {_num(rms, 3)} % of the measured peak. Standard "
             "deviations are the square roots of the diagonal of the posterior covariance C.</p>"
             + (f'\n<ul class="notes">{shown}</ul>' if shown else ""))
 
@@ -209,7 +209,7 @@ def _fit_section(result, control, figures) -> str:
     return f"<h2>Fit</h2>\n{image}\n{table}\n<p>{_e(unit_note)}</p>"
 
 
-def _kalman_section(result, figures) -> str:
+def _kalman_section(result, name, figures) -> str:
     fig = figures.kalman_figure(result)
     if fig is None:
         return "<h2>Kalman filter</h2>\n<p>No Kalman history in this result.</p>"
@@ -219,7 +219,7 @@ def _kalman_section(result, figures) -> str:
     return f"<h2>Kalman filter</h2>\n{image}"
 
 
-def _knn_section(result, figures) -> str:
+def _knn_section(result, name, figures) -> str:
     arrays = figures.knn_arrays(result)
     if arrays is None:
         return "<h2>KNN population</h2>\n<p>No KNN population in this result.</p>"
@@ -251,19 +251,85 @@ def _knn_section(result, figures) -> str:
     return "\n".join(parts)
 
 
+#: report sections of the stages known by name: ``section(result, stage name, figures module)``
+STAGE_SECTIONS = {"kalman": _kalman_section, "knn": _knn_section}
+
+
 def _runs_section(result) -> str:
     runs = dict(result.runs or {})
-    if "kalman_iterations" not in runs and result.history:
-        runs["kalman_iterations"] = len({h.get("iteration", 1) for h in result.history})
+    history = getattr(result, "history", None)
+    if "kalman" in _stages(result) and "kalman_iterations" not in runs and history:
+        runs["kalman_iterations"] = len({h.get("iteration", 1) for h in history})
     rows = []
     for key in list(_RUN_LABELS) + [k for k in runs if k not in _RUN_LABELS]:
         if key not in runs:
             continue
         value = runs[key]
         shown = _duration(value) if key == "wall_seconds" else _num(value, 6)
-        rows.append([_RUN_LABELS.get(key, key), shown])
-    rows.append(["Kalman filter converged", "yes" if result.converged else "no"])
+        rows.append([_run_label(result, key), shown])
+    rows.append([f"{_status_label(result)} converged", "yes" if result.converged else "no"])
     return "<h2>Run statistics</h2>\n" + _table(["", ""], rows, text_columns=(0,))
+
+
+def _stages(result) -> dict:
+    """The stages the result declares (name -> label), in the order they ran."""
+    return dict(getattr(result, "stages", None) or {})
+
+
+def _status_label(result) -> str:
+    """The stage that gave the estimate, as the status line names it."""
+    return getattr(result, "status_label", None) or "identification"
+
+
+def _run_label(result, key: str) -> str:
+    """Row label of a run counter: known ones from :data:`_RUN_LABELS`, a stage's from its label."""
+    if key in _RUN_LABELS:
+        return _RUN_LABELS[key]
+    for stage, label in _stages(result).items():
+        if key == stage:
+            return f"{label} forward runs"
+        if key.startswith(f"{stage}_"):
+            return f"{label} {key[len(stage) + 1:].replace('_', ' ')}"
+    return key
+
+
+def _record_value(value) -> str:
+    """A recorded value in one cell: numbers formatted, sequences of up to 10 values listed."""
+    def one(v):
+        if isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
+            return f"{float(v):.6g}" if math.isfinite(float(v)) else str(float(v))
+        return str(v)
+
+    if isinstance(value, dict):
+        return f"{len(value)} entries"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        flat = list(np.ravel(np.asarray(value, dtype=object)))
+        text = ", ".join(one(v) for v in flat[:10]) + (f", ... ({len(flat)} values)" if len(flat) > 10 else "")
+    else:
+        text = one(value)
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _stage_section(result, name: str, figures) -> str:
+    """A stage the report has no section of its own for: its label and what it recorded
+    (``result.records[name]``; its forward runs are under the run statistics)."""
+    label = _stages(result).get(name, name)
+    record = (getattr(result, "records", None) or {}).get(name)
+    if isinstance(record, dict) and record:
+        body = _table(["", ""], [[str(key), _record_value(value)] for key, value in record.items()], text_columns=(0,))
+    elif record is not None and not isinstance(record, dict):
+        body = f"<p>{_e(_record_value(record))}</p>"
+    else:
+        body = "<p>No record of this stage in this result.</p>"
+    return f"<h2>{_e(label)}</h2>\n{body}"
+
+
+def _stage_sections(result, figures, limit: int | None = None) -> list[str]:
+    """A section per stage the result declares, from the one that gave the estimate back to the first
+    (the first ``limit`` of them): a known stage's by :data:`STAGE_SECTIONS`, any other's by
+    :func:`_stage_section`."""
+    names = list(reversed(_stages(result)))[:limit]
+    return [STAGE_SECTIONS.get(name, _stage_section)(result, name, figures) for name in names]
 
 
 def _notes_section(result, data_notes) -> str:
@@ -318,8 +384,7 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         _parameter_section(result),
         _correlation_section(result, figures),
         _fit_section(result, control, figures),
-        _kalman_section(result, figures),
-        _knn_section(result, figures),
+        *_stage_sections(result, figures),
         _runs_section(result),
         _notes_section(result, data_notes),
     ]

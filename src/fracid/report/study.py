@@ -131,10 +131,10 @@ def study_sections(study, figures: dict) -> list:
                        "covariance).",
         "size_effect": "Nominal strength versus size with Bazant's size effect law fitted.",
     }
-    for name, caption in captions.items():
+    for name in [*captions, *(n for n in figures if n not in captions)]:  # a figure without a caption too
         fig = figures.get(name)
         if fig is not None:
-            sections.append((name.replace("_", " ").capitalize(), _image(to_png(fig), name, caption)))
+            sections.append((name.replace("_", " ").capitalize(), _image(to_png(fig), name, captions.get(name, ""))))
     if study.multi_start is not None:
         ms = study.multi_start
         rows = [[i + 1, *np.round(a, 6).tolist(), *np.round(b, 6).tolist(), f"{f:.4g}"]

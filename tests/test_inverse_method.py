@@ -1,0 +1,129 @@
+"""The inverse method as an argument: a custom method (scipy's least squares) plugged into identify, its
+result, warnings, JSON and HTML report; the default method passed explicitly; the study's settings."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+import fracid
+from fracid.inverse.forward_operator import ForwardOperator, Observation
+from fracid.inverse.knn import ParameterSpace
+from fracid.inverse.method import InverseMethod, MethodResult, result_fields
+from fracid.inverse.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
+from fracid.inverse.study import StudySettings
+from fracid.inverse.twin import synthetic_data
+
+optimize = pytest.importorskip("scipy.optimize")
+
+BAR = fracid.BarWithWeakZone(n_elements=40)
+POINTS = np.linspace(0.004, 0.03, 12)  # end displacement [mm]: pre-peak, peak and softening
+TRUTH = np.array([2.0, 250.0])  # c [mm^2], beta [-]
+SPACE = ParameterSpace(("c", "beta"), [0.5, 100.0], [4.0, 500.0])
+
+
+class LeastSquares:
+    """A method the strategy, result and report do not know: scipy's trust-region least squares on the
+    whitened residual from the centre of the box, covariance (J^T J)^-1 at the end. One stage."""
+
+    name = "least-squares"
+
+    def __call__(self, operator, y_exp, C_exp, space, *, executor=None, store=None, progress=None,
+                 retry_failed=False, blocks=(), notes=()):
+        std = np.sqrt(np.diag(C_exp))
+        runs = {"least_squares": 0, "least_squares_failed": 0}
+
+        def residual(x):
+            runs["least_squares"] += 1
+            record = operator(x)
+            if not record.ok:
+                runs["least_squares_failed"] += 1
+                return np.full(y_exp.size, 1e3)
+            return (record.y - y_exp) / std
+
+        lower, upper = np.asarray(space.lower, float), np.asarray(space.upper, float)
+        fit = optimize.least_squares(residual, 0.5 * (lower + upper), bounds=(lower, upper), x_scale=upper - lower,
+                                     diff_step=1e-4, max_nfev=40)
+        runs["least_squares_evaluations"] = int(fit.nfev)
+        return MethodResult(
+            x=fit.x, C=np.linalg.inv(fit.jac.T @ fit.jac), y_fit=y_exp + fit.fun * std, runs=runs,
+            converged=bool(fit.success), status="converged" if fit.success else f"not converged: {fit.message}",
+            method=self.name, stages={"least_squares": "least squares"},
+            records={"least_squares": {"cost": float(fit.cost), "evaluations": int(fit.nfev), "message": fit.message}},
+            **result_fields(operator, space, fit.x, y_exp, C_exp, blocks=blocks,
+                            notes=[*notes, "least squares from the centre of the box"]))
+
+
+@pytest.fixture(scope="module")
+def problem():
+    op = ForwardOperator([Observation(BAR, POINTS)], fracid.DamageParameters(), ("c", "beta"))
+    return op, synthetic_data(op, TRUTH, {"global:relative": 0.01}, seed=None)
+
+
+def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path):
+    pytest.importorskip("matplotlib")
+    from fracid.report import write_report
+
+    op, data = problem
+    method = LeastSquares()
+    assert isinstance(method, InverseMethod) and isinstance(KnnKalman(), InverseMethod)
+    result = identify(op, data.y, data.covariance, SPACE, method=method, blocks=list(data.blocks))
+    assert type(result) is MethodResult and result.method == "least-squares"
+    np.testing.assert_allclose(result.x, TRUTH, rtol=0.02)
+    assert result.converged and result.warnings() == [] and result.rms_percent < 0.5
+    assert result.forward_runs == result.runs["least_squares"] > 0 and result.runs["wall_seconds"] > 0
+    assert result.stage_runs()["least_squares"]["evaluations"] == result.records["least_squares"]["evaluations"]
+    assert "least squares: converged" in result.summary() and "mm^2" in result.summary()
+
+    saved = json.loads(result.save(tmp_path / "result.json").read_text())
+    assert saved["method"] == "least-squares" and saved["stages"] == {"least_squares": "least squares"}
+    assert saved["records"]["least_squares"]["evaluations"] == result.runs["least_squares_evaluations"]
+
+    text = write_report(tmp_path / "report.html", result, control=data.control).read_text(encoding="utf-8")
+    headings = re.findall(r"<h2>(.*?)</h2>", text)
+    assert headings == ["Identified parameters", "Correlation", "Fit", "least squares", "Run statistics", "Notes"]
+    assert "least squares: converged." in text
+    assert "<td class=\"text\">least squares forward runs</td>" in text
+    assert "<td class=\"text\">least squares evaluations</td>" in text
+    assert "<td class=\"text\">least squares converged</td><td>yes</td>" in text
+    assert "<td class=\"text\">message</td>" in text and "least squares from the centre of the box" in text
+    assert len(re.findall(r"<img ", text)) == 2  # correlation and fit: no KNN or Kalman figures
+
+
+def test_default_method_settings_belong_to_the_default_method(problem):
+    op, data = problem
+    with pytest.raises(ValueError, match="n, groups: settings of the default method"):
+        identify(op, data.y, data.covariance, SPACE, method=LeastSquares(), n=8, groups="all")
+
+
+def test_default_method_passed_explicitly(problem):
+    op, data = problem
+    method = KnnKalman(KnnSettings(n=8, k=3), KalmanSettings(groups="all", max_iterations=3))
+    result = identify(op, data.y, data.covariance, SPACE, method=method)
+    assert isinstance(result, IdentificationResult) and result.method == "knn-kalman"
+    assert list(result.stages) == ["knn", "kalman"] and result.status_label == "Kalman filter"
+    assert result.runs["knn"] == 8 and result.runs["kalman"] > 0
+    assert result.forward_runs == result.runs["knn"] + result.runs["kalman"]
+    assert len(result.history) == result.runs["kalman_iterations"]  # groups "all": one step per pass
+
+
+def test_failed_runs_and_status_of_a_stage_named_by_the_method():
+    result = MethodResult(names=["c"], x=np.array([2.0]), C=np.array([[0.01]]), y_exp=np.array([1.0, 2.0]),
+                          y_fit=np.array([1.0, 2.0]), std_exp=np.array([0.1, 0.1]), status="stopped: no step",
+                          runs={"grid": 9, "grid_failed": 2, "wall_seconds": 1.0}, stages={"grid": "grid search"})
+    assert result.warnings() == ["grid search stopped: no step",
+                                 "failed forward runs: 2 of 9 in the grid search stage (recorded; see report.html)"]
+    assert result.stage_runs() == {"grid": {"runs": 9, "failed": 2}} and result.forward_runs == 9
+
+
+def test_study_settings_group_the_options_and_replace_by_name():
+    settings = StudySettings().replace(n=16, k=3, groups="all", max_iterations=8, starts=0, prior="bounds")
+    assert settings.knn == KnnSettings(n=16, k=3) and settings.kalman == KalmanSettings(groups="all", max_iterations=8)
+    assert (settings.starts, settings.replicates, settings.prior) == (0, 5, "bounds")
+    assert settings.identification == KnnKalman(settings.knn, settings.kalman)
+    assert StudySettings().replace(knn=KnnSettings(n=8), k=2).knn == KnnSettings(n=8, k=2)
+    with pytest.raises(TypeError, match="unknown study setting"):
+        StudySettings().replace(population=16)
+    with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
+        StudySettings(prior="flat")
