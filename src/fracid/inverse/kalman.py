@@ -1,4 +1,4 @@
-"""Kalman filter for parameter identification (SPEC section 4): step by step, and the batch variant."""
+"""Kalman filter for parameter identification (docs/theory.md, section 4.3): step by step, and the batch variant."""
 
 from __future__ import annotations
 
@@ -220,7 +220,7 @@ def kalman_filter(
     callback=None,
     max_backtracks: int = 4,
 ) -> KalmanResult:
-    """Step-by-step Kalman filter with global iterations (SPEC section 4), bounded and failure tolerant.
+    """Step-by-step Kalman filter with global iterations (docs/theory.md, section 4.3), bounded and failure tolerant.
 
     For t = 1..n the observations of group t are assimilated with :func:`kalman_update`, using
     S_t = d h_t / d x and h_t at a linearisation point (forward runs only up to the last
@@ -236,7 +236,7 @@ def kalman_filter(
         (y - h)^T C_exp^-1 (y - h) + (x - x0)^T C0^-1 (x - x0) is higher than the last one's (by more than
         :data:`OBJECTIVE_SLACK`) is moved halfway back, up to ``max_backtracks`` times.
     ``restart="prior-mean"``
-        The thesis's wording: the last estimate becomes the new prior mean (prior covariance C0),
+        The thesis's wording (docs/theory.md, section 4.3): the last estimate becomes the new prior mean (prior covariance C0),
         linearising at the running estimate. It re-uses the data in every pass, so the covariance
         is optimistic and the estimate drifts towards the least-squares fit.
 

@@ -1,4 +1,4 @@
-"""K-nearest-neighbour search over a population of forward runs (the discrete grid method, SPEC 4)."""
+"""K-nearest-neighbour search over a population of forward runs (the discrete grid method, docs/theory.md, section 4.2)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Stability of the estimate (SPEC 4, "Analyses"): identification repeated on data with noise added.
+"""Stability of the estimate (docs/theory.md, section 4.7): identification repeated on data with noise added.
 
 Each replicate adds a draw of N(0, noise covariance) to the data (seeds fixed, so a study is
 reproducible) and runs the Kalman filter again from the same prior. The scatter of the estimates,

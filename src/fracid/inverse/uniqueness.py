@@ -1,4 +1,4 @@
-"""Uniqueness of the estimate (SPEC 4, "Analyses"): maps of the objective, its valley, multi-start.
+"""Uniqueness of the estimate (docs/theory.md, section 4.6): maps of the objective, its valley, multi-start.
 
 The population of a KNN search is an overview of the objective f over the parameter space. Its
 *valley* is the set of parameter sets the data cannot tell from the best one: f - f_min below the
