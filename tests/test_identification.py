@@ -174,7 +174,7 @@ def test_global_and_local_blocks_from_experimental_data(bar_operator):
 
 
 def test_force_and_local_data_of_one_test_share_one_forward_run(monkeypatch):
-    import fracid.forward as fo
+    from fracid.models import DamageModel
 
     both = ForwardOperator([Observation(BAR, POINTS, name="global"),
                             Observation(fracid.BarWithWeakZone(n_elements=100), POINTS[4:],
@@ -182,8 +182,8 @@ def test_force_and_local_data_of_one_test_share_one_forward_run(monkeypatch):
                            fracid.DamageParameters(), ("c", "beta"))
     separate = [ForwardOperator([obs], fracid.DamageParameters(), ("c", "beta")) for obs in both.observations]
     calls = []
-    original = fo.simulate
-    monkeypatch.setattr(fo, "simulate", lambda *a, **kw: calls.append(kw) or original(*a, **kw))
+    original = DamageModel.simulate
+    monkeypatch.setattr(DamageModel, "simulate", lambda self, *a, **kw: calls.append(kw) or original(self, *a, **kw))
     y = both(TRUTH).y
     assert len(calls) == 1 and calls[0]["damage_threshold"] == 0.3  # equal frozen specimens: one run
     # equal up to the Newton tolerance: the shared run also stops at the force block's checkpoints
