@@ -15,7 +15,7 @@ import time
 
 import fracid
 from fracid.models import DamageModel
-from fracid.model.linear_solvers import linear_solver
+from fracid.fem.linear_solvers import linear_solver
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 

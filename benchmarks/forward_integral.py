@@ -16,8 +16,8 @@ import time
 
 import fracid
 from fracid.models import DamageModel
-from fracid.model import forms
-from fracid.model.nonlocal_average import internal_length, nonlocal_averaging
+from fracid.fem import forms
+from fracid.fem.nonlocal_average import internal_length, nonlocal_averaging
 
 
 class _Timed:

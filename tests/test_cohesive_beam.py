@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from fracid.model.cohesive import CohesiveParameters, dissipated_energy_density
-from fracid.model.cohesive_problem import crack_traction
+from fracid.fem.cohesive import CohesiveParameters, dissipated_energy_density
+from fracid.fem.cohesive_problem import crack_traction
 from fracid.models import CohesiveCrackModel
 from fracid.specimens.beam import NotchedBeam
 

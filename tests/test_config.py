@@ -26,7 +26,7 @@ from fracid.data import gregoire2013_beam4_path
 from fracid.inverse.forward_operator import ForwardOperator
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.strategy import identify, identify_data
-from fracid.model.parameters import DamageParameters
+from fracid.fem.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
 from fracid.specimens.beam import NotchedBeam
@@ -449,7 +449,7 @@ log = ["Gf"]"""))
 
 
 def test_cohesive_model_config_builds_its_operator(tmp_path):
-    from fracid.model.cohesive import CohesiveParameters
+    from fracid.fem.cohesive import CohesiveParameters
     from fracid.models import CohesiveCrackModel
 
     cfg = load_config(write(tmp_path, COHESIVE))

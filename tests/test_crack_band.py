@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from fracid.model.assembly import SparsePattern
-from fracid.model.cohesive import CohesiveParameters, hordijk_stress
-from fracid.model.crack_band import band_damage, crack_band_stress, principal_tension, snap_back_limit
+from fracid.fem.assembly import SparsePattern
+from fracid.fem.cohesive import CohesiveParameters, hordijk_stress
+from fracid.fem.crack_band import band_damage, crack_band_stress, principal_tension, snap_back_limit
 from fracid.models import CrackBandModel
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.strip import TensionStrip
@@ -83,7 +83,7 @@ def test_band_wider_than_the_snap_back_limit_is_refused():
 
 
 def _dissipated(strip, band_width=None):
-    from fracid.model.path_following import follow_path
+    from fracid.fem.path_following import follow_path
 
     problem = CrackBandModel(band_width).build(strip, PARAMS)
     # the crack opens to 0.99 wc: the column's elongation is the opening times element size / band width

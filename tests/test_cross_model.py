@@ -11,9 +11,9 @@ import pytest
 
 from fracid.inverse.cross_model import Candidate, compare_models, cross_calibration, relative_rms
 from fracid.inverse.knn import ParameterSpace
-from fracid.model.cohesive import CohesiveParameters
-from fracid.model.parameters import DamageParameters
-from fracid.model.path_following import StepOptions
+from fracid.fem.cohesive import CohesiveParameters
+from fracid.fem.parameters import DamageParameters
+from fracid.fem.path_following import StepOptions
 from fracid.models import CohesiveCrackModel, DamageModel
 from fracid.specimens.beam import NotchedBeam
 

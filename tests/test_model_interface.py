@@ -112,7 +112,7 @@ class FailingBar(LinearCohesiveBar):
     key: ClassVar[str] = "test-failing-bar"
 
     def simulate(self, specimen, p, **options):
-        from fracid.model.path_following import ConvergenceError
+        from fracid.fem.path_following import ConvergenceError
 
         result = super().simulate(specimen, p, **options)
         if p.Gf < 0.09:

@@ -11,11 +11,11 @@ from test_mesh_objectivity import run
 from test_tangent import finite_difference_jacobian, post_peak_state
 
 import fracid
-from fracid.model.assembly import SparsePattern
-from fracid.model.discretization import bar_discretization, plane_stress_discretization
-from fracid.model.nonlocal_average import averaging_matrix, internal_length
-from fracid.model.problem import DamageProblem
-from fracid.model.solver import ControlledSystem
+from fracid.fem.assembly import SparsePattern
+from fracid.fem.discretization import bar_discretization, plane_stress_discretization
+from fracid.fem.nonlocal_average import averaging_matrix, internal_length
+from fracid.fem.problem import DamageProblem
+from fracid.fem.solver import ControlledSystem
 from fracid.models import MODEL_TYPES, DamageModel
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone

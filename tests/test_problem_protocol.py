@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.model.cohesive import CohesiveParameters
-from fracid.model.protocol import Problem
+from fracid.fem.cohesive import CohesiveParameters
+from fracid.fem.protocol import Problem
 from fracid.models import MODEL_TYPES, model_from_type, runs_on
 from fracid.specimens import DogBone, NotchedBeam
 

@@ -16,7 +16,7 @@ from fracid.inverse.size_effect import (
     size_effect_series,
     specimen_size,
 )
-from fracid.model.path_following import ConvergenceError, PathResult
+from fracid.fem.path_following import ConvergenceError, PathResult
 from fracid.parallel import make_executor
 from fracid.report.figures import size_effect_figure, to_png
 from fracid.specimens.beam import NotchedBeam

@@ -3,9 +3,9 @@
 Units throughout: N, mm, MPa (N/mm^2); the gradient parameter ``c`` in mm^2.
 """
 
-from fracid.model.parameters import DamageParameters
-from fracid.model.path_following import ConvergenceError, PathResult, StepOptions, follow_path
-from fracid.model.solver import NewtonOptions
+from fracid.fem.parameters import DamageParameters
+from fracid.fem.path_following import ConvergenceError, PathResult, StepOptions, follow_path
+from fracid.fem.solver import NewtonOptions
 from fracid.specimens.bar import BarWithWeakZone
 from fracid.forward import simulate
 

@@ -41,7 +41,7 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     from fracid.data import DataError
     from fracid.inverse.knn import AllRunsFailed
     from fracid.inverse.sensitivity import ForwardRunError
-    from fracid.model.path_following import ConvergenceError
+    from fracid.fem.path_following import ConvergenceError
 
     resume = f"Finished runs are stored in {store_path}; run the same command again to resume." if store_path else ""
     if isinstance(err, Terminated):

@@ -11,12 +11,12 @@ A forward model is any object with
 damage_threshold, observables)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
-    :class:`~fracid.model.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
+    :class:`~fracid.fem.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
 
 The models below build their problem from the specimen's
 :class:`~fracid.specimens.description.Description` (``specimen.describe()``): a formulation (gradient,
 local or integral damage; cohesive interface; crack band) with a material law
-(:mod:`fracid.model.laws`). :data:`MODEL_TYPES` is the registry the configuration reads.
+(:mod:`fracid.fem.laws`). :data:`MODEL_TYPES` is the registry the configuration reads.
 """
 
 from __future__ import annotations
@@ -26,17 +26,17 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from fracid.model.crack_band_problem import CrackBandProblem, element_extent
-from fracid.model.cohesive_problem import CohesiveCrackProblem, crack_edges
-from fracid.model.fpz import zone_width_observer
-from fracid.model.laws import DamageLaw, HordijkLaw
-from fracid.model.path_following import ConvergenceError, PathResult, StepOptions, follow_path
-from fracid.model.problem import FORMULATIONS
+from fracid.fem.crack_band_problem import CrackBandProblem, element_extent
+from fracid.fem.cohesive_problem import CohesiveCrackProblem, crack_edges
+from fracid.fem.fpz import zone_width_observer
+from fracid.fem.laws import DamageLaw, HordijkLaw
+from fracid.fem.path_following import ConvergenceError, PathResult, StepOptions, follow_path
+from fracid.fem.problem import FORMULATIONS
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
 __all__ = ["MODEL_TYPES", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel", "DamageModel", "ForwardModel",
-           "PathResult", "StepOptions", "model_from_type", "parameter_units", "runs_on"]
+           "PathResult", "StepOptions", "known_units", "model_from_type", "parameter_units", "runs_on"]
 
 
 class ForwardModel(Protocol):
@@ -238,6 +238,16 @@ class CrackBandModel(_CrackModel):
 
 def _ones(points):
     return 1.0 + 0.0 * points[..., 0]
+
+
+def known_units() -> dict:
+    """Unit of every parameter name of the registered models (:data:`MODEL_TYPES`), those of the
+    damage model first where two models share a name."""
+    units = {}
+    for make in MODEL_TYPES.values():
+        for name, unit in make().parameters.units().items():
+            units.setdefault(name, unit)
+    return units
 
 
 def parameter_units(model_or_params) -> dict:

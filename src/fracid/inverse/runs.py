@@ -30,7 +30,7 @@ def code_version() -> str:
     digest = hashlib.sha256()
     root = resources.files("fracid")
     sources = [root / "forward.py", root / "models.py", root / "inverse" / "forward_operator.py"]
-    for package in ("model", "specimens"):
+    for package in ("fem", "specimens"):
         sources += sorted((p for p in (root / package).iterdir() if p.name.endswith(".py")), key=lambda p: p.name)
     for source in sources:
         digest.update(source.name.encode() + b"\0" + source.read_bytes())

@@ -327,7 +327,7 @@ def size_effect_series(params, specimens, *, model=None, executor=None, progress
     Parameters
     ----------
     params
-        Parameters of ``model`` (e.g. :class:`~fracid.model.parameters.DamageParameters`).
+        Parameters of ``model`` (e.g. :class:`~fracid.fem.parameters.DamageParameters`).
     specimens : sequence
         DogBone, NotchedBeam or BarWithWeakZone objects (any order; results keep it).
     model : forward model, optional

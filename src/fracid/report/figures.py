@@ -7,7 +7,7 @@ history, no KNN population, a single parameter for the map). :func:`to_png` rend
 bytes at :data:`DPI`.
 
 Units: control [mm], force [N], parameters in the units of
-:meth:`~fracid.model.parameters.DamageParameters.units`.
+:meth:`~fracid.fem.parameters.DamageParameters.units`.
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter
 
-from fracid.model.parameters import DamageParameters
 
 #: resolution of the PNG images [dots per inch]
 DPI = 110
@@ -52,16 +51,11 @@ def _new_figure(width: float, height: float) -> Figure:
 
 
 def parameter_units() -> dict:
-    """Unit of every parameter name of the registered forward models (:data:`fracid.models.MODEL_TYPES`),
-    those of :class:`DamageParameters` first: a result holds only names, and the figures label
-    the parameters of any model (e.g. ``ft [MPa]`` of the cohesive crack)."""
-    from fracid.models import MODEL_TYPES
+    """Unit of every parameter name of the registered forward models (:func:`fracid.models.known_units`):
+    a result holds only names, and the figures label the parameters of any model (e.g. ``ft [MPa]``)."""
+    from fracid.models import known_units
 
-    units = {}
-    for make in MODEL_TYPES.values():
-        for name, unit in make().parameters.units().items():
-            units.setdefault(name, unit)
-    return {**units, **DamageParameters.units()}
+    return known_units()
 
 
 def parameter_label(name: str) -> str:

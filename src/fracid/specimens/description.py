@@ -16,8 +16,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from fracid.model.discretization import MixedDiscretization, bar_discretization, plane_stress_discretization
-from fracid.model.dofs import Conditions
+from fracid.fem.discretization import MixedDiscretization, bar_discretization, plane_stress_discretization
+from fracid.fem.dofs import Conditions
 
 
 @dataclass(frozen=True)
@@ -194,7 +194,7 @@ def discretize(description: Description) -> MixedDiscretization:
 
 
 def conditions(description: Description, *, open_crack: bool = False, discrete_crack: bool = False) -> Conditions:
-    """The :class:`~fracid.model.dofs.Conditions` of the description.
+    """The :class:`~fracid.fem.dofs.Conditions` of the description.
 
     ``open_crack``: for a model whose crack opens fully (plates and supports as
     :class:`Load` and :class:`Support` say for that case); ``discrete_crack``: the crack path's

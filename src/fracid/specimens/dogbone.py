@@ -187,7 +187,7 @@ class DogBone:
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
-        from fracid.model.path_following import StepOptions
+        from fracid.fem.path_following import StepOptions
 
         return StepOptions(maximum=target / 60)
 

@@ -80,7 +80,7 @@ class TensionStrip:
 
     def default_steps(self, target: float):
         """Adaptive steps capped at 1/50 of the target."""
-        from fracid.model.path_following import StepOptions
+        from fracid.fem.path_following import StepOptions
 
         return StepOptions(maximum=target / 50)
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from fracid.model.level_sets import superlevel_length
+from fracid.fem.level_sets import superlevel_length
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,7 @@ def cached_sampler(points, axis: int, along_range) -> AcrossSampler:
 
 def zone_width_observer(zone, kappa_threshold: float):
     """Observer f(problem, q, arrays) -> width [mm] of the zone where kappa > ``kappa_threshold``, for
-    :func:`~fracid.model.path_following.follow_path`: across the crack path in 2D (see :func:`fpz_width`;
+    :func:`~fracid.fem.path_following.follow_path`: across the crack path in 2D (see :func:`fpz_width`;
     ``zone`` a :class:`~fracid.specimens.description.ZoneWidth`), along a bar in 1D."""
     current = {}  # the problem of this run and its sampler: the mesh is looked up once per run, not per step
 

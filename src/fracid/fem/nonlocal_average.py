@@ -11,7 +11,7 @@ averaging is linear, so it is one sparse matrix A with ebar = A eps (rows sum to
 
 The internal length follows from the gradient model's parameter by the Taylor expansion of the
 average (Peerlings et al. 1996): ebar = eps + l^2 / 2 lap(eps) + ..., so c = l^2 / 2 and the integral
-model uses the same :class:`~fracid.model.parameters.DamageParameters` as the gradient model.
+model uses the same :class:`~fracid.fem.parameters.DamageParameters` as the gradient model.
 """
 
 from __future__ import annotations

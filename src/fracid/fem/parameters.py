@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from fracid.model.ranges import ParameterRange, ParameterSet
+from fracid.fem.ranges import ParameterRange, ParameterSet
 
 _R = ParameterRange
 _RANGES = {

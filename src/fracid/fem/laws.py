@@ -15,9 +15,9 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from fracid.model.damage import exponential_damage, kappa_at_damage
-from fracid.model.equivalent_strain import modified_von_mises_plane_stress, modified_von_mises_uniaxial
-from fracid.model.parameters import DamageParameters
+from fracid.fem.damage import exponential_damage, kappa_at_damage
+from fracid.fem.equivalent_strain import modified_von_mises_plane_stress, modified_von_mises_uniaxial
+from fracid.fem.parameters import DamageParameters
 
 
 class SofteningLaw(Protocol):
@@ -43,7 +43,7 @@ class EquivalentStrain(Protocol):
 @dataclass(frozen=True)
 class ExponentialSoftening:
     """omega = 1 - kappa_i / kappa (1 - alpha + alpha exp(-beta (kappa - kappa_i))) beyond kappa_i
-    (parameters ``kappa_i``, ``alpha``, ``beta``; see :func:`~fracid.model.damage.exponential_damage`)."""
+    (parameters ``kappa_i``, ``alpha``, ``beta``; see :func:`~fracid.fem.damage.exponential_damage`)."""
 
     def damage(self, kappa, params):
         return exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
@@ -100,13 +100,13 @@ class DamageLaw:
 @dataclass(frozen=True)
 class HordijkLaw:
     """Hordijk's traction-opening law, for the cohesive crack and the crack band (parameters of
-    :class:`~fracid.model.cohesive.CohesiveParameters`: ft, Gf, c1, c2 and the elastic E, nu)."""
+    :class:`~fracid.fem.cohesive.CohesiveParameters`: ft, Gf, c1, c2 and the elastic E, nu)."""
 
     name: ClassVar[str] = "hordijk"
 
     @property
     def parameters(self) -> type:
-        from fracid.model.cohesive import CohesiveParameters
+        from fracid.fem.cohesive import CohesiveParameters
 
         return CohesiveParameters
 

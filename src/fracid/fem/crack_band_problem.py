@@ -1,13 +1,13 @@
-"""A plane-stress problem whose material is the rotating crack band of :mod:`fracid.model.crack_band`."""
+"""A plane-stress problem whose material is the rotating crack band of :mod:`fracid.fem.crack_band`."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from fracid.model.assembly import assemble_vector, norm2
-from fracid.model.crack_band import crack_band_stress, crack_direction_stress, snap_back_limit
-from fracid.model.forms import ElementArrays, _btdb
-from fracid.model.problem import ContinuumProblem
+from fracid.fem.assembly import assemble_vector, norm2
+from fracid.fem.crack_band import crack_band_stress, crack_direction_stress, snap_back_limit
+from fracid.fem.forms import ElementArrays, _btdb
+from fracid.fem.problem import ContinuumProblem
 
 
 def element_extent(nodes, cells, direction) -> np.ndarray:
@@ -20,7 +20,7 @@ def element_extent(nodes, cells, direction) -> np.ndarray:
 class CrackBandProblem(ContinuumProblem):
     """Smeared crack band (rotating crack, Hordijk softening) on a plane-stress discretisation.
 
-    Displacement unknowns only (:class:`~fracid.model.problem.ContinuumProblem`); the material is the
+    Displacement unknowns only (:class:`~fracid.fem.problem.ContinuumProblem`); the material is the
     crack band's.
 
     Parameters

@@ -31,8 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.model.cohesive import _normalised_law, hordijk_stress, hordijk_tangent
-from fracid.model.damage import update_history
+from fracid.fem.cohesive import _normalised_law, hordijk_stress, hordijk_tangent
+from fracid.fem.damage import update_history
 
 
 def principal_tension(s):

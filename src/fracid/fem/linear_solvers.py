@@ -58,7 +58,7 @@ class SuperLUSolver:
 
 
 def _pardiso():
-    from fracid.model.pardiso import PardisoSolver  # lazy: pypardiso is an optional extra
+    from fracid.fem.pardiso import PardisoSolver  # lazy: pypardiso is an optional extra
 
     return PardisoSolver()
 

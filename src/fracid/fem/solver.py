@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.model.assembly import SparsePattern, dot, norm2
-from fracid.model.linear_solvers import SingularMatrixError
+from fracid.fem.assembly import SparsePattern, dot, norm2
+from fracid.fem.linear_solvers import SingularMatrixError
 
 
 class IncrementFailed(RuntimeError):
@@ -84,7 +84,7 @@ class SolverStatistics:
 
 @dataclass
 class ControlledSystem:
-    """A :class:`~fracid.model.problem.DamageProblem` bordered by the load factor and one control functional."""
+    """A :class:`~fracid.fem.problem.DamageProblem` bordered by the load factor and one control functional."""
 
     problem: object
     control: np.ndarray

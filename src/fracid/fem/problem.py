@@ -1,8 +1,8 @@
 """Continuum damage formulations as problems for the nonlinear solver: gradient, local and integral.
 
-Each takes a material law (:class:`~fracid.model.laws.DamageLaw`), its parameters, a discretisation and
-the boundary :class:`~fracid.model.dofs.Conditions`, and implements the
-:class:`~fracid.model.protocol.Problem` protocol. :data:`FORMULATIONS` names them for the model
+Each takes a material law (:class:`~fracid.fem.laws.DamageLaw`), its parameters, a discretisation and
+the boundary :class:`~fracid.fem.dofs.Conditions`, and implements the
+:class:`~fracid.fem.protocol.Problem` protocol. :data:`FORMULATIONS` names them for the model
 registry.
 """
 
@@ -10,17 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.model.assembly import assemble_vector, norm2
-from fracid.model.discretization import MixedDiscretization
-from fracid.model.dofs import Conditions, number_dofs
-from fracid.model.forms import elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage, model_constants
-from fracid.model.laws import DamageLaw
-from fracid.model.nonlocal_average import internal_length, nonlocal_averaging
+from fracid.fem.assembly import assemble_vector, norm2
+from fracid.fem.discretization import MixedDiscretization
+from fracid.fem.dofs import Conditions, number_dofs
+from fracid.fem.forms import elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage, model_constants
+from fracid.fem.laws import DamageLaw
+from fracid.fem.nonlocal_average import internal_length, nonlocal_averaging
 
 
 class ContinuumProblem:
     """What every continuum formulation shares: the unknowns under the conditions (a
-    :class:`~fracid.model.dofs.DofMap`), the constant parts of the tangent, the assembly of the element
+    :class:`~fracid.fem.dofs.DofMap`), the constant parts of the tangent, the assembly of the element
     arrays, the fields and the elastic energy. Subclasses give ``_element_arrays(qe, history_old)``.
 
     Parameters
@@ -70,7 +70,7 @@ class ContinuumProblem:
 
     def evaluate(self, q: np.ndarray, history_old: np.ndarray):
         """Internal-force residual, element arrays and per-field reference norms at state q
-        (see :meth:`fracid.model.protocol.Problem.evaluate`)."""
+        (see :meth:`fracid.fem.protocol.Problem.evaluate`)."""
         arrays = self._element_arrays(self.gather(q), history_old)
         residual = assemble_vector(self.element_dofs, arrays.residual, self.n_free)
         n_u = self.dofs.n_u

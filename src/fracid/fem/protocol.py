@@ -1,8 +1,8 @@
 """What the nonlinear solver and the recorder of a forward run may use of a problem.
 
-Every formulation (the damage problems of :mod:`fracid.model.problem`, the crack band, the cohesive
-crack) implements :class:`Problem`; :func:`~fracid.model.path_following.follow_path`,
-:class:`~fracid.model.solver.ControlledSystem` and the observers use nothing else. A problem keeps
+Every formulation (the damage problems of :mod:`fracid.fem.problem`, the crack band, the cohesive
+crack) implements :class:`Problem`; :func:`~fracid.fem.path_following.follow_path`,
+:class:`~fracid.fem.solver.ControlledSystem` and the observers use nothing else. A problem keeps
 no state between calls: what it returns depends only on its arguments.
 """
 
@@ -52,7 +52,7 @@ class Problem(Protocol):
 
     def evaluate(self, q: np.ndarray, history_old: np.ndarray):
         """``(residual, arrays, references)``: internal forces r(q) (shape (n_free,)), the element arrays
-        (:class:`~fracid.model.forms.ElementArrays`: tangents, trial ``kappa`` = history, ``omega``) and the
+        (:class:`~fracid.fem.forms.ElementArrays`: tangents, trial ``kappa`` = history, ``omega``) and the
         norm that makes each field's residual relative."""
 
     def fields(self, q: np.ndarray, history: np.ndarray, omega: np.ndarray) -> dict:

@@ -4,7 +4,7 @@ The crack of a symmetric half model lies on its symmetry line (the ligament of a
 mid-height section of a dog-bone). Its opening is twice the normal displacement of the nodes on
 that line. Before cracking the crack faces are tied
 by a stiff penalty (sigma = k w up to ft, at w0 = ft / k); beyond, the traction follows Hordijk's law
-of the opening in excess of w0 (secant unloading, :func:`~fracid.model.cohesive.cohesive_traction`);
+of the opening in excess of w0 (secant unloading, :func:`~fracid.fem.cohesive.cohesive_traction`);
 closure (w < 0) is resisted by the same penalty. The crack edges' nodal forces and tangents are
 added to the element arrays of the bulk elements that own the edges, so the problem keeps the
 element structure (one sparse pattern) the nonlinear solver expects.
@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.model.assembly import assemble_vector
-from fracid.model.cohesive import cohesive_traction
-from fracid.model.elements import gauss_line, line_quadratic
-from fracid.model.level_sets import superlevel_length
-from fracid.model.problem import ElasticProblem
+from fracid.fem.assembly import assemble_vector
+from fracid.fem.cohesive import cohesive_traction
+from fracid.fem.elements import gauss_line, line_quadratic
+from fracid.fem.level_sets import superlevel_length
+from fracid.fem.problem import ElasticProblem
 
 _GAUSS = 3
 

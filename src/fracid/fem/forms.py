@@ -1,9 +1,9 @@
 """Element residuals and consistent tangents of the damage models, for all elements at once.
 
-Pure functions over the arrays of a :class:`~fracid.model.discretization.MixedDiscretization`:
-the material law enters only through a :class:`~fracid.model.laws.DamageLaw` (its softening law and
+Pure functions over the arrays of a :class:`~fracid.fem.discretization.MixedDiscretization`:
+the material law enters only through a :class:`~fracid.fem.laws.DamageLaw` (its softening law and
 equivalent strain, values and derivatives) and the history update
-:func:`~fracid.model.damage.update_history`.
+:func:`~fracid.fem.damage.update_history`.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from fracid.model.damage import update_history
-from fracid.model.nonlocal_average import NonlocalAveraging, softening_coupling
+from fracid.fem.damage import update_history
+from fracid.fem.nonlocal_average import NonlocalAveraging, softening_coupling
 
 
 class ElementArrays(NamedTuple):
@@ -126,7 +126,7 @@ def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_ta
 
 def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
     """Integral-type nonlocal damage: kappa follows the Gaussian average ebar = A eps_eq of the
-    local equivalent strain (see :mod:`fracid.model.nonlocal_average`).
+    local equivalent strain (see :mod:`fracid.fem.nonlocal_average`).
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """Strain states (kinematic assumptions): the number of strain components and the unit elastic matrix (E = 1).
 
-The equivalent strain that drives damage is a material law (:mod:`fracid.model.laws`), not part of the
+The equivalent strain that drives damage is a material law (:mod:`fracid.fem.laws`), not part of the
 kinematics."""
 
 from __future__ import annotations

@@ -24,8 +24,8 @@ from typing import ClassVar
 import numpy as np
 from scipy.special import gammainc
 
-from fracid.model.damage import update_history
-from fracid.model.ranges import ParameterRange, ParameterSet
+from fracid.fem.damage import update_history
+from fracid.fem.ranges import ParameterRange, ParameterSet
 
 
 _R = ParameterRange
@@ -140,7 +140,7 @@ def cohesive_traction(w, w_max, ft, wc, c1, c2):
     """Traction, consistent tangent and history update of the Hordijk law with secant unloading.
 
     Loading (w >= w_max, neutral loading included, as in
-    :func:`fracid.model.damage.update_history`): the point follows the envelope,
+    :func:`fracid.fem.damage.update_history`): the point follows the envelope,
     sigma = hordijk_stress(w). Unloading (0 <= w < w_max): it goes back linearly to the origin,
     sigma = hordijk_stress(w_max) w / w_max, so that reloading retraces the same secant until the
     envelope is met again. Closure (w < 0): sigma = 0 with zero tangent, as in

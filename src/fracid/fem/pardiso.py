@@ -19,7 +19,7 @@ import weakref
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.model.linear_solvers import SingularMatrixError
+from fracid.fem.linear_solvers import SingularMatrixError
 
 _MTYPE = 11  # real unsymmetric
 _ERRORS = {
@@ -106,7 +106,7 @@ class PardisoSolver:
         When PARDISO had to perturb pivots (it never stops on a zero pivot: it perturbs it and
         refines), the solution is accepted only if ``||A x - b|| <= residual_rtol ||b||``; otherwise
         the analysis is redone with the current values (new scaling and matching) and, if that does
-        not help either, :class:`~fracid.model.linear_solvers.SingularMatrixError` is raised.
+        not help either, :class:`~fracid.fem.linear_solvers.SingularMatrixError` is raised.
         The default is loose on purpose: the damage tangents mix rows of order E t (equilibrium)
         with rows of order mm^2 (diffusion), so even a sound factorization of the virgin state
         leaves relative residuals near 1e-7 (SuperLU too), and the Newton iteration only needs a

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.model.elasticity import UNIAXIAL, StrainState
-from fracid.model.elements import gauss_line, line_linear, line_quadratic
+from fracid.fem.elasticity import UNIAXIAL, StrainState
+from fracid.fem.elements import gauss_line, line_linear, line_quadratic
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,8 +127,8 @@ def plane_stress_discretization(nodes, cells, n_vertices: int, thickness: float,
     Displacement dofs of node j are 2 j (x) and 2 j + 1 (y); the ebar dof of vertex v is
     2 n_nodes + v. The geometry is isoparametric with the 8-node element (curved edges allowed).
     """
-    from fracid.model.elasticity import PLANE_STRESS
-    from fracid.model.elements import gauss_quad, quad_linear, quad_serendipity
+    from fracid.fem.elasticity import PLANE_STRESS
+    from fracid.fem.elements import gauss_quad, quad_linear, quad_serendipity
 
     nodes = np.asarray(nodes, dtype=float)
     cells = np.asarray(cells, dtype=int)

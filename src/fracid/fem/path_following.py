@@ -9,9 +9,9 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from fracid.model.assembly import dot
-from fracid.model.linear_solvers import linear_solver as _make_linear_solver
-from fracid.model.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
+from fracid.fem.assembly import dot
+from fracid.fem.linear_solvers import linear_solver as _make_linear_solver
+from fracid.fem.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
 
 @dataclass

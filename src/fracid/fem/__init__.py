@@ -1,0 +1,1 @@
+"""The finite-element model: material laws, formulations, discretisation, dofs and conditions, solver, path following."""

@@ -1,1 +1,0 @@
-"""The forward model: material laws, elements, assembly, linear and nonlinear solvers."""
