@@ -185,12 +185,10 @@ def run_identify(args, config_path=None) -> int:
                  data_notes=data.notes)
     _write_figures(out / "figures", result, data.control)
     _say(args, result.summary())
-    runs = result.runs
-    _say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {runs['knn']} KNN "
-               f"({runs['knn_failed']} failed, {runs.get('knn_computed', runs['knn'])} computed) + {runs['kalman']} "
-               f"Kalman ({runs.get('kalman_failed', 0)} failed, {runs.get('kalman_computed', runs['kalman'])} "
-               f"computed); {runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, "
-               "figures/*.png")
+    stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
+                        for stage, c in result.stage_runs().items())
+    _say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {stages}; "
+               f"{result.runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, figures/*.png")
     for text in result.warnings():
         _warn(text)
     if not np.all(np.isfinite(result.x)) or not np.all(np.isfinite(result.y_fit)):
