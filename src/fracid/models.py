@@ -225,7 +225,7 @@ class CrackBandModel(_CrackModel):
         crackable = 1.0
         if d.crack.nodes is not None:
             on_path = (d.nodes_of(d.crack.nodes)[None, None, :] == d.cells[:, :4, None]).any(axis=2).sum(axis=1) >= 2
-            crackable = at_points(lambda points: on_path[:, None] * _ones(points), disc)
+            crackable = np.repeat(on_path[:, None], disc.weights.shape[1], axis=1).astype(float)
         if d.crack.mirrored and self.band_width is None:
             width = 2.0 * width
         return CrackBandProblem(disc, self.law, params, conditions(d, open_crack=True), width,
@@ -234,10 +234,6 @@ class CrackBandModel(_CrackModel):
 
     def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
         return {}
-
-
-def _ones(points):
-    return 1.0 + 0.0 * points[..., 0]
 
 
 def known_units() -> dict:
