@@ -33,6 +33,28 @@ def exponential_damage(kappa, kappa_i, alpha, beta):
     return omega, d_omega
 
 
+def exponential_damage_parameter_derivatives(kappa, kappa_i, alpha, beta) -> dict:
+    """Partial derivatives of :func:`exponential_damage` at fixed kappa with respect to its parameters.
+
+    Returns
+    -------
+    dict {"kappa_i", "alpha", "beta": ndarray}
+        d omega / d kappa_i [-], d omega / d alpha [-], d omega / d beta [-]; zero below the
+        threshold (at kappa = kappa_i exactly, the derivative of the damaged branch).
+    """
+    kappa = np.asarray(kappa, dtype=float)
+    damaged = kappa >= kappa_i
+    k = np.where(damaged, kappa, kappa_i)
+    decay = np.exp(-beta * (k - kappa_i))
+    g = 1.0 - alpha + alpha * decay
+    ratio = np.where(damaged, kappa_i / k, 0.0)
+    return {
+        "kappa_i": np.where(damaged, -(g + kappa_i * alpha * beta * decay) / k, 0.0),
+        "alpha": ratio * (1.0 - decay),
+        "beta": ratio * alpha * decay * (k - kappa_i),
+    }
+
+
 def update_history(kappa_old, driving):
     """Kuhn-Tucker update of the history variable.
 

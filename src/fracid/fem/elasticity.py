@@ -21,14 +21,28 @@ def plane_stress_matrix(nu: float) -> np.ndarray:
     return np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]]) / (1.0 - nu * nu)
 
 
+def uniaxial_matrix_derivative(nu: float) -> np.ndarray:
+    """d/d nu of :func:`uniaxial_matrix`: zero."""
+    return np.zeros((1, 1))
+
+
+def plane_stress_matrix_derivative(nu: float) -> np.ndarray:
+    """d/d nu of :func:`plane_stress_matrix`."""
+    numerator = np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
+    d_numerator = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -0.5]])
+    return d_numerator / (1.0 - nu * nu) + numerator * 2.0 * nu / (1.0 - nu * nu) ** 2
+
+
 @dataclass(frozen=True)
 class StrainState:
-    """A kinematic assumption: its name, number of strain components and unit elastic matrix."""
+    """A kinematic assumption: its name, number of strain components, unit elastic matrix and the
+    matrix's derivative with respect to Poisson's ratio."""
 
     name: str
     n_components: int
     unit_elastic_matrix: Callable[[float], np.ndarray]
+    unit_elastic_matrix_derivative: Callable[[float], np.ndarray]
 
 
-UNIAXIAL = StrainState("uniaxial", 1, uniaxial_matrix)
-PLANE_STRESS = StrainState("plane stress", 3, plane_stress_matrix)
+UNIAXIAL = StrainState("uniaxial", 1, uniaxial_matrix, uniaxial_matrix_derivative)
+PLANE_STRESS = StrainState("plane stress", 3, plane_stress_matrix, plane_stress_matrix_derivative)

@@ -106,3 +106,45 @@ def modified_von_mises_uniaxial(strain, nu, eta):
     eps_eq = ((eta - 1.0) * e + (eta + 1.0) * np.abs(e)) / (2.0 * eta)
     d = ((eta - 1.0) + (eta + 1.0) * sign) / (2.0 * eta)
     return eps_eq, d[..., None]
+
+
+def _invariant_parameter_derivatives(I1, J2, nu, eta):
+    """d eps_eq / d nu and d eps_eq / d eta at fixed invariants I1, J2 (zero root: the root's terms dropped)."""
+    a = (eta - 1.0) / (1.0 - 2.0 * nu)
+    root = np.sqrt(a * a * I1 * I1 + 12.0 * eta * J2 / (1.0 + nu) ** 2)
+    eps_eq = (a * I1 + root) / (2.0 * eta)
+    has_root = root > 0.0
+    safe = np.where(has_root, root, 1.0)
+    d_a = (I1 + np.where(has_root, a * I1 * I1 / safe, 0.0)) / (2.0 * eta)
+    d_nu = d_a * 2.0 * (eta - 1.0) / (1.0 - 2.0 * nu) ** 2 - np.where(has_root, 6.0 * J2 / ((1.0 + nu) ** 3 * safe), 0.0)
+    d_eta = (d_a / (1.0 - 2.0 * nu) + np.where(has_root, 6.0 * J2 / ((1.0 + nu) ** 2 * safe), 0.0) / (2.0 * eta)
+             - eps_eq / eta)
+    return d_nu, d_eta
+
+
+def modified_von_mises_plane_stress_parameter_derivatives(strain, nu, eta) -> dict:
+    """Derivatives of :func:`modified_von_mises_plane_stress` at fixed in-plane strain.
+
+    Returns
+    -------
+    dict {"nu", "eta": ndarray, shape (...)}
+        d eps_eq / d nu (through the invariants' coefficients and ezz = -nu/(1-nu)(exx + eyy)) and
+        d eps_eq / d eta [-].
+    """
+    e = np.asarray(strain, dtype=float)
+    exx, eyy, gxy = e[..., 0], e[..., 1], e[..., 2]
+    ezz = -nu / (1.0 - nu) * (exx + eyy)
+    I1 = exx + eyy + ezz
+    J2 = (exx**2 + eyy**2 + ezz**2 - exx * eyy - eyy * ezz - ezz * exx) / 3.0 + gxy**2 / 4.0
+    _, d_I1, d_J2 = _from_invariants(I1, J2, nu, eta)
+    d_nu, d_eta = _invariant_parameter_derivatives(I1, J2, nu, eta)
+    d_ezz = -(exx + eyy) / (1.0 - nu) ** 2
+    d_nu = d_nu + (d_I1 + d_J2 * (2.0 * ezz - exx - eyy) / 3.0) * d_ezz
+    return {"nu": d_nu, "eta": d_eta}
+
+
+def modified_von_mises_uniaxial_parameter_derivatives(strain, nu, eta) -> dict:
+    """Derivatives of :func:`modified_von_mises_uniaxial` at fixed strain: ``{"nu": 0, "eta": ...}``."""
+    e = np.asarray(strain, dtype=float)[..., 0]
+    eps_eq = ((eta - 1.0) * e + (eta + 1.0) * np.abs(e)) / (2.0 * eta)
+    return {"nu": np.zeros_like(e), "eta": (e + np.abs(e)) / (2.0 * eta) - eps_eq / eta}

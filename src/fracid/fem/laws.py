@@ -15,8 +15,10 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
-from fracid.fem.damage import exponential_damage, kappa_at_damage
-from fracid.fem.equivalent_strain import modified_von_mises_plane_stress, modified_von_mises_uniaxial
+from fracid.fem.damage import exponential_damage, exponential_damage_parameter_derivatives, kappa_at_damage
+from fracid.fem.equivalent_strain import (modified_von_mises_plane_stress,
+                                          modified_von_mises_plane_stress_parameter_derivatives,
+                                          modified_von_mises_uniaxial, modified_von_mises_uniaxial_parameter_derivatives)
 from fracid.fem.parameters import DamageParameters
 
 
@@ -24,10 +26,14 @@ class SofteningLaw(Protocol):
     """Damage omega(kappa) of the history variable kappa.
 
     ``damage(kappa, params) -> (omega, d omega / d kappa)`` at every point; ``kappa_at_damage(omega,
-    params)`` its inverse (the FPZ width's level); ``onset(params)`` the kappa at which damage starts.
+    params)`` its inverse (the FPZ width's level); ``onset(params)`` the kappa at which damage starts;
+    ``parameter_derivatives(kappa, params) -> {name: d omega / d name}`` at fixed kappa, for the
+    parameters it depends on (the direct differentiation of :mod:`fracid.fem.ddm`).
     """
 
     def damage(self, kappa, params): ...
+
+    def parameter_derivatives(self, kappa, params) -> dict: ...
 
     def kappa_at_damage(self, omega: float, params) -> float: ...
 
@@ -35,9 +41,12 @@ class SofteningLaw(Protocol):
 
 
 class EquivalentStrain(Protocol):
-    """Scalar strain measure driving damage: ``(strain_state, strain, params) -> (eps_eq, d eps_eq / d strain)``."""
+    """Scalar strain measure driving damage: ``(strain_state, strain, params) -> (eps_eq, d eps_eq / d strain)``;
+    ``parameter_derivatives(strain_state, strain, params) -> {name: d eps_eq / d name}`` at fixed strain."""
 
     def __call__(self, strain_state, strain, params): ...
+
+    def parameter_derivatives(self, strain_state, strain, params) -> dict: ...
 
 
 @dataclass(frozen=True)
@@ -48,6 +57,9 @@ class ExponentialSoftening:
     def damage(self, kappa, params):
         return exponential_damage(kappa, params.kappa_i, params.alpha, params.beta)
 
+    def parameter_derivatives(self, kappa, params) -> dict:
+        return exponential_damage_parameter_derivatives(kappa, params.kappa_i, params.alpha, params.beta)
+
     def kappa_at_damage(self, omega: float, params) -> float:
         return kappa_at_damage(omega, params.kappa_i, params.alpha, params.beta)
 
@@ -55,7 +67,9 @@ class ExponentialSoftening:
         return params.kappa_i
 
 
-_MODIFIED_VON_MISES = {"uniaxial": modified_von_mises_uniaxial, "plane stress": modified_von_mises_plane_stress}
+_MODIFIED_VON_MISES = {"uniaxial": (modified_von_mises_uniaxial, modified_von_mises_uniaxial_parameter_derivatives),
+                       "plane stress": (modified_von_mises_plane_stress,
+                                        modified_von_mises_plane_stress_parameter_derivatives)}
 
 
 @dataclass(frozen=True)
@@ -64,11 +78,17 @@ class ModifiedVonMises:
     compressive to tensile strength), for the uniaxial and plane-stress strain states."""
 
     def __call__(self, strain_state, strain, params):
+        return self._functions(strain_state)[0](strain, params.nu, params.eta)
+
+    def parameter_derivatives(self, strain_state, strain, params) -> dict:
+        return self._functions(strain_state)[1](strain, params.nu, params.eta)
+
+    @staticmethod
+    def _functions(strain_state):
         try:
-            function = _MODIFIED_VON_MISES[strain_state.name]
+            return _MODIFIED_VON_MISES[strain_state.name]
         except KeyError:
             raise ValueError(f"no modified von Mises strain for the {strain_state.name!r} strain state") from None
-        return function(strain, params.nu, params.eta)
 
 
 @dataclass(frozen=True)

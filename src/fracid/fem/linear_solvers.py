@@ -1,7 +1,8 @@
 """Linear-solver backends behind one small interface.
 
 A backend is any object with ``solve(matrix, rhs) -> x`` for a square sparse CSC matrix and a
-right-hand side of shape (n,) or (n, k). It raises :class:`SingularMatrixError` when the matrix
+right-hand side of shape (n,) or (n, k), and optionally ``factorize(matrix) -> solve(rhs)``, which keeps
+a factorization for several right-hand sides given at different times (see :func:`factorize`). It raises :class:`SingularMatrixError` when the matrix
 cannot be factorized, which the Newton solver treats as a failed iteration (the step is cut).
 """
 
@@ -45,6 +46,10 @@ class SuperLUSolver:
         self.diag_pivot_thresh = diag_pivot_thresh
 
     def solve(self, matrix, rhs):
+        return self.factorize(matrix)(rhs)
+
+    def factorize(self, matrix):
+        """The LU factors' solve function ``rhs -> x``."""
         try:
             lu = spla.splu(
                 matrix,
@@ -54,7 +59,16 @@ class SuperLUSolver:
             )
         except RuntimeError as err:  # "Factor is exactly singular"
             raise SingularMatrixError(str(err)) from err
-        return lu.solve(rhs)
+        return lu.solve
+
+
+def factorize(solver, matrix):
+    """``rhs -> x`` solving with ``matrix``: the backend's kept factorization if it has ``factorize``,
+    else a solve (a new factorization) per call."""
+    keep = getattr(solver, "factorize", None)
+    if keep is not None:
+        return keep(matrix)
+    return lambda rhs: solver.solve(matrix, rhs)
 
 
 def _pardiso():

@@ -67,6 +67,29 @@ def averaging_matrix(points, weights, length: float, cutoff: float = 4.0, mirror
     The neighbour lists come from one :class:`scipy.spatial.cKDTree` query per image (one without
     planes), not from a loop over points.
     """
+    rows, cols, values, _ = _gaussian_pairs(points, weights, length, cutoff, mirror)
+    matrix = sp.csr_matrix((values, (rows, cols)), shape=(len(weights),) * 2)  # sums the images of a pair
+    return (sp.diags(1.0 / np.asarray(matrix.sum(axis=1)).ravel()) @ matrix).tocsr()
+
+
+def averaging_length_derivative(points, weights, length: float, cutoff: float = 4.0, mirror=()) -> sp.csr_matrix:
+    """d A / d l of :func:`averaging_matrix` [1/mm] (same arguments), for the direct differentiation.
+
+    With W_ij = w_j psi_ij and s_i = sum_j W_ij, A = diag(1/s) W and d psi / d l = psi rho^2 / l^3, so
+    dA/dl = diag(1/s) (W' - diag(s'/s) W). The truncation radius moves with l, but the weights it
+    drops are exp(-cutoff^2 / 2) of the central one: their derivative is left out.
+    """
+    rows, cols, values, rho = _gaussian_pairs(points, weights, length, cutoff, mirror)
+    n = len(weights)
+    W = sp.csr_matrix((values, (rows, cols)), shape=(n, n))
+    dW = sp.csr_matrix((values * rho**2 / length**3, (rows, cols)), shape=(n, n))
+    s, ds = np.asarray(W.sum(axis=1)).ravel(), np.asarray(dW.sum(axis=1)).ravel()
+    return (sp.diags(1.0 / s) @ (dW - sp.diags(ds / s) @ W)).tocsr()
+
+
+def _gaussian_pairs(points, weights, length, cutoff, mirror):
+    """Pairs (i, j) within ``cutoff`` l of each other (images across the planes included): rows, cols,
+    the unnormalised weights w_j psi_ij and the distances rho_ij [mm]."""
     points = np.asarray(points, dtype=float)
     weights = np.asarray(weights, dtype=float)
     if points.ndim != 2 or weights.shape != (points.shape[0],):
@@ -92,9 +115,7 @@ def averaging_matrix(points, weights, length: float, cutoff: float = 4.0, mirror
         cols.append(pairs["j"])
         distances.append(pairs["v"])
     rows, cols, rho = (np.concatenate(a) for a in (rows, cols, distances))
-    values = weights[cols] * np.exp(-0.5 * (rho / length) ** 2)
-    matrix = sp.csr_matrix((values, (rows, cols)), shape=(points.shape[0],) * 2)  # sums the images of a pair
-    return (sp.diags(1.0 / np.asarray(matrix.sum(axis=1)).ravel()) @ matrix).tocsr()
+    return rows, cols, weights[cols] * np.exp(-0.5 * (rho / length) ** 2), rho
 
 
 class NonlocalAveraging(NamedTuple):

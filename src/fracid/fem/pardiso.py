@@ -169,9 +169,7 @@ class PardisoSolver:
 
     def _checked_solve(self, matrix, data, b):
         x = np.zeros_like(b, order="F")
-        self._run(23, data, b, x)
-        self.n_factorizations += 1
-        self.perturbed_pivots = int(self.iparm[13])
+        self._run(33, data, b, x)
         if not np.all(np.isfinite(x)) or (
             self.perturbed_pivots and np.linalg.norm(matrix @ x - b) > self.residual_rtol * np.linalg.norm(b)
         ):
@@ -182,13 +180,20 @@ class PardisoSolver:
 
     def solve(self, matrix, rhs):
         """Solve ``matrix @ x = rhs`` for a square sparse matrix (CSC preferred) and rhs of shape (n,) or (n, k)."""
+        return self.factorize(matrix)(rhs)
+
+    def factorize(self, matrix):
+        """Factorize ``matrix`` (phase 22, after an analysis when its pattern is new) and return
+        ``rhs -> x`` (phase 33), valid until the next factorization of this solver.
+
+        When PARDISO perturbed pivots, the first solution is checked (see ``residual_rtol``); a
+        rejected one redoes the analysis with these values once before raising
+        :class:`~fracid.fem.linear_solvers.SingularMatrixError`.
+        """
         if not sp.issparse(matrix) or matrix.format != "csc":
             matrix = sp.csc_matrix(matrix)
         if matrix.shape[0] != matrix.shape[1]:
             raise ValueError(f"the matrix must be square; got shape {matrix.shape}")
-        b = np.asfortranarray(rhs, dtype=np.float64)
-        if b.shape[0] != matrix.shape[0] or b.ndim not in (1, 2):
-            raise ValueError(f"rhs of shape {np.shape(rhs)} does not match the matrix of shape {matrix.shape}")
         fresh = not self._same_pattern(matrix)
         if fresh and not matrix.has_canonical_format:  # PARDISO needs sorted indices without duplicates
             matrix = matrix.copy()
@@ -197,13 +202,33 @@ class PardisoSolver:
         data = np.ascontiguousarray(matrix.data, dtype=np.float64)
         if fresh:
             self._analyse(matrix, data)
-        try:
+        self._factor(data)
+        checked, count = [False], [self.n_factorizations]
+
+        def solve(rhs):
+            b = np.asfortranarray(rhs, dtype=np.float64)
+            if b.shape[0] != matrix.shape[0] or b.ndim not in (1, 2):
+                raise ValueError(f"rhs of shape {np.shape(rhs)} does not match the matrix of shape {matrix.shape}")
+            if self.n_factorizations != count[0]:
+                raise RuntimeError("this PARDISO factorization was replaced by a later one")
+            try:
+                return self._checked_solve(matrix, data, b)
+            except SingularMatrixError:
+                if fresh or checked[0]:
+                    raise
+            checked[0] = True  # the scaling and matching of an earlier matrix may not suit this one
+            self._analyse(matrix, data)
+            self._factor(data)
+            count[0] = self.n_factorizations
             return self._checked_solve(matrix, data, b)
-        except SingularMatrixError:
-            if fresh:
-                raise
-        self._analyse(matrix, data)  # the scaling and matching of an earlier matrix may not suit this one
-        return self._checked_solve(matrix, data, b)
+
+        return solve
+
+    def _factor(self, data):
+        dummy = np.zeros(1)
+        self._run(22, data, dummy, dummy)
+        self.n_factorizations += 1
+        self.perturbed_pivots = int(self.iparm[13])
 
     def free(self):
         """Release PARDISO's memory; the next solve starts with a new analysis."""

@@ -10,6 +10,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from fracid.fem.assembly import dot
+from fracid.fem.ddm import PathDerivatives
 from fracid.fem.linear_solvers import linear_solver as _make_linear_solver
 from fracid.fem.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
@@ -35,6 +36,10 @@ class PathResult:
     stats : SolverStatistics
     status : str
         Why the analysis ended.
+    derivatives : dict or None
+        With ``sensitivities`` asked: ``derivatives[name]`` (n_steps + 1, p) is d/dx of ``force`` or of
+        the observable ``name`` at every step, x the parameters ``derivatives["names"]`` (the control
+        is held; see :mod:`fracid.fem.ddm`). Observers' values are not differentiated.
     """
 
     control_name: str
@@ -44,6 +49,7 @@ class PathResult:
     fields: dict = field(default_factory=dict)
     stats: SolverStatistics = field(default_factory=SolverStatistics)
     status: str = ""
+    derivatives: dict | None = None
 
     @property
     def n_steps(self) -> int:
@@ -133,6 +139,7 @@ def follow_path(
     field_steps="last",
     callback: Callable | None = None,
     checkpoints=None,
+    sensitivities=None,
 ) -> PathResult:
     """Trace the equilibrium path by increasing the functional ``control`` up to ``target``.
 
@@ -181,6 +188,8 @@ def follow_path(
     system = ControlledSystem(problem, problem.functionals[control])
     stats = SolverStatistics()
     recorder = _Recorder(problem, control, dict(observers or {}), field_steps)
+    derivatives = PathDerivatives(problem, sensitivities) if sensitivities is not None else None
+    factor = None  # factorization at the last converged state (from the derivatives), for the next increment
 
     z = np.zeros(problem.n_free + 1)
     kappa = problem.initial_history()
@@ -194,7 +203,10 @@ def follow_path(
 
     def result(final_status):
         stats.time_total = time.perf_counter() - t_start
-        return recorder.result(stats, final_status)
+        out = recorder.result(stats, final_status)
+        if derivatives is not None:
+            out.derivatives = derivatives.result()
+        return out
 
     while tau < target * (1.0 - 1e-12):
         if stats.steps >= max_steps:
@@ -206,10 +218,10 @@ def follow_path(
             increment = ahead[0] - tau
         try:
             z_new, arrays, iterations, state = solve_increment(
-                system, z, tau + increment, kappa, solver, newton, stats, state
+                system, z, tau + increment, kappa, solver, newton, stats, state, factor
             )
         except IncrementFailed as err:
-            state = None  # the failed iterations overwrote the problem's tangent buffer
+            state = factor = None  # the failed iterations overwrote the problem's tangent buffer
             stats.failed_increments += 1
             step = increment * steps.shrink
             minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or first_step)
@@ -221,6 +233,8 @@ def follow_path(
                 raise ConvergenceError(message, result("failed: " + str(err))) from None
             continue
         tau += increment
+        if derivatives is not None:
+            factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
         z, kappa = z_new, arrays.kappa
         stats.steps += 1
         force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)

@@ -11,11 +11,13 @@ from __future__ import annotations
 import numpy as np
 
 from fracid.fem.assembly import assemble_vector, norm2
+from fracid.fem import damage_sensitivity as ds
 from fracid.fem.discretization import MixedDiscretization
 from fracid.fem.dofs import Conditions, number_dofs
-from fracid.fem.forms import elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage, model_constants
+from fracid.fem.forms import (_damage, elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage,
+                              model_constants)
 from fracid.fem.laws import DamageLaw
-from fracid.fem.nonlocal_average import internal_length, nonlocal_averaging
+from fracid.fem.nonlocal_average import averaging_length_derivative, internal_length, nonlocal_averaging
 
 
 class ContinuumProblem:
@@ -67,6 +69,15 @@ class ContinuumProblem:
 
     def _element_arrays(self, qe, history_old):
         raise NotImplementedError
+
+    def assemble_columns(self, element_values: np.ndarray) -> np.ndarray:
+        """Element vectors with a last axis of p columns (n_el, n_dof_el, p) assembled to (n_free, p)."""
+        return np.column_stack([assemble_vector(self.element_dofs, element_values[..., k], self.n_free)
+                                for k in range(element_values.shape[-1])])
+
+    def gather_columns(self, dq: np.ndarray) -> np.ndarray:
+        """Element dof values (n_el, n_dof_el, p) of p free-dof vectors (n_free, p)."""
+        return np.stack([self.gather(dq[:, k]) for k in range(dq.shape[1])], axis=-1)
 
     def evaluate(self, q: np.ndarray, history_old: np.ndarray):
         """Internal-force residual, element arrays and per-field reference norms at state q
@@ -146,6 +157,57 @@ class DamageProblem(ContinuumProblem):
     def _element_arrays(self, qe, kappa_old):
         return local_damage(self.disc, self.law, self.params, self.const, qe, kappa_old, self._tangent)
 
+    # direct differentiation (docs/theory.md, section 5): the formulations differ only by their
+    # driving strain (local eps_eq, its average, or the nodal ebar) and the ebar equation's rows
+
+    @property
+    def differentiable(self) -> tuple:
+        """Parameters this problem differentiates with respect to: all of the law's."""
+        return tuple(self.law.parameters.names())
+
+    def differentiate(self, q, kappa_old, kappa_old_rate, names) -> "ds.StepDerivative":
+        """The pseudo-load of a converged step and how to complete its derivatives (see
+        :class:`~fracid.fem.damage_sensitivity.StepDerivative`)."""
+        names = ds.check_names(names, self.differentiable)
+        qe, n_u = self.gather(q), self.dofs.n_u
+        driving, eps, eq, d_eq = self._driving(qe)
+        loading = driving >= kappa_old
+        kappa = np.where(loading, driving, kappa_old)
+        omega, d_omega = _damage(self.law, self.params, self.const, kappa)
+        law_rate = ds.damage_parameter_derivatives(self.law, self.params, self.const, kappa, names)
+        explicit = self._driving_parameter_rate(eps, eq, names)
+        omega_rate = law_rate + d_omega[..., None] * np.where(loading[..., None], explicit, kappa_old_rate)
+        force = ds.equilibrium_pseudo_load(self.disc, self.params, self.const, qe[:, :n_u], omega, omega_rate, names)
+        pseudo_load = self.assemble_columns(self._with_field_rows(force, qe, eps, names))
+
+        def complete(dq):
+            dqe = self.gather_columns(dq)
+            rate = ds.history_derivative(loading, self._driving_response(dqe, eps, d_eq) + explicit, kappa_old_rate)
+            total_omega = law_rate + d_omega[..., None] * rate
+            energy = ds.elastic_energy_derivative(self.disc, self.params, self.const, qe[:, :n_u], dqe[:, :n_u], omega,
+                                                  total_omega, names)
+            return rate, self.symmetry_factor * energy
+
+        return ds.StepDerivative(pseudo_load, complete)
+
+    def _driving(self, qe):
+        """The strain that drives kappa at every point, the strain, eps_eq and d eps_eq / d eps."""
+        eps = np.einsum("eqsi,ei->eqs", self.disc.strain_operator, qe[:, : self.dofs.n_u])
+        eq, d_eq = self.law.equivalent_strain(self.disc.strain_state, eps, self.params)
+        return eq, eps, eq, d_eq
+
+    def _driving_parameter_rate(self, eps, eq, names):
+        """d driving / d x at fixed q, (n_el, n_q, p)."""
+        return ds.equivalent_strain_parameter_derivatives(self.law, self.params, self.disc.strain_state, eps, names)
+
+    def _driving_response(self, dqe, eps, d_eq):
+        """d driving / d q . q' at every point, (n_el, n_q, p), for element dof rates ``dqe`` (n_el, n_dof_el, p)."""
+        return np.einsum("eqs,eqsi,eip->eqp", d_eq, self.disc.strain_operator, dqe[:, : self.dofs.n_u])
+
+    def _with_field_rows(self, force, qe, eps, names):
+        """Element pseudo-loads of all dofs from those of equilibrium (the ebar rows of the gradient model)."""
+        return force
+
 
 class GradientDamageProblem(DamageProblem):
     """Implicit gradient-enhanced damage: the nonlocal strain ebar is a nodal field solving
@@ -157,6 +219,26 @@ class GradientDamageProblem(DamageProblem):
         super().__init__(disc, law, params, conditions, **options)
         n_u = self.dofs.n_u
         self._tangent[:, n_u:, n_u:] = self.const.ebar_matrix
+
+    def _driving(self, qe):
+        _, eps, eq, d_eq = super()._driving(qe)
+        return qe[:, self.dofs.n_u:] @ self.disc.ebar_shape.T, eps, eq, d_eq
+
+    def _driving_parameter_rate(self, eps, eq, names):
+        return np.zeros(eq.shape + (len(names),))  # kappa follows the nodal unknown ebar
+
+    def _driving_response(self, dqe, eps, d_eq):
+        return np.einsum("eip,qi->eqp", dqe[:, self.dofs.n_u:], self.disc.ebar_shape)
+
+    def _with_field_rows(self, force, qe, eps, names):
+        # r_ebar = (M + c K_g) ebar - int N^T eps_eq
+        disc, ee = self.disc, qe[:, self.dofs.n_u:]
+        eq_rate = ds.equivalent_strain_parameter_derivatives(self.law, self.params, disc.strain_state, eps, names)
+        rows = -np.einsum("eq,qi,eqp->eip", disc.weights, disc.ebar_shape, eq_rate)
+        if "c" in names:
+            G = disc.ebar_gradient
+            rows[..., names.index("c")] += np.einsum("eq,eqdi,eqdj,ej->ei", disc.weights, G, G, ee)
+        return np.concatenate([force, rows], axis=1)
 
     def _element_arrays(self, qe, kappa_old):
         n_u = self.dofs.n_u
@@ -176,6 +258,30 @@ class IntegralDamageProblem(DamageProblem):
     def _element_arrays(self, qe, kappa_old):
         return integral_damage(self.disc, self.law, self.params, self.const, qe, kappa_old, self._tangent,
                                self.averaging)
+
+    def _average(self, point_values):
+        """A applied to each column of (n_el, n_q, p) point values."""
+        flat = point_values.reshape(-1, point_values.shape[-1])
+        return (self.averaging.matrix @ flat).reshape(point_values.shape)
+
+    def _driving(self, qe):
+        _, eps, eq, d_eq = super()._driving(qe)
+        return (self.averaging.matrix @ eq.ravel()).reshape(eq.shape), eps, eq, d_eq
+
+    def _driving_parameter_rate(self, eps, eq, names):
+        rate = self._average(super()._driving_parameter_rate(eps, eq, names))
+        if "c" in names:  # l = sqrt(2 c): dA/dc = dA/dl / l
+            length = internal_length(self.params.c)
+            if getattr(self, "_length_derivative", None) is None:
+                n_el, n_q = self.disc.weights.shape
+                self._length_derivative = averaging_length_derivative(
+                    self.disc.points.reshape(n_el * n_q, -1), self.disc.weights.ravel(), length,
+                    mirror=self.symmetry_planes)
+            rate[..., names.index("c")] += (self._length_derivative @ eq.ravel()).reshape(eq.shape) / length
+        return rate
+
+    def _driving_response(self, dqe, eps, d_eq):
+        return self._average(super()._driving_response(dqe, eps, d_eq))
 
 
 # formulation name of the model registry -> problem class

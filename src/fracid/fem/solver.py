@@ -10,6 +10,7 @@ built once, and stays regular at limit points of the load.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 
@@ -77,6 +78,7 @@ class SolverStatistics:
     time_linear: float = 0.0
     time_total: float = 0.0
     linear_solves: int = 0
+    factorizations: int = 0
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -123,6 +125,10 @@ class ControlledSystem:
         """The bordered tangent (CSC), with the nonlocal coupling of the integral model if any."""
         return _add_coupling(self.pattern.matrix(arrays.tangent, self.border_values), _coupling(arrays))
 
+    def scaled_matrix_scale(self) -> np.ndarray:
+        """The diagonal of S of :meth:`scaled_matrix` (after its first call)."""
+        return self._scale
+
     def scaled_matrix(self, arrays):
         """The bordered matrix equilibrated as S M S, and the diagonal of S.
 
@@ -163,13 +169,16 @@ def _add_coupling(matrix, coupling):
 
 
 def solve_increment(
-    system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics, state=None
+    system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics, state=None,
+    factor=None,
 ):
     """Newton-Raphson iterations for one increment to the control value ``tau``.
 
     ``state`` is the evaluation at ``z0`` returned by the previous increment: at a converged state the
     internal forces and tangent under the updated history equal those of the last iteration (the
-    loading pattern does not change), so the first iteration of a step costs no evaluation.
+    loading pattern does not change), so the first iteration of a step costs no evaluation; ``factor``,
+    given with ``state``, is the factorization of the bordered tangent at that state (from the direct
+    differentiation of the last step, :mod:`fracid.fem.ddm`), so it costs no factorization either.
 
     Returns
     -------
@@ -198,10 +207,15 @@ def solve_increment(
             return z, arrays, iteration, state
         if iteration == options.max_iterations:
             break
-        matrix, equilibration = system.scaled_matrix(arrays)
+        if iteration == 0 and factor is not None and state is not None:
+            equilibration, solve = system.scaled_matrix_scale(), factor
+        else:
+            matrix, equilibration = system.scaled_matrix(arrays)
+            solve = functools.partial(solver.solve, matrix)
+            stats.factorizations += 1
         t0 = time.perf_counter()
         try:
-            dz = equilibration * solver.solve(matrix, -residual * equilibration)
+            dz = equilibration * solve(-residual * equilibration)
         except SingularMatrixError as err:
             raise IncrementFailed(f"singular tangent at iteration {iteration}: {err}") from err
         finally:
