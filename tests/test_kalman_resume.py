@@ -44,14 +44,14 @@ def test_identification_killed_in_its_kalman_stage_resumes(bar_config, tmp_path)
     child = identify(bar_config, out, start_new_session=True)
     try:
         deadline = time.monotonic() + 300
-        while time.monotonic() < deadline and child.poll() is None and stored_rows(store) < N_KNN + 6:
+        while time.monotonic() < deadline and child.poll() is None and stored_rows(store) < N_KNN + 3:
             time.sleep(0.02)
         assert child.poll() is None, f"finished or died before the kill: {child.stderr.read()}"
-        os.killpg(child.pid, signal.SIGKILL)  # in the Kalman stage: the population (8) and 6 Kalman runs stored
+        os.killpg(child.pid, signal.SIGKILL)  # in the Kalman stage: the population (8) and 3 Kalman runs stored
     finally:
         child.communicate()
     before = stored_rows(store)
-    assert before >= N_KNN + 6 and not (out / "result.json").exists()
+    assert before >= N_KNN + 3 and not (out / "result.json").exists()
 
     resumed = finished(bar_config, out)
     runs = resumed["runs"]

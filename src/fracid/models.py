@@ -97,6 +97,15 @@ class _PathFollowing:
     def runs_on(self, specimen) -> bool:
         return self.why_not(specimen) is None
 
+    @property
+    def differentiable(self) -> tuple:
+        """Parameters whose derivatives a run computes by direct differentiation (``simulate(...,
+        sensitivities=names)``; see :mod:`fracid.fem.ddm`): those its problem class declares."""
+        declared = getattr(self._problem_class, "differentiable", ())
+        if isinstance(declared, property):  # declared per instance: every parameter of the law
+            return tuple(self.parameters.names())
+        return tuple(declared)
+
 
 @dataclass(frozen=True)
 class DamageModel(_PathFollowing):
@@ -130,6 +139,10 @@ class DamageModel(_PathFollowing):
         if d.strength_factor is not uniform:
             return "its imperfection is a reduced tensile strength, which a damage law does not read"
         return None
+
+    @property
+    def _problem_class(self):
+        return FORMULATIONS[self.regularization]
 
     def build(self, specimen, params):
         """The problem of this formulation on ``specimen`` (a specimen or its description)."""
@@ -182,6 +195,8 @@ class CohesiveCrackModel(_CrackModel):
             return "the specimen has no crack path on a symmetry line"
         return None
 
+    _problem_class = CohesiveCrackProblem
+
     def build(self, specimen, params):
         d = _description(specimen)
         disc = discretize(d)
@@ -213,6 +228,8 @@ class CrackBandModel(_CrackModel):
     @property
     def key(self) -> str:
         return "crack-band-hordijk" + ("" if self.band_width is None else f"-band-{self.band_width:g}")
+
+    _problem_class = CrackBandProblem
 
     def build(self, specimen, params):
         d = _description(specimen)

@@ -136,6 +136,86 @@ def hordijk_tangent(w, ft, wc, c1, c2):
     return _softening(w, ft, wc, c1, c2)[1]
 
 
+def hordijk_parameter_derivatives(w, ft, wc, c1, c2, params) -> dict:
+    """Derivatives of :func:`hordijk_stress` at fixed opening w with respect to the law's parameters
+    ft, Gf, c1 and c2 of ``params`` (a :class:`CohesiveParameters`), including their effect through
+    the critical opening wc = Gf / (ft I(c1, c2)).
+
+    The law's arguments ``ft`` and ``wc`` may be those of ``params`` scaled by a factor a (ft a,
+    wc / a: a strength imperfection at equal fracture energy); they move with the parameters in
+    proportion (:meth:`CohesiveParameters.argument_rates`).
+
+    Parameters
+    ----------
+    w : array_like
+        Opening [mm].
+    ft, wc, c1, c2 : array_like
+        The law's arguments, as in :func:`hordijk_stress`.
+    params : CohesiveParameters
+
+    Returns
+    -------
+    dict {"ft", "Gf", "c1", "c2": ndarray}
+        d sigma / d name [MPa per unit parameter], zero where the traction is cut to 0 (w < 0,
+        w >= wc). At w = wc the law has a kink and the derivative with respect to wc jumps: the
+        value of the cut-off side (0) is returned there, the one-sided derivative of opening
+        the point further.
+    """
+    w = np.asarray(w, dtype=float)
+    active = (w >= 0.0) & (w < wc)
+    x = np.where(active, w / wc, 0.0)
+    f, df = _normalised_law(x, c1, c2)
+    decay, tail = np.exp(-c2 * x), np.exp(-c2)
+    partial = {  # with respect to the arguments, wc held
+        "ft": f,
+        "wc": -ft * df * x / wc,
+        "c1": ft * 3.0 * c1**2 * (x**3 * decay - x * tail),
+        "c2": ft * (-x * (1.0 + (c1 * x) ** 3) * decay + x * (1.0 + c1**3) * tail),
+    }
+    out = {}
+    for name, (ft_rate, wc_rate, c1_rate, c2_rate) in params.argument_rates().items():
+        value = partial["ft"] * ft * ft_rate + partial["wc"] * wc * wc_rate + partial["c1"] * c1_rate + partial["c2"] * c2_rate
+        out[name] = np.where(active, value, 0.0)
+    return out
+
+
+def cohesive_traction_parameter_derivatives(w, w_max, ft, wc, c1, c2, params):
+    """Derivatives of the traction of :func:`cohesive_traction` at fixed opening w and fixed
+    history w_max: with respect to the parameters, and with respect to w_max.
+
+    Loading (w >= w_max): the envelope's, :func:`hordijk_parameter_derivatives` at w, and no
+    dependence on w_max. Unloading (0 <= w < w_max): sigma = hordijk_stress(w_max) w / w_max, so
+    d sigma / d x = d hordijk_stress(w_max) / d x  w / w_max and
+    d sigma / d w_max = w (w_max sigma_H'(w_max) - sigma_H(w_max)) / w_max^2. Closed (w < 0): zeros.
+
+    Parameters
+    ----------
+    w, w_max, ft, wc, c1, c2
+        As in :func:`cohesive_traction`.
+    params : CohesiveParameters
+        Whose ft, Gf, c1, c2 the arguments derive from (see :func:`hordijk_parameter_derivatives`).
+
+    Returns
+    -------
+    rates : dict {"ft", "Gf", "c1", "c2": ndarray}
+        d sigma / d name at fixed w and w_max [MPa per unit parameter].
+    d_sigma_d_w_max : ndarray
+        [MPa/mm], nonzero at unloading points only.
+    """
+    w = np.asarray(w, dtype=float)
+    w_max = np.asarray(w_max, dtype=float)
+    loading = w >= w_max
+    unloading = ~loading & (w >= 0.0)
+    reached = np.where(unloading, w_max, 1.0)  # w < w_max implies w_max > 0
+    envelope = hordijk_parameter_derivatives(w, ft, wc, c1, c2, params)
+    at_max = hordijk_parameter_derivatives(reached, ft, wc, c1, c2, params)
+    ratio = np.where(unloading, w / reached, 0.0)
+    rates = {name: np.where(loading, envelope[name], at_max[name] * ratio) for name in envelope}
+    stress, slope = _softening(reached, ft, wc, c1, c2)
+    d_w_max = np.where(unloading, w * (reached * slope - stress) / reached**2, 0.0)
+    return rates, d_w_max
+
+
 def cohesive_traction(w, w_max, ft, wc, c1, c2):
     """Traction, consistent tangent and history update of the Hordijk law with secant unloading.
 
@@ -265,6 +345,29 @@ class CohesiveParameters(ParameterSet):
         """Critical opening [mm] at which the traction vanishes, wc = Gf / (ft I(c1, c2)), so that
         the area under the law is exactly Gf (about 5.136 Gf / ft for Hordijk's constants)."""
         return self.Gf / (self.ft * self.area_factor)
+
+    def area_factor_derivatives(self) -> tuple[float, float]:
+        """(d I / d c1, d I / d c2) of :attr:`area_factor` [-], in closed form:
+        3 c1^2 (M3 - exp(-c2) / 2) and (1 + c1^3) exp(-c2) / 2 - M1 - c1^3 M4, with
+        Mn = int_0^1 t^n exp(-c2 t) dt."""
+        c1, c2 = self.c1, self.c2
+        moment = lambda n: float(_incomplete_moment(n, c2, 1.0))  # noqa: E731
+        tail = math.exp(-c2)
+        return (3.0 * c1**2 * (moment(3) - 0.5 * tail),
+                0.5 * (1.0 + c1**3) * tail - moment(1) - c1**3 * moment(4))
+
+    def argument_rates(self) -> dict:
+        """How the law's arguments (ft, wc, c1, c2) move with each law parameter:
+        {name: (d ln ft / d name, d ln wc / d name, d c1 / d name, d c2 / d name)} for ft, Gf, c1, c2
+        (relative for ft and wc, so that they also hold for arguments scaled by a constant factor)."""
+        area = self.area_factor
+        d_c1, d_c2 = self.area_factor_derivatives()
+        return {
+            "ft": (1.0 / self.ft, -1.0 / self.ft, 0.0, 0.0),
+            "Gf": (0.0, 1.0 / self.Gf, 0.0, 0.0),
+            "c1": (0.0, -d_c1 / area, 1.0, 0.0),
+            "c2": (0.0, -d_c2 / area, 0.0, 1.0),
+        }
 
     def law(self) -> tuple[float, float, float, float]:
         """(ft, wc, c1, c2), the trailing arguments of the law functions of this module."""

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.fem.cohesive import _normalised_law, hordijk_stress, hordijk_tangent
+from fracid.fem.cohesive import _normalised_law, hordijk_parameter_derivatives, hordijk_stress, hordijk_tangent
 from fracid.fem.damage import update_history
 
 
@@ -94,6 +94,13 @@ def crack_direction_stress(s, nu):
     return lam, F, dF, dlam
 
 
+def crack_direction_stress_nu_derivative(s):
+    """d/d nu of :func:`crack_direction_stress` at fixed s: <lambda_1> P_2 = <lambda_1> (I - P_1)
+    in Voigt components, shape (..., 3) (zero where lambda_1 <= 0)."""
+    lam, F1, _, _ = principal_tension(s)
+    return np.where((lam > 0.0)[..., None], lam[..., None] * np.array([1.0, 1.0, 0.0]) - F1, 0.0)
+
+
 def snap_back_limit(E, ft, wc, c1, c2, samples: int = 2001) -> float:
     """Widest crack band [mm] for which the band's stress-strain law has no snap-back:
     h_max = E / max_w |d sigma_H / dw| (the softening slope of the band, -1 / (1/E - h / |sigma_H'|),
@@ -144,6 +151,45 @@ def band_damage(kappa, band_width, E, ft, wc, c1, c2, tol=1e-13, max_iterations=
     omega = np.where(cracked, w / (h * k), 0.0)
     d_omega = np.where(cracked, dw / (h * k) - w / (h * k * k), 0.0)
     return omega, d_omega
+
+
+def band_damage_parameter_derivatives(kappa, band_width, E, ft, wc, c1, c2, params):
+    """Derivatives of the damage of :func:`band_damage` at fixed kappa, for the direct differentiation.
+
+    From the band's equation g = E (kappa - w / h) - sigma_H(w) = 0 at fixed kappa:
+    dw = -(dg/dx) / (dg/dw) with dg/dw = -E / h - sigma_H'(w), and omega = w / (h kappa).
+
+    Parameters
+    ----------
+    kappa, band_width, E, ft, wc, c1, c2
+        As in :func:`band_damage` (``ft`` and ``wc`` may be scaled from those of ``params`` by a
+        strength factor, see :func:`~fracid.fem.cohesive.hordijk_parameter_derivatives`).
+    params : CohesiveParameters
+        Whose ft, Gf, c1, c2 the law's arguments derive from.
+
+    Returns
+    -------
+    arguments : dict {"E", "band_width": ndarray}
+        d omega / d E [1/MPa] and d omega / d h [1/mm] with respect to the arguments E and h (the
+        caller chains them to the parameters: E = params.E times a stiffness factor, h the width
+        times 1 - nu^2).
+    law : dict {"ft", "Gf", "c1", "c2": ndarray}
+        d omega / d name [per unit parameter].
+    All zero where the band has not cracked (kappa <= ft / E). At the onset kappa = ft / E, where
+    omega leaves zero with a kink, the uncracked side's (zero) derivative is returned.
+    """
+    omega, _ = band_damage(kappa, band_width, E, ft, wc, c1, c2)
+    kappa, h, E, ft = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (kappa, band_width, E, ft)))
+    cracked = kappa > ft / E
+    k = np.where(cracked, kappa, 1.0)
+    w = omega * h * k
+    slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)  # dg / dw < 0
+    per_opening = np.where(cracked, 1.0 / (h * k), 0.0)  # d omega / d w at fixed h, kappa
+    arguments = {"E": per_opening * (-(k - w / h) / slope),
+                 "band_width": per_opening * (-E * w / (h * h * slope)) - np.where(cracked, w / (h * h * k), 0.0)}
+    law = {name: per_opening * rate / slope
+           for name, rate in hordijk_parameter_derivatives(w, ft, wc, c1, c2, params).items()}
+    return arguments, law
 
 
 def element_mean(values, weights):

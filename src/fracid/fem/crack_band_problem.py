@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from fracid.fem import damage_sensitivity as ds
 from fracid.fem.assembly import assemble_vector, norm2
-from fracid.fem.crack_band import crack_band_stress, crack_direction_stress, snap_back_limit
+from fracid.fem.crack_band import (band_damage, band_damage_parameter_derivatives, crack_band_stress,
+                                   crack_direction_stress, crack_direction_stress_nu_derivative, element_mean,
+                                   snap_back_limit)
+from fracid.fem.damage import update_history
 from fracid.fem.forms import ElementArrays, _btdb
 from fracid.fem.problem import ContinuumProblem
 
@@ -43,6 +47,9 @@ class CrackBandProblem(ContinuumProblem):
         Young's modulus relative to ``params.E`` at the integration points [-].
     """
 
+    #: parameters :meth:`differentiate` differentiates with respect to (all of CohesiveParameters)
+    differentiable = ("E", "nu", "ft", "Gf", "c1", "c2")
+
     def __init__(self, disc, law, params, conditions, band_width, *, strength_factor=1.0, crackable=1.0,
                  stiffness_factor=1.0):
         if disc.strain_state.n_components != 3:
@@ -70,10 +77,13 @@ class CrackBandProblem(ContinuumProblem):
 
     def _stress(self, ue, kappa_old):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
-        _, wc, c1, c2 = self.params.law()
-        law = (wc / self.strength, c1, c2)
         return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu, self.ft,
-                                 law, self.crackable)
+                                 self._law(), self.crackable)
+
+    def _law(self):
+        """(wc, c1, c2) of Hordijk's law at the points: wc divided by the strength factor (equal Gf)."""
+        _, wc, c1, c2 = self.params.law()
+        return wc / self.strength, c1, c2
 
     def evaluate(self, q, kappa_old):
         ue = self.gather(q)
@@ -95,3 +105,85 @@ class CrackBandProblem(ContinuumProblem):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)
         sigma = self.const.E[..., None] * (s - omega[..., None] * crack_direction_stress(s, self.params.nu)[1])
         return self.symmetry_factor * 0.5 * float(np.sum(self.disc.weights * np.sum(eps * sigma, axis=-1)))
+
+    # direct differentiation (fracid.fem.ddm)
+
+    def differentiate(self, q, kappa_old, kappa_old_rate, names) -> "ds.StepDerivative":
+        """The pseudo-load of a converged step and how to complete its derivatives (see
+        :class:`~fracid.fem.damage_sensitivity.StepDerivative`).
+
+        sigma = E (s - omega F(s, nu)) with s = D(nu) eps, omega = omega(kappa; E, h = (1 - nu^2) h_el,
+        ft, Gf, c1, c2) of the element's history kappa = max(kappa_old, mean lambda_1(s)). At fixed
+        displacements, s moves with nu only; omega with the parameters at fixed kappa
+        (:func:`~fracid.fem.crack_band.band_damage_parameter_derivatives`) and with kappa's explicit
+        part: at loading elements the parameter derivative of mean lambda_1 at fixed eps (through
+        D(nu)), elsewhere the kappa' carried from the last step.
+
+        Non-differentiable points, where the one-sided derivative of the branch the element is on
+        is used: the onset of cracking of an element, kappa = ft / E (omega leaves 0 with a kink; its
+        parameter derivatives jump from 0), the opening at which Hordijk's traction reaches zero
+        (w = wc), loading versus unloading at kappa = mean lambda_1, and the closure of a crack
+        (lambda_1 = 0, where F switches off) or equal principal values (the crack direction is
+        undefined). With the element's crack band advancing one element at a time, a recorded step
+        exactly on such a point is rare.
+        """
+        names = ds.check_names(names, self.differentiable)
+        p, params, nu = len(names), self.params, self.params.nu
+        disc, const = self.disc, self.const
+        B, weights = disc.strain_operator, disc.weights
+        share = weights / np.sum(weights, axis=1, keepdims=True)
+
+        def element_means(values):  # weighted element means of (n_el, n_q, p) values, at every point
+            return np.broadcast_to(np.einsum("eq,eqp->ep", share, values)[:, None, :], values.shape)
+
+        ue = self.gather(q)
+        eps = np.einsum("eqsi,ei->eqs", B, ue)
+        s = np.einsum("eqsj,ej->eqs", const.DB, ue)
+        lam, F, dF, dlam = crack_direction_stress(s, nu)
+        F_nu = crack_direction_stress_nu_derivative(s)
+        kappa, loading = update_history(kappa_old, element_mean(lam, weights))
+
+        # omega and its parameter derivatives at fixed kappa, with the arguments crack_band_stress uses
+        mean = lambda v: element_mean(v, weights)  # noqa: E731
+        wc, c1, c2 = self._law()
+        width = np.broadcast_to(self.band_width, weights.shape)
+        h, crackable = (1.0 - nu * nu) * width, mean(self.crackable)
+        arguments = (kappa, h, mean(const.E), mean(self.ft), mean(wc), c1, c2)
+        omega, d_omega = (crackable * v for v in band_damage(*arguments))
+        by_argument, law = band_damage_parameter_derivatives(*arguments, params)
+        law.update(E=by_argument["E"] * mean(const.E) / params.E, nu=by_argument["band_width"] * (-2.0 * nu * width))
+        law_rate = crackable[..., None] * ds.stacked(law, names, weights.shape)
+
+        # s' at fixed displacements (nu only) and the explicit part of the driving mean lambda_1
+        s_rate = np.zeros(s.shape + (p,))
+        if "nu" in names:
+            s_rate[..., names.index("nu")] = np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(nu),
+                                                       eps)
+        explicit = element_means(np.einsum("eqs,eqsp->eqp", dlam, s_rate))
+        nu_column = np.zeros(p)
+        if "nu" in names:
+            nu_column[names.index("nu")] = 1.0
+        E_column = np.array([1.0 / params.E if name == "E" else 0.0 for name in names])
+        sigma = const.E[..., None] * (s - omega[..., None] * F)
+
+        def stress_rate(ds_rate, omega_rate):
+            """d sigma (n_el, n_q, 3, p) for rates of s and omega (all parameters' columns)."""
+            d_F = np.einsum("eqst,eqtp->eqsp", dF, ds_rate) + F_nu[..., None] * nu_column
+            return (sigma[..., None] * E_column + const.E[..., None, None]
+                    * (ds_rate - omega_rate[..., None, :] * F[..., None] - omega[..., None, None] * d_F))
+
+        omega_rate = law_rate + d_omega[..., None] * np.where(loading[..., None], explicit, kappa_old_rate)
+        d_sigma = stress_rate(s_rate, omega_rate)
+        pseudo_load = self.assemble_columns(np.einsum("eqsi,eqsp->eip", B, d_sigma * weights[..., None, None]))
+
+        def complete(dq):
+            due = self.gather_columns(dq)
+            d_eps = np.einsum("eqsi,eip->eqsp", B, due)
+            ds_total = np.einsum("eqsj,ejp->eqsp", const.DB, due) + s_rate
+            rate = ds.history_derivative(loading, element_means(np.einsum("eqs,eqsp->eqp", dlam, ds_total)),
+                                         kappa_old_rate)
+            total_sigma = stress_rate(ds_total, law_rate + d_omega[..., None] * rate)
+            energy = 0.5 * np.einsum("eq,eqsp->p", weights, d_eps * sigma[..., None] + eps[..., None] * total_sigma)
+            return rate, self.symmetry_factor * energy
+
+        return ds.StepDerivative(pseudo_load, complete)

@@ -11,7 +11,7 @@ import numpy as np
 
 from fracid.fem.assembly import dot
 from fracid.fem.ddm import PathDerivatives
-from fracid.fem.linear_solvers import linear_solver as _make_linear_solver
+from fracid.fem.linear_solvers import SingularMatrixError, linear_solver as _make_linear_solver
 from fracid.fem.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
 
@@ -93,6 +93,11 @@ class StepOptions:
         The first increment after damage onset, as a fraction of ``initial``; the steps then grow
         back. Small first steps resolve the peak and keep the damaged zone that a single large step
         would create at once (an artefact, blatant in the local model) from appearing.
+    jump_to_onset : bool
+        While the response is linear, jump straight to just below damage onset. That step's
+        position depends on the parameters; without the jump (and with ``initial`` given,
+        ``onset_fraction = max_factor = 1`` and checkpoints at every step) the step sequence does
+        not, which is what comparing derivatives with differences of runs needs.
     """
 
     initial: float | None = None
@@ -103,6 +108,7 @@ class StepOptions:
     shrink: float = 0.5
     easy_iterations: int = 4
     onset_fraction: float = 0.02
+    jump_to_onset: bool = True
 
 
 def _check_request(problem, control, target, stop_force_fraction, max_steps):
@@ -234,7 +240,12 @@ def follow_path(
             continue
         tau += increment
         if derivatives is not None:
-            factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
+            try:
+                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
+            except SingularMatrixError as err:
+                message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
+                           f"derivatives are not defined there (a bifurcation of the path): {err}")
+                raise ConvergenceError(message, result("failed: singular tangent for the derivatives")) from None
         z, kappa = z_new, arrays.kappa
         stats.steps += 1
         force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
@@ -244,7 +255,7 @@ def follow_path(
             status = f"force below {stop_force_fraction:g} of the peak"
             break
         onset_ratio = problem.onset_ratio(kappa)
-        if elastic and 0.0 < onset_ratio < 1.0:
+        if elastic and 0.0 < onset_ratio < 1.0 and steps.jump_to_onset:
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
             base = base if base is not None else tau_onset / 20.0

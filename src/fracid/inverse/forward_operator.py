@@ -67,6 +67,8 @@ class RunRecord:
 
     ``y`` holds the computed values (NaN where not computed); ``status`` is ``"ok"`` or ``"failed"``;
     ``error`` the reason of a failure and ``reached`` the control value reached per observation.
+    ``S`` is d y / d x (n_outputs x n_parameters) when the run computed it by direct differentiation
+    (an operator with ``sensitivities=True``), else None.
     """
 
     x: np.ndarray
@@ -76,19 +78,24 @@ class RunRecord:
     reached: list = field(default_factory=list)
     seconds: float = 0.0
     retried: bool = False
+    S: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
         return self.status == "ok"
 
     def as_dict(self) -> dict:
-        return {"x": self.x, "y": self.y, "status": self.status, "error": self.error, "reached": list(self.reached),
-                "seconds": self.seconds, "retried": self.retried}
+        out = {"x": self.x, "y": self.y, "status": self.status, "error": self.error, "reached": list(self.reached),
+               "seconds": self.seconds, "retried": self.retried}
+        if self.S is not None:
+            out["S"] = self.S
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> "RunRecord":
+        S = d.get("S")
         return cls(np.asarray(d["x"], float), np.asarray(d["y"], float), d["status"], d["error"], list(d["reached"]),
-                   float(d["seconds"]), bool(d["retried"]))
+                   float(d["seconds"]), bool(d["retried"]), None if S is None else np.asarray(S, float))
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +117,10 @@ class ForwardOperator:
         Step rule (the specimen's default if None); the retry divides its increments by 4.
     model : ForwardModel, optional
         The forward model (see :mod:`fracid.models`); :class:`~fracid.models.DamageModel` by default.
+    sensitivities : bool
+        Every run also returns S = d y / d x (``RunRecord.S``) by direct differentiation inside the
+        analysis (:mod:`fracid.fem.ddm`), where the model and the observed quantities allow it (see
+        :meth:`differentiated`); None for a quantity without derivatives (a local width).
     """
 
     observations: tuple
@@ -118,6 +129,7 @@ class ForwardOperator:
     regularization: str | None = None
     steps: StepOptions | None = None
     model: object = None
+    sensitivities: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "observations", tuple(self.observations))
@@ -137,6 +149,19 @@ class ForwardOperator:
             raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {known}")
         sizes = [o.control_points.size for o in self.observations]
         object.__setattr__(self, "_offsets", np.concatenate([[0], np.cumsum(sizes)]))
+
+    @property
+    def differentiable(self) -> bool:
+        """Whether the model differentiates its runs with respect to every identified parameter and
+        every observed quantity has derivatives: the force, the functionals and energies do; the
+        specimen's ``observables`` (widths of the damaged zone, from observers) do not."""
+        names = set(getattr(self.model, "differentiable", ()))
+        return set(self.names) <= names and not any(
+            o.quantity in getattr(o.specimen, "observables", ()) for o in self.observations)
+
+    def differentiated(self) -> "ForwardOperator":
+        """This operator with ``sensitivities=True`` if it is :attr:`differentiable`, else itself."""
+        return replace(self, sensitivities=True) if self.differentiable and not self.sensitivities else self
 
     @property
     def n_outputs(self) -> int:
@@ -174,6 +199,8 @@ class ForwardOperator:
             record.status, record.error = "failed", f"invalid parameters: {err}"
             return record
         limit = self.n_outputs if needed is None else int(needed)
+        if self.sensitivities:
+            record.S = np.full((self.n_outputs, len(self.names)), np.nan)
         for threshold, group in self._run_groups(limit):
             if not self._fill(record, group, params, limit, threshold):
                 break
@@ -210,7 +237,13 @@ class ForwardOperator:
         record.reached.append(float(run.control[-1]))
         for (obs, part), points in zip(group, wanted):
             values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
-            record.y[part.start : part.start + points.size] = np.interp(points, run.control, values)
+            rows = slice(part.start, part.start + points.size)
+            record.y[rows] = np.interp(points, run.control, values)
+            derivative = (run.derivatives or {}).get(obs.quantity)
+            if derivative is None:
+                record.S = None
+            elif record.S is not None:  # the checkpoints are steps: the interpolation picks the step's value
+                record.S[rows] = np.column_stack([np.interp(points, run.control, d) for d in derivative.T])
         return True
 
     def _run(self, obs, params, target, checkpoints, threshold, observables):
@@ -221,7 +254,8 @@ class ForwardOperator:
                 result = self.model.simulate(obs.specimen, params, control=obs.control, target=target,
                                              stop_force_fraction=None, steps=steps, field_steps=None,
                                              checkpoints=checkpoints, damage_threshold=threshold,
-                                             observables=observables)
+                                             observables=observables,
+                                             **({"sensitivities": self.names} if self.sensitivities else {}))
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError, evaluate_points, memoized
+from fracid.inverse.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
 
 
 def kalman_update(x, C, S, innovation, R):
@@ -214,7 +214,7 @@ def kalman_filter(
     max_iterations: int = 10,
     tol: float = 0.01,
     restart: str = "linearize",
-    sensitivity=CentralDifferences(),
+    sensitivity=None,
     executor=None,
     bounds=None,
     callback=None,
@@ -252,10 +252,11 @@ def kalman_filter(
         Prior mean and covariance (from KNN or the user). x0 is moved into the bounds first.
     groups : sequence of index arrays, optional
         The observation sequence; one observation per step by default.
-    sensitivity : callable
-        See :mod:`fracid.inverse.sensitivity`.
+    sensitivity : callable, optional
+        See :mod:`fracid.inverse.sensitivity`; by default the exact sensitivities of the runs where
+        the model has direct differentiation, else central differences (:func:`exact_sensitivity`).
     executor : Executor, optional
-        Runs the 2 p + 1 runs of each sensitivity in parallel.
+        Runs the 2 p + 1 runs of central differences in parallel.
     bounds : (lower, upper) arrays, optional
         The box every estimate stays in (the identification bounds).
     callback : callable(iteration, step, x, C), optional
@@ -280,6 +281,8 @@ def kalman_filter(
     if restart not in ("linearize", "prior-mean"):
         raise ValueError(f"restart = {restart!r}; choose 'linearize' or 'prior-mean'")
     y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
+    if sensitivity is None:
+        evaluate, sensitivity = exact_sensitivity(evaluate)
     groups = _observation_groups(y_exp.size, groups)
     lower, upper = _box(bounds, x0.size)
     x0 = np.clip(x0, lower, upper)
@@ -381,7 +384,7 @@ def batch_kalman(
     *,
     max_iterations: int = 20,
     tol: float = 0.01,
-    sensitivity=CentralDifferences(),
+    sensitivity=None,
     executor=None,
     bounds=None,
 ) -> KalmanResult:

@@ -53,6 +53,7 @@ def run_key(operator, x, needed: int | None = None) -> str:
         steps=repr(operator.steps),
         needed=None if needed is None or needed >= operator.n_outputs else int(needed),
         code=code_version(),
+        **({"sensitivities": True} if getattr(operator, "sensitivities", False) else {}),
     )
 
 
@@ -123,6 +124,14 @@ class StoredOperator:
 
     def __call__(self, x, needed=None) -> RunRecord:
         return self.evaluate_many([x], needed)[0]
+
+    def differentiated(self) -> "StoredOperator":
+        """The same store and settings over ``operator.differentiated()`` (runs with S), or itself when
+        the operator has no direct differentiation."""
+        exact = self.operator.differentiated()
+        if exact is self.operator:
+            return self
+        return StoredOperator(exact, self.store, study=self.study, retry_failed=self.retry_failed)
 
     def evaluate_many(self, points, needed=None, executor=None) -> list[RunRecord]:
         needed = None if needed is None or needed >= self.operator.n_outputs else int(needed)

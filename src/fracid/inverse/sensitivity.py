@@ -2,8 +2,10 @@
 
 A sensitivity method is a callable ``(evaluate, x, needed, executor) -> (y, S, records)``: the outputs
 at x, the matrix S = d y / d x (n_outputs x n_parameters) and the runs it made. The Kalman filter only
-sees this interface, so a cheaper method (a direct differentiation of the finite-element model) can
-replace the central differences without touching the filter.
+sees this interface. :class:`DirectDifferentiation` reads S from the run itself (computed inside the
+finite-element analysis, :mod:`fracid.fem.ddm`): one run instead of the 2 p + 1 of
+:class:`CentralDifferences`, which stay the fallback for a model without it.
+:func:`exact_sensitivity` picks the method for an operator.
 
 :func:`sensitivity_history` (docs/theory.md, section 4.5): normalised sensitivities of the response to
 every parameter along the load history, the information accumulated up to each step and, per
@@ -102,6 +104,48 @@ class CentralDifferences:
         return centre.y, S, records
 
 
+@dataclass(frozen=True)
+class DirectDifferentiation:
+    """S from the forward run at x (``RunRecord.S``, by direct differentiation inside the analysis).
+
+    ``evaluate`` must return records with S (an operator from :func:`exact_sensitivity`); a record
+    without S (a model or an observed quantity without derivatives) falls back to ``fallback``.
+    A failed run raises :class:`ForwardRunError`.
+    """
+
+    fallback: object = CentralDifferences()
+
+    def __call__(self, evaluate, x, needed=None, executor=None):
+        x = np.asarray(x, dtype=float)
+        record = evaluate_points(evaluate, [x], needed, executor)[0]
+        if not record.ok:
+            raise ForwardRunError(f"the forward run at x = {x.tolist()} failed: {record.error}")
+        if record.S is None:
+            return self.fallback(evaluate, x, needed, executor)
+        return record.y, record.S, [record]
+
+
+def exact_sensitivity(evaluate):
+    """``(evaluate, sensitivity)`` for a method that needs S: the operator's differentiated version
+    (its runs return S, see :meth:`~fracid.inverse.forward_operator.ForwardOperator.differentiated`)
+    with :class:`DirectDifferentiation` where the model has direct differentiation, else ``evaluate``
+    itself with :class:`CentralDifferences`."""
+    make = getattr(evaluate, "differentiated", None)
+    exact = make() if callable(make) else evaluate
+    if getattr(exact, "sensitivities", False):
+        return exact, DirectDifferentiation()
+    return evaluate, CentralDifferences()
+
+
+def sensitivity_label(sensitivity) -> str:
+    """How a sensitivity method computes S, in words (for notes and reports)."""
+    if isinstance(sensitivity, DirectDifferentiation):
+        return "direct differentiation inside the analysis"
+    if isinstance(sensitivity, CentralDifferences):
+        return f"central differences (relative step {sensitivity.relative_step:g})"
+    return getattr(sensitivity, "__name__", type(sensitivity).__name__)
+
+
 @dataclass
 class SensitivityHistory:
     """Sensitivities and information along the observation sequence.
@@ -134,7 +178,7 @@ class SensitivityHistory:
     variance_share: np.ndarray
 
 
-def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sensitivity=CentralDifferences(),
+def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sensitivity=None,
                         executor=None) -> SensitivityHistory:
     """Sensitivity of the response along the load history, and what the data up to each step identify.
 
@@ -151,7 +195,11 @@ def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sens
     names : sequence of str, optional
     blocks : sequence of (name, start, stop), optional
         Data blocks; each is normalised by its own largest |y| (global and local data differ in units).
+    sensitivity : callable, optional
+        The sensitivity method; by default :func:`exact_sensitivity`'s choice.
     """
+    if sensitivity is None:
+        evaluate, sensitivity = exact_sensitivity(evaluate)
     x = np.asarray(x, dtype=float)
     C_exp, C0 = np.atleast_2d(np.asarray(C_exp, float)), np.atleast_2d(np.asarray(C0, float))
     y, S, _ = sensitivity(evaluate, x, None, executor)

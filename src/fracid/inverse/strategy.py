@@ -17,6 +17,7 @@ from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.knn import ParameterSpace, knn_search
 from fracid.inverse.method import InverseMethod, MethodResult, identification_bounds, result_fields
 from fracid.inverse.runs import StoredOperator
+from fracid.inverse.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.parallel import BatchStats
 
 
@@ -260,17 +261,19 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
     start = time.perf_counter() if started is None else started
     bounds = identification_bounds(operator, knn.space)
     C0 = knn.C0 if C0 is None else np.asarray(C0, float)
-    before = _counters(operator)
+    evaluate, sensitivity = exact_sensitivity(operator)
+    before = _counters(evaluate)
     with kalman_progress(progress, groups, y_exp.size, max_iterations) as callback:
-        kalman = kalman_filter(operator, y_exp, C_exp, knn.x0, C0, groups=groups, max_iterations=max_iterations,
-                               tol=tol, restart=restart, executor=executor, bounds=bounds, callback=callback)
+        kalman = kalman_filter(evaluate, y_exp, C_exp, knn.x0, C0, groups=groups, max_iterations=max_iterations,
+                               tol=tol, restart=restart, executor=executor, bounds=bounds, callback=callback,
+                               sensitivity=sensitivity)
     x, C, y_fit, status = kalman.x, kalman.C, kalman.y, kalman.status
     if kalman.failed and np.isfinite(knn.f[knn.order[0]]):
         best = knn.order[0]
         x, C = knn.points[best], knn.C0
         y_fit = np.asarray(knn_output(knn, best, y_exp.size))
         status = f"{kalman.status}; the result is the best point of the KNN population"
-    after = _counters(operator)
+    after = _counters(evaluate)
     knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
                    "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}
     runs = {"knn": len(knn.points), "knn_failed": knn.n_failed, "kalman": kalman.runs,
@@ -279,7 +282,8 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
     if after is not None:
         runs.update(kalman_computed=after[0] - before[0], kalman_reused=after[1] - before[1])
     notes = list(notes) + [f"KNN: {method} population of {len(knn.points)}, k = {knn.k}",
-                           f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std; "
+                           f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {tol} std, "
+                           f"sensitivities by {sensitivity_label(sensitivity)}; "
                            f"{status}"]
     return IdentificationResult(
         x=x, C=C, y_fit=y_fit, history=kalman.history, knn=knn_summary, runs=runs, converged=kalman.converged,

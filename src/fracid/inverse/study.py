@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.method import identification_bounds
-from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError, sensitivity_history
+from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
 from fracid.inverse.stability import stability as stability_check
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.strategy import KalmanSettings, KnnKalman, KnnSettings
@@ -65,7 +65,8 @@ def predict(operator, data, x, C, *, executor=None, name="prediction") -> Predic
     """Compute held-out data at the estimate x with the uncertainty propagated from C."""
     nan = np.full(data.n_y, np.nan)
     try:
-        y, S, _ = CentralDifferences()(operator, x, None, executor)
+        evaluate, sensitivity = exact_sensitivity(operator)
+        y, S, _ = sensitivity(evaluate, x, None, executor)
     except ForwardRunError as err:
         return Prediction(name, data.control, data.y, data.std, nan, nan, status=str(err))
     std = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", S, C, S), 0.0))
