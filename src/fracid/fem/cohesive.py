@@ -174,7 +174,8 @@ def hordijk_parameter_derivatives(w, ft, wc, c1, c2, params) -> dict:
     }
     out = {}
     for name, (ft_rate, wc_rate, c1_rate, c2_rate) in params.argument_rates().items():
-        value = partial["ft"] * ft * ft_rate + partial["wc"] * wc * wc_rate + partial["c1"] * c1_rate + partial["c2"] * c2_rate
+        value = (partial["ft"] * ft * ft_rate + partial["wc"] * wc * wc_rate + partial["c1"] * c1_rate
+                 + partial["c2"] * c2_rate)
         out[name] = np.where(active, value, 0.0)
     return out
 

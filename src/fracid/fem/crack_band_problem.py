@@ -157,8 +157,8 @@ class CrackBandProblem(ContinuumProblem):
         # s' at fixed displacements (nu only) and the explicit part of the driving mean lambda_1
         s_rate = np.zeros(s.shape + (p,))
         if "nu" in names:
-            s_rate[..., names.index("nu")] = np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(nu),
-                                                       eps)
+            d_D = disc.strain_state.unit_elastic_matrix_derivative(nu)
+            s_rate[..., names.index("nu")] = np.einsum("st,eqt->eqs", d_D, eps)
         explicit = element_means(np.einsum("eqs,eqsp->eqp", dlam, s_rate))
         nu_column = np.zeros(p)
         if "nu" in names:
