@@ -6,7 +6,7 @@ the derivative z' = d(q, lambda)/dx of the state solves the step's bordered tang
 right-hand side -dr/dx taken at fixed q (the *pseudo-load*). The history variable kappa = max(kappa_old,
 driving) enters the pseudo-load by its explicit part: at loading points the parameter derivative of the
 driving strain at fixed q, elsewhere the derivative kappa_old' carried from the last step
-(docs/theory.md, section 5). After the solve, :func:`history_derivative` gives the new kappa'.
+(docs/theory.md, section 6). After the solve, :func:`history_derivative` gives the new kappa'.
 
 Units: the derivatives are per unit of each parameter (per MPa for E, per mm^2 for c, ...).
 """

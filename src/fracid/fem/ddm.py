@@ -8,7 +8,7 @@ parameters x gives the bordered system of the step's consistent tangent
     [ v^T    0   ] [ lambda' ] = [     0      ]
 
 with d r / d x taken at fixed q (the formulation's pseudo-load, which carries the history
-variables' derivatives from the last step; docs/theory.md, section 5). The matrix is the one the
+variables' derivatives from the last step; docs/theory.md, section 6). The matrix is the one the
 next increment's first Newton iteration factorizes anyway, so :class:`PathDerivatives` factorizes it
 once and hands the factorization on: the derivatives cost a pseudo-load, a solve with p right-hand
 sides and the history update per step, not a factorization.

@@ -157,7 +157,7 @@ class DamageProblem(ContinuumProblem):
     def _element_arrays(self, qe, kappa_old):
         return local_damage(self.disc, self.law, self.params, self.const, qe, kappa_old, self._tangent)
 
-    # direct differentiation (docs/theory.md, section 5): the formulations differ only by their
+    # direct differentiation (docs/theory.md, section 6): the formulations differ only by their
     # driving strain (local eps_eq, its average, or the nodal ebar) and the ebar equation's rows
 
     @property

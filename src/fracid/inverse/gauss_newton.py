@@ -12,7 +12,7 @@ from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares, lsq_linear
 
 from fracid.inverse.kalman import KalmanResult, _box, _check_inputs
-from fracid.inverse.sensitivity import CentralDifferences, ForwardRunError, memoized
+from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, memoized
 
 
 class _Done(Exception):
@@ -81,7 +81,7 @@ class _WhitenedProblem:
         return y, J, 0.5 * (C + C.T)
 
 
-def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=CentralDifferences(), executor=None, bounds=None,
+def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=None, bounds=None,
                  max_iterations: int = 20, tol: float = 0.01, callback=None) -> KalmanResult:
     """Bayesian MAP estimate by a bounded Gauss-Newton / Levenberg-Marquardt method with the sensitivity as Jacobian.
 
@@ -103,9 +103,10 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=CentralDifferenc
         Measured observations and their covariance (any symmetric positive definite matrix).
     x0, C0 : ndarray
         Prior mean and covariance. x0 is moved into the bounds first and is the starting point.
-    sensitivity : callable
+    sensitivity : callable, optional
         ``(evaluate, x, needed, executor) -> (y, S, records)``, see :mod:`fracid.inverse.sensitivity`;
-        called once per point, with ``needed=None``.
+        called once per point, with ``needed=None``. By default the exact sensitivities of the runs
+        where the model has direct differentiation, else central differences (:func:`exact_sensitivity`).
     executor : Executor, optional
         Passed to the sensitivity.
     bounds : (lower, upper) arrays, optional
@@ -143,6 +144,8 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=CentralDifferenc
     there, not the spread of the one-sided posterior (see ``at_bound``).
     """
     y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
+    if sensitivity is None:
+        evaluate, sensitivity = exact_sensitivity(evaluate)
     lower, upper = _box(bounds, x0.size)
     if np.any(lower >= upper):
         raise ValueError("gauss_newton needs lower < upper for every parameter; leave a fixed parameter out of x")

@@ -13,6 +13,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from fracid.inverse.gauss_newton import gauss_newton
 from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.knn import ParameterSpace, knn_search
 from fracid.inverse.method import InverseMethod, MethodResult, identification_bounds, result_fields
@@ -168,6 +169,57 @@ class KnnKalman:
                              started=start, progress=progress)
         result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
         return result
+
+
+@dataclass(frozen=True)
+class KnnGaussNewton:
+    """KNN over a population for the overview and the prior, then bounded Gauss-Newton
+    (:func:`~fracid.inverse.gauss_newton.gauss_newton`: trust region with the bounds) on the same
+    Bayesian objective as the Kalman filter: the same MAP point and covariance, found with the
+    Jacobian of the runs (exact, by direct differentiation, where the model has it).
+
+    Stages ``"knn"`` and ``"gauss_newton"``; returns an :class:`IdentificationResult` whose ``history``
+    holds the estimate and covariance at every linearisation.
+
+    Attributes
+    ----------
+    knn : KnnSettings
+    max_iterations : int
+        Linearisations at most.
+    tol : float
+        Convergence: the next step moves no parameter by more than ``tol`` of its standard deviation [-].
+    """
+
+    knn: KnnSettings = KnnSettings()
+    max_iterations: int = 20
+    tol: float = 0.01
+    name: ClassVar[str] = "knn-gauss-newton"
+
+    def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
+                 retry_failed=False, blocks=(), notes=()) -> IdentificationResult:
+        """Both stages (see :class:`~fracid.inverse.method.InverseMethod`)."""
+        start = time.perf_counter()
+        stats = BatchStats()
+        knn = KnnKalman(self.knn).search(operator, y_exp, C_exp, space, executor=executor, store=store,
+                                        progress=progress, stats=stats, retry_failed=retry_failed)
+        evaluate, sensitivity = exact_sensitivity(StoredOperator(operator, store, retry_failed=retry_failed))
+        bounds = identification_bounds(operator, knn.space)
+        fit = gauss_newton(evaluate, y_exp, C_exp, knn.x0, knn.C0, sensitivity=sensitivity, executor=executor,
+                           bounds=bounds, max_iterations=self.max_iterations, tol=self.tol)
+        runs = {"knn": len(knn.points), "knn_failed": knn.n_failed, "knn_computed": stats.computed,
+                "knn_reused": stats.reused, "gauss_newton": fit.runs, "gauss_newton_failed": len(fit.failures),
+                "gauss_newton_iterations": fit.iterations, "gauss_newton_computed": evaluate.computed,
+                "gauss_newton_reused": evaluate.reused, "wall_seconds": time.perf_counter() - start}
+        notes = list(notes) + [f"KNN: {self.knn.method} population of {len(knn.points)}, k = {knn.k}",
+                               f"Gauss-Newton (bounded trust region): {fit.iterations} linearisation(s), tol "
+                               f"{self.tol} std, sensitivities by {sensitivity_label(sensitivity)}; {fit.status}"]
+        knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
+                       "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": self.knn.method,
+                       "seed": self.knn.seed}
+        return IdentificationResult(
+            x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history, knn=knn_summary, runs=runs, converged=fit.converged,
+            status=fit.status, method=self.name, stages={"knn": "KNN", "gauss_newton": "Gauss-Newton"},
+            **result_fields(operator, knn.space, fit.x, y_exp, C_exp, blocks=blocks, notes=notes))
 
 
 #: the keywords of :func:`identify` that build the default method, with their defaults
