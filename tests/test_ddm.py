@@ -166,3 +166,16 @@ def test_notched_beam_gradient_model_all_parameters():
 def test_dogbone_gradient_model():
     dogbone = SPECIMENS["dogbone"](size=50.0, h_fine=4.0)
     compare(DamageModel("gradient"), dogbone, fracid.DamageParameters(), ("E", "nu", "kappa_i", "alpha", "c"), 30)
+
+
+def test_zone_widths_are_differentiated():
+    """The damaged-zone width of the bar and the FPZ width of the beam move with the level-set crossings:
+    DDM equals central differences where no sample crosses the threshold between the runs."""
+    bar = fracid.BarWithWeakZone(n_elements=60)
+    model = DamageModel("gradient")
+    params = fracid.DamageParameters()
+    run = compare(model, bar, params, ("kappa_i", "beta", "c"), 60, quantities=("damaged_zone_width",), target=0.12)
+    assert run.observables["damaged_zone_width"][-1] > 0
+    beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0, fine_width=12.0)
+    run = compare(model, beam, params, ("beta", "c"), 16, quantities=("fpz_width",))
+    assert run.observables["fpz_width"][-1] > 0

@@ -120,6 +120,8 @@ class DamageModel(_PathFollowing):
 
     regularization: str = "gradient"
     law: DamageLaw = field(default_factory=DamageLaw)
+    #: its observers (the zone widths) have derivatives in the runs with ``sensitivities``
+    differentiates_observers: ClassVar[bool] = True
 
     def __post_init__(self):
         if self.regularization not in FORMULATIONS:
@@ -156,7 +158,10 @@ class DamageModel(_PathFollowing):
         zone = description.zone
         if zone is None:
             return {}
-        return {zone.name: zone_width_observer(zone, self.law.softening.kappa_at_damage(damage_threshold, params))}
+        law = self.law
+        return {zone.name: zone_width_observer(zone, law.softening.kappa_at_damage(damage_threshold, params),
+                                               lambda names: law.kappa_at_damage_derivatives(damage_threshold, params,
+                                                                                             names))}
 
 
 class _CrackModel(_PathFollowing):

@@ -38,6 +38,9 @@ class PathDerivatives:
         :class:`~fracid.fem.damage_sensitivity.StepDerivative`.
     names : sequence of str
         The parameters, in the order of the derivatives' last axis.
+    observers : mapping {name: observer}, optional
+        The run's observers; those with ``differentiable`` true are differentiated by their
+        ``derivative(problem, history, history_rate, names)`` (the zone widths of the damage models).
 
     Raises
     ------
@@ -47,7 +50,7 @@ class PathDerivatives:
         When a name is not a parameter the problem differentiates.
     """
 
-    def __init__(self, problem, names):
+    def __init__(self, problem, names, observers=None):
         if not callable(getattr(problem, "differentiate", None)):
             raise NotImplementedError(f"{type(problem).__name__} has no direct differentiation; "
                                       "use finite differences of runs (fracid.inverse.sensitivity.CentralDifferences)")
@@ -59,7 +62,8 @@ class PathDerivatives:
         p = len(self.names)
         self.history_rate = np.zeros(np.shape(problem.initial_history()) + (p,))
         self.load_point = problem.symmetry_factor * problem.load_vector
-        keys = ["force", "load_point", "work", "elastic", *problem.functionals]
+        self.observers = {name: fn for name, fn in (observers or {}).items() if getattr(fn, "differentiable", False)}
+        keys = ["force", "load_point", "work", "elastic", *problem.functionals, *self.observers]
         self.records = {key: [np.zeros(p)] for key in keys}
         self._last = (0.0, 0.0)  # force and load-point displacement of the last step
 
@@ -90,6 +94,8 @@ class PathDerivatives:
         rec["elastic"].append(d_elastic)
         for name, vector in problem.functionals.items():
             rec[name].append(np.einsum("i,ip->p", vector, dq))
+        for name, observer in self.observers.items():
+            rec[name].append(observer.derivative(problem, arrays.kappa, self.history_rate, self.names))
         self._last = (force, displacement)
         return solve
 
@@ -98,7 +104,7 @@ class PathDerivatives:
         displacement and the energies (the names of :class:`~fracid.fem.path_following.PathResult`),
         and ``"names"``: the parameters."""
         rec = {key: np.array(values) for key, values in self.records.items()}
-        out = {name: rec[name] for name in self.problem.functionals}
+        out = {name: rec[name] for name in [*self.problem.functionals, *self.observers]}
         out.update(force=rec["force"], load_point_displacement=rec["load_point"], external_work=rec["work"],
                    elastic_energy=rec["elastic"], dissipated_energy=rec["work"] - rec["elastic"])
         out["names"] = self.names

@@ -116,6 +116,15 @@ class DamageLaw:
         """Characteristic values a specimen sizes its default control with: ``strain`` [-]."""
         return {"strain": self.softening.onset(params)}
 
+    def kappa_at_damage_derivatives(self, omega: float, params, names) -> np.ndarray:
+        """d kappa / d x of the kappa at which the damage reaches ``omega`` (the FPZ width's level), by
+        the implicit function theorem on omega(kappa; x) = omega: -(d omega / d x) / (d omega / d kappa),
+        from the damaged branch (at omega = 0, the onset's derivative)."""
+        kappa = np.atleast_1d(self.softening.kappa_at_damage(omega, params))
+        _, d_kappa = self.softening.damage(kappa, params)
+        partial = self.softening.parameter_derivatives(kappa, params)
+        return np.array([-float(partial[name][0]) / float(d_kappa[0]) if name in partial else 0.0 for name in names])
+
 
 @dataclass(frozen=True)
 class HordijkLaw:

@@ -39,7 +39,8 @@ class PathResult:
     derivatives : dict or None
         With ``sensitivities`` asked: ``derivatives[name]`` (n_steps + 1, p) is d/dx of ``force`` or of
         the observable ``name`` at every step, x the parameters ``derivatives["names"]`` (the control
-        is held; see :mod:`fracid.fem.ddm`). Observers' values are not differentiated.
+        is held; see :mod:`fracid.fem.ddm`), and of the observers that are differentiable (the
+        damaged-zone widths).
     """
 
     control_name: str
@@ -194,7 +195,7 @@ def follow_path(
     system = ControlledSystem(problem, problem.functionals[control])
     stats = SolverStatistics()
     recorder = _Recorder(problem, control, dict(observers or {}), field_steps)
-    derivatives = PathDerivatives(problem, sensitivities) if sensitivities is not None else None
+    derivatives = PathDerivatives(problem, sensitivities, observers) if sensitivities is not None else None
     factor = None  # factorization at the last converged state (from the derivatives), for the next increment
 
     z = np.zeros(problem.n_free + 1)

@@ -154,10 +154,12 @@ class ForwardOperator:
     def differentiable(self) -> bool:
         """Whether the model differentiates its runs with respect to every identified parameter and
         every observed quantity has derivatives: the force, the functionals and energies do; the
-        specimen's ``observables`` (widths of the damaged zone, from observers) do not."""
+        specimen's ``observables`` (zone widths, from observers) only with a model whose
+        ``differentiates_observers`` is true."""
         names = set(getattr(self.model, "differentiable", ()))
-        return set(self.names) <= names and not any(
-            o.quantity in getattr(o.specimen, "observables", ()) for o in self.observations)
+        observers = getattr(self.model, "differentiates_observers", False)
+        return set(self.names) <= names and (observers or not any(
+            o.quantity in getattr(o.specimen, "observables", ()) for o in self.observations))
 
     def differentiated(self) -> "ForwardOperator":
         """This operator with ``sensitivities=True`` if it is :attr:`differentiable`, else itself."""
