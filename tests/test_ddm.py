@@ -179,3 +179,16 @@ def test_zone_widths_are_differentiated():
     beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0, fine_width=12.0)
     run = compare(model, beam, params, ("beta", "c"), 16, quantities=("fpz_width",))
     assert run.observables["fpz_width"][-1] > 0
+
+
+def test_pardiso_keeps_the_factorization_for_the_derivatives():
+    pytest.importorskip("pypardiso")
+    beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0, fine_width=12.0)
+    model, params = DamageModel("gradient"), fracid.DamageParameters()
+    runs = [model.simulate(beam, params, sensitivities=("c", "beta"), linear_solver=solver, target=0.05)
+            for solver in ("superlu", "pardiso")]
+    np.testing.assert_allclose(runs[1].derivatives["force"], runs[0].derivatives["force"], rtol=0,
+                               atol=1e-9 * np.abs(runs[0].derivatives["force"]).max())
+    plain = model.simulate(beam, params, linear_solver="pardiso", target=0.05)
+    # the derivatives' factorization starts the next increment: one more in all, not one per step
+    assert runs[1].stats.factorizations <= plain.stats.factorizations + 1
