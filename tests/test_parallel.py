@@ -255,3 +255,27 @@ def test_dask_client_gives_the_same_records(serial_records):
     assert_records_equal(records, serial_records)
     assert stats.computed == 24 and stats.failed == N_FAILED
     assert [r["time"] for r in again if "time" in r] != [r["time"] for r in records if "time" in r]  # not cached
+
+
+def test_filters_run_side_by_side_on_the_pool_and_share_the_store(tmp_path):
+    """The multi-start filters run in threads that submit their runs to the pool; each thread writes
+    the store through a connection of its own; the ends equal those of the filters run one by one."""
+    import fracid
+    from fracid.inverse.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.runs import StoredOperator
+    from fracid.inverse.uniqueness import multi_start
+    from fracid.parallel import concurrently, executor_width
+
+    op = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=40), np.linspace(0.004, 0.03, 6))],
+                         fracid.DamageParameters(), ("c", "beta"))
+    y = op(np.array([2.0, 250.0])).y
+    C = np.eye(y.size) * (0.02 * np.abs(y).max()) ** 2
+    starts = np.array([[1.5, 200.0], [3.0, 400.0], [2.5, 300.0]])
+    C0, bounds = np.diag([1.0, 100.0**2]), (np.array([0.5, 100.0]), np.array([4.0, 500.0]))
+    serial = multi_start(op, y, C, starts, C0, bounds=bounds)
+    with RunStore(tmp_path / "runs.sqlite") as store, make_executor(2) as pool:
+        assert executor_width(pool) == 2 and concurrently(abs, [-1, -2, 3], pool) == [1, 2, 3]
+        evaluate = StoredOperator(op, store).differentiated()
+        parallel = multi_start(evaluate, y, C, starts, C0, bounds=bounds, executor=pool)
+        assert evaluate.computed == len(store) > 0 and evaluate.failed == 0
+    np.testing.assert_allclose(parallel.ends, serial.ends, rtol=1e-9)

@@ -85,6 +85,31 @@ class SerialExecutor(cf.Executor):
         return "SerialExecutor()"
 
 
+def executor_width(executor) -> int:
+    """How many tasks ``executor`` runs at once: its workers (1 for None or a serial executor)."""
+    if executor is None or isinstance(executor, SerialExecutor):
+        return 1
+    if _is_dask(executor):
+        return max(1, sum(executor.nthreads().values()))
+    return max(1, int(getattr(executor, "_max_workers", 1)))
+
+
+def concurrently(function, items, executor) -> list:
+    """``[function(item) for item in items]``, as many at once as ``executor`` has workers.
+
+    For independent sequential procedures whose steps are forward runs on ``executor`` (the filters
+    of a multi-start check or of noisy replicates): each runs in a thread of this process and
+    submits its runs to the executor, so the workers stay busy although every procedure waits for
+    its own run. Results in the order of ``items``; an exception of ``function`` propagates.
+    """
+    items = list(items)
+    width = min(executor_width(executor), len(items))
+    if width <= 1:
+        return [function(item) for item in items]
+    with cf.ThreadPoolExecutor(width, thread_name_prefix="fracid-concurrent") as threads:
+        return list(threads.map(function, items))
+
+
 def make_executor(workers=None, scheduler: str | None = None):
     """An executor for :func:`run_batch`.
 

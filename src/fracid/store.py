@@ -24,6 +24,7 @@ import math
 import numbers
 import os
 import sqlite3
+import threading
 import time
 from collections.abc import Iterable, Mapping
 from typing import Self
@@ -258,9 +259,15 @@ class RunStore:
 
     def __init__(self, path, *, readonly: bool = False, timeout: float = 30.0):
         self.path = os.fspath(path)
-        self.readonly = readonly
+        self.readonly, self.timeout = readonly, timeout
         self._conn = _connect(self.path, readonly, timeout)
         self.journal_mode = self._conn.execute("PRAGMA journal_mode").fetchone()[0]
+        # a SQLite connection belongs to its thread: other threads (concurrent filters of a study)
+        # get connections of their own, which WAL lets read and write side by side
+        self._owner = threading.get_ident()
+        self._local = threading.local()
+        self._others: list = []
+        self._others_lock = threading.Lock()
 
     # -- writing ------------------------------------------------------------------------------
 
@@ -326,8 +333,12 @@ class RunStore:
     # -- life cycle ---------------------------------------------------------------------------
 
     def close(self) -> None:
-        """Close the connection (idempotent)."""
+        """Close the connections (idempotent)."""
         if self._conn is not None:
+            with self._others_lock:
+                for conn in self._others:
+                    conn.close()
+                self._others.clear()
             self._conn.close()
             self._conn = None
 
@@ -356,7 +367,14 @@ class RunStore:
     def _reader(self) -> sqlite3.Connection:
         if self._conn is None:
             raise RuntimeError(f"RunStore({self.path!r}) is closed")
-        return self._conn
+        if threading.get_ident() == self._owner:
+            return self._conn
+        conn = getattr(self._local, "conn", None)
+        if conn is None:
+            conn = self._local.conn = _connect(self.path, self.readonly, self.timeout, check_same_thread=False)
+            with self._others_lock:
+                self._others.append(conn)
+        return conn
 
     def _writer(self) -> sqlite3.Connection:
         if self.readonly:
@@ -373,15 +391,18 @@ class RunStore:
             yield from conn.execute(f"SELECT {columns} FROM runs WHERE key IN ({marks})", chunk)
 
 
-def _connect(path: str, readonly: bool, timeout: float) -> sqlite3.Connection:
-    """Open ``path``: autocommit (each statement its own transaction), WAL, synchronous=NORMAL."""
+def _connect(path: str, readonly: bool, timeout: float, check_same_thread: bool = True) -> sqlite3.Connection:
+    """Open ``path``: autocommit (each statement its own transaction), WAL, synchronous=NORMAL.
+
+    ``check_same_thread=False`` for the connections of other threads, which the owner closes."""
     if readonly and not os.path.exists(path):
         raise FileNotFoundError(f"RunStore: no store at {path!r} to open read-only")
     directory = os.path.dirname(os.path.abspath(path))
     if not readonly and not os.path.isdir(directory):
         raise FileNotFoundError(f"RunStore: the directory {directory!r} of {path!r} does not exist")
     target = f"file:{_uri_path(path)}?mode=ro" if readonly else path
-    conn = sqlite3.connect(target, timeout=timeout, isolation_level=None, uri=readonly)
+    conn = sqlite3.connect(target, timeout=timeout, isolation_level=None, uri=readonly,
+                           check_same_thread=check_same_thread)
     try:
         if not readonly:
             conn.execute("PRAGMA journal_mode=WAL")

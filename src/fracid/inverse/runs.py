@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import threading
 from importlib import resources
 
 import numpy as np
@@ -116,9 +117,10 @@ class StoredOperator:
         self.operator, self.store, self.study, self.retry_failed = operator, store, study, retry_failed
         self.memory: dict = {}
         self.computed = self.reused = self.failed = 0
+        self._lock = threading.Lock()  # filters of a study may share this operator from several threads
 
     def __getattr__(self, name):  # names, units, n_outputs, parameters(), ... of the operator
-        if name == "operator":
+        if name in ("operator", "_lock"):
             raise AttributeError(name)
         return getattr(self.operator, name)
 
@@ -143,7 +145,8 @@ class StoredOperator:
             records = run_population(self.operator, list(missing.values()), executor=executor, store=self.store,
                                      progress=False, stats=stats, study=self.study, needed=needed,
                                      retry_failed=self.retry_failed)
-            self.computed, self.reused, self.failed = (self.computed + stats.computed, self.reused + stats.reused,
-                                                       self.failed + stats.failed)
-            self.memory.update(zip(missing, records))
+            with self._lock:
+                self.computed, self.reused, self.failed = (self.computed + stats.computed, self.reused + stats.reused,
+                                                           self.failed + stats.failed)
+                self.memory.update(zip(missing, records))
         return [self.memory[key] for key in keys]

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fracid.inverse.kalman import kalman_filter
+from fracid.parallel import concurrently
 
 
 @dataclass
@@ -93,17 +94,22 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     C_noise = np.asarray(C_exp if C_noise is None else C_noise, float)
     data = noisy_replicates(y_exp, C_noise, int(replicates), seed)
     estimates, errors = np.full((len(data), np.size(x0)), np.nan), []
-    stds = []
-    for i, y in enumerate(data):
+    stds, done = [], []
+
+    def run(y):
         result = kalman_filter(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor, **kalman)
+        done.append(result)
+        if progress is not None:
+            progress(len(done), len(data))
+        return result
+
+    for i, result in enumerate(concurrently(run, data, executor)):  # the replicates side by side
         if result.failed:  # a replicate that fails is recorded; the study goes on
             error = result.status
         else:
             estimates[i], error = result.x, ""
             stds.append(result.std)
         errors.append(error)
-        if progress is not None:
-            progress(i + 1, len(data))
     noise = float(np.sqrt(np.mean(np.diag(C_noise) / np.maximum(y_exp**2, 1e-300))))
     posterior = np.mean(stds, axis=0) if stds else None
     return Stability(estimates, errors, noise, seed, posterior)

@@ -282,7 +282,9 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
     kalman = settings.kalman.options(data.n_y, data.blocks)
     bounds = identification_bounds(operator, space)
     C_bounds = bounds_covariance(space)
-    evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
+    # every run after the population carries its sensitivities where the model has them: one stored
+    # operator (and its counters) for all stages
+    evaluate, _ = exact_sensitivity(StoredOperator(operator, store, retry_failed=retry_failed))
     runs, notes = {}, []
 
     def count(name, before):

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from fracid.inverse.kalman import kalman_filter
+from fracid.parallel import concurrently
 from fracid.inverse.sensitivity import ForwardRunError
 
 
@@ -153,14 +154,20 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
     from fracid.inverse.knn import objective
 
     starts, results, failed = np.atleast_2d(starts), [], []
-    for x in starts:
+    done = []
+
+    def run(x):
         result = kalman_filter(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor, **kalman)
+        done.append(x)
+        if progress is not None:
+            progress(len(done), len(starts))
+        return result
+
+    for x, result in zip(starts, concurrently(run, starts, executor)):  # the filters side by side
         if result.failed:  # recorded; the other starts still tell
             failed.append(f"start {x.tolist()}: {result.status}")
         else:
             results.append(result)
-        if progress is not None:
-            progress(len(results) + len(failed), len(starts))
     if not results:
         raise ForwardRunError("the Kalman filter failed from every starting point: " + "; ".join(failed))
     ends = np.array([r.x for r in results])
