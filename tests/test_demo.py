@@ -1,6 +1,6 @@
 """The main job: `fracid demo` identifies kappa_i, beta and c on the real Gregoire et al. (2013) beam.
 
-It runs the full demo (about 6 minutes on 2 cores) and checks the fit against the measured mean curve:
+It runs the full demo (about 4 minutes on 2 cores) and checks the fit against the measured mean curve:
 root-mean-square error over the measured range below 5 % of the peak load, and the computed peak
 inside the measured scatter band (between the lower and upper envelopes at the CMOD of the computed peak).
 """
