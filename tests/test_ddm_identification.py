@@ -11,6 +11,8 @@ from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import (CentralDifferences, DirectDifferentiation, exact_sensitivity,
                                         sensitivity_label)
 from fracid.inverse.strategy import KnnGaussNewton, KnnKalman, KnnSettings, KalmanSettings, identify
+from fracid.models import CohesiveCrackModel
+from fracid.specimens import SPECIMENS
 from fracid.store import RunStore
 
 BAR = fracid.BarWithWeakZone(n_elements=100)
@@ -59,30 +61,16 @@ def test_exact_sensitivity_picks_ddm_where_the_model_has_it(operator):
     # an analytic model without S: central differences
     evaluate, sensitivity = exact_sensitivity(lambda x, needed=None: np.array([x[0] ** 2, x[1]]))
     assert isinstance(sensitivity, CentralDifferences)
-    # a local width has no derivatives: the operator is not differentiated
-    beam_fpz = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=40), POINTS, "damaged_zone_width")],
-                               fracid.DamageParameters(), ("c",))
-    assert not beam_fpz.differentiable and beam_fpz.differentiated() is beam_fpz
-
-
-def test_kalman_and_gauss_newton_identify_the_bar_twin_with_one_run_per_linearisation(operator):
-    y = operator(TRUTH).y
-    std = 0.02 * np.abs(y).max()
-    noisy = y + np.random.default_rng(7).normal(scale=std, size=y.size)
-    C_exp = np.eye(y.size) * std**2
-    knn = KnnSettings(n=16, k=4)
-    kalman = identify(operator, noisy, C_exp, SPACE, method=KnnKalman(knn, KalmanSettings(groups="all")))
-    newton = identify(operator, noisy, C_exp, SPACE, method=KnnGaussNewton(knn))
-    assert kalman.converged and newton.converged
-    # the same MAP point and covariance (the batch filter is Gauss-Newton with line search)
-    np.testing.assert_array_less(np.abs(kalman.x - newton.x), 0.1 * kalman.std)
-    np.testing.assert_allclose(newton.std, kalman.std, rtol=0.05)
-    assert np.all(np.abs(kalman.x - TRUTH) <= 2 * kalman.std)
-    # exact sensitivities: one forward run per linearisation (central differences would take 5)
-    assert kalman.runs["kalman"] <= kalman.runs["kalman_iterations"] + 2
-    assert newton.runs["gauss_newton"] <= newton.runs["gauss_newton_iterations"] + 2
-    assert any("direct differentiation" in note for note in kalman.notes)
-    assert newton.stages == {"knn": "KNN", "gauss_newton": "Gauss-Newton"}
+    # the damage models differentiate their zone widths; the crack models' crack length is a staircase
+    width = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=40), POINTS, "damaged_zone_width")],
+                            fracid.DamageParameters(), ("c",))
+    assert width.differentiable and width.differentiated().sensitivities
+    model = CohesiveCrackModel()
+    beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0)
+    crack = ForwardOperator([Observation(beam, np.linspace(0.01, 0.1, 5), "crack_length")], model.parameters(),
+                            ("ft",), model=model)
+    force = ForwardOperator([Observation(beam, np.linspace(0.01, 0.1, 5))], model.parameters(), ("ft",), model=model)
+    assert not crack.differentiable and crack.differentiated() is crack and force.differentiable
 
 
 class _WithoutDerivatives:

@@ -168,6 +168,8 @@ def test_new_specimen_and_law_are_identified_by_the_unchanged_inverse_code(plate
     points = np.linspace(0.005, 0.06, 12)
     op = ForwardOperator([Observation(PLATE, points)], PARAMS, ("kappa_u", "c"), model=MODEL)
     assert op.units == {"kappa_u": "-", "c": "mm^2"} and op.model.key == "gradient-damage-linear"
+    # the new law gives no parameter derivatives: its runs are differentiated by central differences
+    assert MODEL.differentiable == () and op.differentiated() is op
     truth = np.array([2.0e-3, 4.0])
     data = synthetic_data(op, truth, {"global:relative": 0.01}, seed=None)
     assert data.y.max() == pytest.approx(plate_run.force.max(), rel=0.02)  # the operator runs the same model

@@ -101,10 +101,7 @@ class _PathFollowing:
     def differentiable(self) -> tuple:
         """Parameters whose derivatives a run computes by direct differentiation (``simulate(...,
         sensitivities=names)``; see :mod:`fracid.fem.ddm`): those its problem class declares."""
-        declared = getattr(self._problem_class, "differentiable", ())
-        if isinstance(declared, property):  # declared per instance: every parameter of the law
-            return tuple(self.parameters.names())
-        return tuple(declared)
+        return tuple(getattr(self._problem_class, "differentiable", ()))
 
 
 @dataclass(frozen=True)
@@ -146,6 +143,11 @@ class DamageModel(_PathFollowing):
     def _problem_class(self):
         return FORMULATIONS[self.regularization]
 
+    @property
+    def differentiable(self) -> tuple:
+        """Every parameter of the law if the law gives its parameter derivatives, else none."""
+        return tuple(self.parameters.names()) if self.law.differentiable else ()
+
     def build(self, specimen, params):
         """The problem of this formulation on ``specimen`` (a specimen or its description)."""
         d = _description(specimen)
@@ -166,6 +168,9 @@ class DamageModel(_PathFollowing):
 
 class _CrackModel(_PathFollowing):
     """The models of one crack with Hordijk's law: plane stress, where the specimen says the crack runs."""
+
+    #: observers whose values the runs do not differentiate (a count of cracked points: a staircase)
+    observer_names: ClassVar[tuple] = ("crack_length",)
 
     @property
     def parameters(self) -> type:

@@ -112,6 +112,13 @@ class DamageLaw:
     def damage(self, kappa, params):
         return self.softening.damage(kappa, params)
 
+    @property
+    def differentiable(self) -> bool:
+        """Whether both parts give their parameter derivatives (a law without them is identified with
+        central differences of runs)."""
+        return all(callable(getattr(part, "parameter_derivatives", None))
+                   for part in (self.softening, self.equivalent_strain))
+
     def scales(self, params) -> dict:
         """Characteristic values a specimen sizes its default control with: ``strain`` [-]."""
         return {"strain": self.softening.onset(params)}

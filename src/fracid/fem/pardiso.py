@@ -167,9 +167,13 @@ class PardisoSolver:
         self._run(11, data, dummy, dummy)
         self.n_analyses += 1
 
-    def _checked_solve(self, matrix, data, b):
+    def _checked_solve(self, matrix, data, b, phase):
+        """Phase 23 (factorize and solve) or 33 (solve with the last factorization), with the check."""
         x = np.zeros_like(b, order="F")
-        self._run(33, data, b, x)
+        self._run(phase, data, b, x)
+        if phase == 23:
+            self.n_factorizations += 1
+            self.perturbed_pivots = int(self.iparm[13])
         if not np.all(np.isfinite(x)) or (
             self.perturbed_pivots and np.linalg.norm(matrix @ x - b) > self.residual_rtol * np.linalg.norm(b)
         ):
@@ -180,16 +184,47 @@ class PardisoSolver:
 
     def solve(self, matrix, rhs):
         """Solve ``matrix @ x = rhs`` for a square sparse matrix (CSC preferred) and rhs of shape (n,) or (n, k)."""
-        return self.factorize(matrix)(rhs)
+        matrix, data, fresh = self._prepare(matrix)
+        b = self._rhs(matrix, rhs)
+        try:
+            return self._checked_solve(matrix, data, b, phase=23)
+        except SingularMatrixError:
+            if fresh:
+                raise
+        self._analyse(matrix, data)  # the scaling and matching of an earlier matrix may not suit this one
+        return self._checked_solve(matrix, data, b, phase=23)
 
     def factorize(self, matrix):
-        """Factorize ``matrix`` (phase 22, after an analysis when its pattern is new) and return
-        ``rhs -> x`` (phase 33), valid until the next factorization of this solver.
+        """Factorize ``matrix`` (phase 22) and return ``rhs -> x`` (phase 33), valid until the next
+        factorization of this solver (it raises RuntimeError after one).
 
-        When PARDISO perturbed pivots, the first solution is checked (see ``residual_rtol``); a
-        rejected one redoes the analysis with these values once before raising
+        A solution with perturbed pivots is checked as in :meth:`solve`; a rejected one redoes the
+        analysis with these values once before raising
         :class:`~fracid.fem.linear_solvers.SingularMatrixError`.
         """
+        matrix, data, fresh = self._prepare(matrix)
+        self._factor(data)
+        state = {"count": self.n_factorizations, "retried": fresh}
+
+        def solve(rhs):
+            b = self._rhs(matrix, rhs)
+            if self.n_factorizations != state["count"]:
+                raise RuntimeError("this PARDISO factorization was replaced by a later one")
+            try:
+                return self._checked_solve(matrix, data, b, phase=33)
+            except SingularMatrixError:
+                if state["retried"]:
+                    raise
+            state["retried"] = True  # the scaling and matching of an earlier matrix may not suit this one
+            self._analyse(matrix, data)
+            self._factor(data)
+            state["count"] = self.n_factorizations
+            return self._checked_solve(matrix, data, b, phase=33)
+
+        return solve
+
+    def _prepare(self, matrix):
+        """The matrix as canonical CSC, its data, and whether its pattern needed a new analysis (done here)."""
         if not sp.issparse(matrix) or matrix.format != "csc":
             matrix = sp.csc_matrix(matrix)
         if matrix.shape[0] != matrix.shape[1]:
@@ -202,27 +237,14 @@ class PardisoSolver:
         data = np.ascontiguousarray(matrix.data, dtype=np.float64)
         if fresh:
             self._analyse(matrix, data)
-        self._factor(data)
-        checked, count = [False], [self.n_factorizations]
+        return matrix, data, fresh
 
-        def solve(rhs):
-            b = np.asfortranarray(rhs, dtype=np.float64)
-            if b.shape[0] != matrix.shape[0] or b.ndim not in (1, 2):
-                raise ValueError(f"rhs of shape {np.shape(rhs)} does not match the matrix of shape {matrix.shape}")
-            if self.n_factorizations != count[0]:
-                raise RuntimeError("this PARDISO factorization was replaced by a later one")
-            try:
-                return self._checked_solve(matrix, data, b)
-            except SingularMatrixError:
-                if fresh or checked[0]:
-                    raise
-            checked[0] = True  # the scaling and matching of an earlier matrix may not suit this one
-            self._analyse(matrix, data)
-            self._factor(data)
-            count[0] = self.n_factorizations
-            return self._checked_solve(matrix, data, b)
-
-        return solve
+    @staticmethod
+    def _rhs(matrix, rhs):
+        b = np.asfortranarray(rhs, dtype=np.float64)
+        if b.shape[0] != matrix.shape[0] or b.ndim not in (1, 2):
+            raise ValueError(f"rhs of shape {np.shape(rhs)} does not match the matrix of shape {matrix.shape}")
+        return b
 
     def _factor(self, data):
         dummy = np.zeros(1)

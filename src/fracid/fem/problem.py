@@ -162,8 +162,9 @@ class DamageProblem(ContinuumProblem):
 
     @property
     def differentiable(self) -> tuple:
-        """Parameters this problem differentiates with respect to: all of the law's."""
-        return tuple(self.law.parameters.names())
+        """Parameters this problem differentiates with respect to: all of the law's, if the law gives
+        its parameter derivatives (none otherwise)."""
+        return tuple(self.law.parameters.names()) if self.law.differentiable else ()
 
     def differentiate(self, q, kappa_old, kappa_old_rate, names) -> "ds.StepDerivative":
         """The pseudo-load of a converged step and how to complete its derivatives (see

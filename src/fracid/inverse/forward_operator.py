@@ -154,12 +154,16 @@ class ForwardOperator:
     def differentiable(self) -> bool:
         """Whether the model differentiates its runs with respect to every identified parameter and
         every observed quantity has derivatives: the force, the functionals and energies do; the
-        specimen's ``observables`` (zone widths, from observers) only with a model whose
-        ``differentiates_observers`` is true."""
+        specimen's ``observables`` and the model's ``observer_names`` (zone widths, crack lengths, from
+        observers) only with a model whose ``differentiates_observers`` is true."""
         names = set(getattr(self.model, "differentiable", ()))
-        observers = getattr(self.model, "differentiates_observers", False)
-        return set(self.names) <= names and (observers or not any(
-            o.quantity in getattr(o.specimen, "observables", ()) for o in self.observations))
+        if getattr(self.model, "differentiates_observers", False):
+            return set(self.names) <= names
+        observed = {o.quantity for o in self.observations}
+        for o in self.observations:
+            if observed & {*getattr(o.specimen, "observables", ()), *getattr(self.model, "observer_names", ())}:
+                return False
+        return set(self.names) <= names
 
     def differentiated(self) -> "ForwardOperator":
         """This operator with ``sensitivities=True`` if it is :attr:`differentiable`, else itself."""
@@ -241,10 +245,12 @@ class ForwardOperator:
             values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
             rows = slice(part.start, part.start + points.size)
             record.y[rows] = np.interp(points, run.control, values)
-            derivative = (run.derivatives or {}).get(obs.quantity)
-            if derivative is None:
+            if record.S is None:
+                continue
+            derivative = (getattr(run, "derivatives", None) or {}).get(obs.quantity)
+            if derivative is None:  # a quantity the run did not differentiate: no S from this run
                 record.S = None
-            elif record.S is not None:  # the checkpoints are steps: the interpolation picks the step's value
+            else:  # the checkpoints are steps: the interpolation picks the step's value
                 record.S[rows] = np.column_stack([np.interp(points, run.control, d) for d in derivative.T])
         return True
 
