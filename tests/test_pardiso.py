@@ -199,3 +199,19 @@ def test_missing_pypardiso_gives_a_clear_error(monkeypatch):
 def test_importing_fracid_does_not_import_pypardiso():
     code = "import sys, fracid, fracid.fem.pardiso; assert 'pypardiso' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_the_peer_beam_at_its_fine_mesh_runs_and_equals_superlu():
+    """27k unknowns, point-like plates: with scaling and matching every factorization perturbed pivots
+    and was rejected (the run stopped at its first increment); now the curve equals SuperLU's."""
+    import fracid
+    from fracid.models import DamageModel
+    from fracid.specimens import SPECIMENS
+
+    peer = SPECIMENS["notched-beam"](h_fine=0.5, plate_width=1.0)
+    params = fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=1.1e-4, alpha=0.99, beta=500.0, c=4.0, eta=10.0)
+    runs = [DamageModel("gradient").simulate(peer, params, control="cmod", target=0.16, max_steps=4,
+                                             stop_force_fraction=None, linear_solver=solver)
+            for solver in ("superlu", "pardiso")]
+    assert runs[1].n_steps == 4 and runs[1].stats.failed_increments == 0
+    np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-8 * np.abs(runs[0].force).max())

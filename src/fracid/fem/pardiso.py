@@ -1,7 +1,7 @@
 """Intel MKL PARDISO backend (optional: ``pip install 'fracid[pardiso]'``, which pulls pypardiso and MKL).
 
 :class:`PardisoSolver` factorizes real unsymmetric matrices (PARDISO matrix type 11). The symbolic
-analysis (phase 11: fill-reducing ordering, scaling and matching) runs once per sparsity pattern;
+analysis (phase 11: fill-reducing ordering) runs once per sparsity pattern;
 while the pattern stays the same, as it does for the tangents of a forward analysis, each call only
 refactorizes and solves (phase 23). pypardiso is used for locating MKL and for the ctypes prototype
 of ``pardiso``; the calls are made here, because pypardiso (0.4.7) leaves ``iparm[0] = 0``, with
@@ -57,8 +57,13 @@ def _default_iparm() -> np.ndarray:
     iparm[1] = 2  # nested dissection ordering (METIS)
     iparm[7] = 2  # up to two steps of iterative refinement (pivoting is only within supernodes)
     iparm[9] = 13  # pivot perturbation 1e-13
-    iparm[10] = 1  # scaling and
-    iparm[12] = 1  # weighted matching, both computed from the values seen by the analysis
+    # no scaling (iparm[10]) and no weighted matching (iparm[12]): both are computed from the values the
+    # analysis sees and then reused for every later matrix of the pattern; on the peer beam (27k and 48k
+    # unknowns, equilibrated damage tangents) they made every factorization perturb pivots and fail
+    # the residual check, while without them the residuals equal SuperLU's (1e-10) and the
+    # factorization is as fast (benchmarks/linear_solvers.py)
+    iparm[10] = 0
+    iparm[12] = 0
     iparm[11] = 2  # solve with the transpose: CSC arrays read as CSR describe A^T
     iparm[17] = -1  # report the nonzeros of the factors in iparm[17]
     iparm[34] = 1  # zero-based indices
@@ -105,7 +110,7 @@ class PardisoSolver:
     residual_rtol : float
         When PARDISO had to perturb pivots (it never stops on a zero pivot: it perturbs it and
         refines), the solution is accepted only if ``||A x - b|| <= residual_rtol ||b||``; otherwise
-        the analysis is redone with the current values (new scaling and matching) and, if that does
+        the analysis is redone with the current values and, if that does
         not help either, :class:`~fracid.fem.linear_solvers.SingularMatrixError` is raised.
         The default is loose on purpose: the damage tangents mix rows of order E t (equilibrium)
         with rows of order mm^2 (diffusion), so even a sound factorization of the virgin state
@@ -191,7 +196,7 @@ class PardisoSolver:
         except SingularMatrixError:
             if fresh:
                 raise
-        self._analyse(matrix, data)  # the scaling and matching of an earlier matrix may not suit this one
+        self._analyse(matrix, data)  # an analysis of an earlier matrix may not suit this one
         return self._checked_solve(matrix, data, b, phase=23)
 
     def factorize(self, matrix):
@@ -215,7 +220,7 @@ class PardisoSolver:
             except SingularMatrixError:
                 if state["retried"]:
                     raise
-            state["retried"] = True  # the scaling and matching of an earlier matrix may not suit this one
+            state["retried"] = True  # an analysis of an earlier matrix may not suit this one
             self._analyse(matrix, data)
             self._factor(data)
             state["count"] = self.n_factorizations
