@@ -215,3 +215,18 @@ def test_the_peer_beam_at_its_fine_mesh_runs_and_equals_superlu():
             for solver in ("superlu", "pardiso")]
     assert runs[1].n_steps == 4 and runs[1].stats.failed_increments == 0
     np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-8 * np.abs(runs[0].force).max())
+
+
+def test_runs_on_one_mesh_share_the_symbolic_analysis():
+    from fracid.fem.linear_solvers import linear_solver
+    from fracid.models import DamageModel
+
+    bar = fracid.BarWithWeakZone(n_elements=40)
+    solver = linear_solver("pardiso")
+    assert linear_solver("pardiso") is solver  # one per thread
+    analyses = solver.n_analyses
+    first = DamageModel().simulate(bar, fracid.DamageParameters(), target=0.03, linear_solver="pardiso")
+    after_first = solver.n_analyses
+    second = DamageModel().simulate(bar, fracid.DamageParameters(c=2.0), target=0.03, linear_solver="pardiso")
+    assert after_first <= analyses + 1 and solver.n_analyses == after_first  # the second run reused it
+    assert second.n_steps > 0 and first.n_steps > 0

@@ -8,6 +8,7 @@ cannot be factorized, which the Newton solver treats as a failed iteration (the 
 
 from __future__ import annotations
 
+import threading
 from typing import Protocol
 
 import numpy as np
@@ -71,10 +72,18 @@ def factorize(solver, matrix):
     return lambda rhs: solver.solve(matrix, rhs)
 
 
+_SHARED = threading.local()
+
+
 def _pardiso():
+    """This thread's PARDISO solver: the forward runs of a population on one mesh (one after the other
+    in a worker) share it, so its symbolic analysis is done once per mesh, not once per run."""
     from fracid.fem.pardiso import PardisoSolver  # lazy: pypardiso is an optional extra
 
-    return PardisoSolver()
+    solver = getattr(_SHARED, "pardiso", None)
+    if solver is None:
+        solver = _SHARED.pardiso = PardisoSolver()
+    return solver
 
 
 _BACKENDS = {"superlu": SuperLUSolver, "pardiso": _pardiso}
