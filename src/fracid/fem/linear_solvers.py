@@ -12,6 +12,7 @@ import threading
 from typing import Protocol
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 
@@ -38,29 +39,111 @@ class SuperLUSolver:
         enough that a small threshold preserves the fill-reducing ordering: on a damaged dog-bone
         (6149 unknowns) 0.001 gives 1.0e6 factor entries in 0.03 s against 2.4e6 in 0.13 s with
         partial pivoting (1.0), at the same residual (1e-15).
+    ordering : {"auto", "metis", "superlu"}
+        ``"metis"``: a nested-dissection ordering of A + A^T by METIS (the ``metis`` extra, pymetis),
+        computed once per sparsity pattern and applied symmetrically; SuperLU then keeps it. On the
+        damage tangents of the notched beam it factorizes 1.35 (10k unknowns) to 1.8 (48k) times
+        faster than ``permc_spec``, with less fill (docs/speed/linear_solvers.md). ``"superlu"``:
+        SuperLU orders with ``permc_spec`` at every factorization. ``"auto"``: METIS when pymetis is
+        installed.
     """
 
     name = "superlu"
 
-    def __init__(self, permc_spec: str = "MMD_AT_PLUS_A", diag_pivot_thresh: float = 0.001):
+    def __init__(self, permc_spec: str = "MMD_AT_PLUS_A", diag_pivot_thresh: float = 0.001, ordering: str = "auto"):
+        if ordering not in ("auto", "metis", "superlu"):
+            raise ValueError(f"ordering = {ordering!r}; choose 'auto', 'metis' or 'superlu'")
+        if ordering == "metis":
+            _pymetis()  # a clear error now rather than at the first factorization
         self.permc_spec = permc_spec
         self.diag_pivot_thresh = diag_pivot_thresh
+        self.ordering = ordering if ordering != "auto" else ("metis" if _has_pymetis() else "superlu")
+        self._order = None  # the symmetric ordering of the last pattern seen
 
     def solve(self, matrix, rhs):
         return self.factorize(matrix)(rhs)
 
     def factorize(self, matrix):
         """The LU factors' solve function ``rhs -> x``."""
+        if self.ordering == "metis":
+            order = self._order if self._order is not None and self._order.fits(matrix) else None
+            self._order = order = order or SymmetricOrdering.of(matrix)
+            lu = self._splu(order.permuted(matrix), "NATURAL")
+            return order.wrap(lu.solve)
+        return self._splu(matrix, self.permc_spec).solve
+
+    def _splu(self, matrix, permc_spec):
         try:
-            lu = spla.splu(
-                matrix,
-                permc_spec=self.permc_spec,
-                diag_pivot_thresh=self.diag_pivot_thresh,
-                options={"SymmetricMode": self.diag_pivot_thresh < 1.0},
-            )
+            return spla.splu(matrix, permc_spec=permc_spec, diag_pivot_thresh=self.diag_pivot_thresh,
+                             options={"SymmetricMode": self.diag_pivot_thresh < 1.0})
         except RuntimeError as err:  # "Factor is exactly singular"
             raise SingularMatrixError(str(err)) from err
-        return lu.solve
+
+
+class SymmetricOrdering:
+    """A fill-reducing ordering of one sparsity pattern, applied as P A P^T (rows and columns alike).
+
+    Attributes
+    ----------
+    perm : ndarray of int
+        New position k holds the old row/column ``perm[k]``.
+    """
+
+    def __init__(self, matrix, perm):
+        self.shape, self.indptr, self.indices = matrix.shape, matrix.indptr.copy(), matrix.indices.copy()
+        self.perm = np.asarray(perm, dtype=np.int64)
+        # the permuted pattern once, with the position of every entry in the original data
+        positions = sp.csc_matrix((np.arange(matrix.nnz, dtype=float) + 1.0, matrix.indices, matrix.indptr),
+                                  shape=matrix.shape)[self.perm][:, self.perm].tocsc()
+        positions.sort_indices()
+        self._source = positions.data.astype(np.int64) - 1
+        self._indices, self._indptr = positions.indices, positions.indptr
+
+    @classmethod
+    def of(cls, matrix) -> "SymmetricOrdering":
+        """METIS nested dissection of the graph of A + A^T (without the diagonal)."""
+        pymetis = _pymetis()
+        pattern = sp.csr_matrix((np.ones(matrix.nnz), matrix.indices, matrix.indptr), shape=matrix.shape)
+        graph = (pattern + pattern.T).tocsr()
+        graph.setdiag(0.0)
+        graph.eliminate_zeros()
+        perm, _ = pymetis.nested_dissection(adjacency=pymetis.CSRAdjacency(graph.indptr, graph.indices))
+        return cls(matrix, perm)
+
+    def fits(self, matrix) -> bool:
+        return (matrix.shape == self.shape and np.array_equal(matrix.indptr, self.indptr)
+                and np.array_equal(matrix.indices, self.indices))
+
+    def permuted(self, matrix):
+        """P A P^T of a matrix of this pattern (CSC)."""
+        return sp.csc_matrix((matrix.data[self._source], self._indices, self._indptr), shape=self.shape)
+
+    def wrap(self, solve):
+        """``rhs -> x`` of A from ``solve`` of P A P^T."""
+        perm = self.perm
+
+        def solve_original(rhs):
+            x = np.empty_like(rhs, dtype=float)
+            x[perm] = solve(np.ascontiguousarray(rhs[perm]))
+            return x
+
+        return solve_original
+
+
+def _has_pymetis() -> bool:
+    try:
+        _pymetis()
+    except ImportError:
+        return False
+    return True
+
+
+def _pymetis():
+    try:
+        import pymetis
+    except ImportError as err:
+        raise ImportError(f"the METIS ordering needs pymetis: pip install 'fracid[metis]' ({err})") from err
+    return pymetis
 
 
 def factorize(solver, matrix):
