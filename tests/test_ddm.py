@@ -190,5 +190,6 @@ def test_pardiso_keeps_the_factorization_for_the_derivatives():
     np.testing.assert_allclose(runs[1].derivatives["force"], runs[0].derivatives["force"], rtol=0,
                                atol=1e-9 * np.abs(runs[0].derivatives["force"]).max())
     plain = model.simulate(beam, params, linear_solver="pardiso", target=0.05)
-    # the derivatives' factorization starts the next increment: one more in all, not one per step
-    assert runs[1].stats.factorizations <= plain.stats.factorizations + 1
+    # the derivatives mostly need no factorization of their own (iterative refinement with the last
+    # Newton iteration's; the converged tangent is factorized where that does not converge)
+    assert runs[1].stats.factorizations <= plain.stats.factorizations + runs[1].n_steps // 4

@@ -196,7 +196,7 @@ def follow_path(
     stats = SolverStatistics()
     recorder = _Recorder(problem, control, dict(observers or {}), field_steps)
     derivatives = PathDerivatives(problem, sensitivities, observers) if sensitivities is not None else None
-    factor = None  # factorization at the last converged state (from the derivatives), for the next increment
+    factor = None  # a factorization to start the next increment with (the derivatives' or the last iteration's)
 
     z = np.zeros(problem.n_free + 1)
     kappa = problem.initial_history()
@@ -224,7 +224,7 @@ def follow_path(
         if ahead.size and ahead[0] < tau + increment:
             increment = ahead[0] - tau
         try:
-            z_new, arrays, iterations, state = solve_increment(
+            z_new, arrays, iterations, state, factor = solve_increment(
                 system, z, tau + increment, kappa, solver, newton, stats, state, factor
             )
         except IncrementFailed as err:
@@ -242,7 +242,7 @@ def follow_path(
         tau += increment
         if derivatives is not None:
             try:
-                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
+                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats, factor)
             except SingularMatrixError as err:
                 message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
                            f"derivatives are not defined there (a bifurcation of the path): {err}")
