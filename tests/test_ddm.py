@@ -192,4 +192,4 @@ def test_pardiso_keeps_the_factorization_for_the_derivatives():
     plain = model.simulate(beam, params, linear_solver="pardiso", target=0.05)
     # the derivatives mostly need no factorization of their own (iterative refinement with the last
     # Newton iteration's; the converged tangent is factorized where that does not converge)
-    assert runs[1].stats.factorizations <= plain.stats.factorizations + runs[1].n_steps // 4
+    assert runs[1].stats.factorizations <= plain.stats.factorizations + runs[1].n_steps // 10
