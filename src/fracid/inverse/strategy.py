@@ -213,9 +213,7 @@ class KnnGaussNewton:
         notes = list(notes) + [f"KNN: {self.knn.method} population of {len(knn.points)}, k = {knn.k}",
                                f"Gauss-Newton (bounded trust region): {fit.iterations} linearisation(s), tol "
                                f"{self.tol} std, sensitivities by {sensitivity_label(sensitivity)}; {fit.status}"]
-        knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
-                       "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": self.knn.method,
-                       "seed": self.knn.seed}
+        knn_summary = knn_record(knn, self.knn.method, self.knn.seed)
         return IdentificationResult(
             x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history, knn=knn_summary, runs=runs, converged=fit.converged,
             status=fit.status, method=self.name, stages={"knn": "KNN", "gauss_newton": "Gauss-Newton"},
@@ -326,8 +324,7 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
         y_fit = np.asarray(knn_output(knn, best, y_exp.size))
         status = f"{kalman.status}; the result is the best point of the KNN population"
     after = _counters(evaluate)
-    knn_summary = {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors,
-                   "order": knn.order, "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}
+    knn_summary = knn_record(knn, method, seed)
     runs = {"knn": len(knn.points), "knn_failed": knn.n_failed, "kalman": kalman.runs,
             "kalman_failed": len(kalman.failures), "kalman_run_equivalents": kalman.run_equivalents,
             "kalman_iterations": kalman.iterations, "wall_seconds": time.perf_counter() - start}
@@ -341,6 +338,12 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
         x=x, C=C, y_fit=y_fit, history=kalman.history, knn=knn_summary, runs=runs, converged=kalman.converged,
         status=status, **result_fields(operator, knn.space, x, y_exp, C_exp, blocks=blocks, notes=notes),
     )
+
+
+def knn_record(knn, method, seed) -> dict:
+    """What a result keeps of the KNN stage: population, objective, statuses, ranking, k, prior and design."""
+    return {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors, "order": knn.order,
+            "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}
 
 
 def knn_output(knn, index, size):
