@@ -3,13 +3,15 @@
 Cases: the notched beam (Gregoire geometry) and the D = 100 mm dog-bone, loaded past the peak and down to
 20 % of it; the peer beam of the OOFEM comparison (E 37000, nu 0.2, kappa_i 1.1e-4, alpha 0.99, beta 500,
 c 4, eta 10, 1 mm plates, CMOD control to 0.16 mm) at h_fine 1 (``peer1``) and 0.5 mm (``peer05``).
-Per case and backend it prints: unknowns, steps, Newton iterations, factorizations, time per factorization
-(time in factorizations and solves / factorizations), wall time, peak memory (resident set size of this
-process), wall / time in linear solves, and, once every backend of a case ran, wall / (factorizations x the
-fastest time per factorization measured for that case): how far the run is from the sparse-solver floor.
+Per case, Newton variant and backend it prints: unknowns, steps, iterations, factorizations, time per
+factorization, time per solve, wall time, peak memory (resident set size of this process), wall / time in
+linear solves, and, once every backend of a case ran, wall / (factorizations x the fastest time per
+factorization measured for that case): how far the run is from the sparse-solver floor. ``--newton``:
+``modified`` (the default, ``NewtonOptions()``: a factorization is kept while the residual falls fast) and
+``full`` (``reuse_ratio=0``: one factorization per iteration but the first of a step).
 
     python benchmarks/forward_2d.py [--specimen beam,dogbone,peer1,peer05,dogbone1600|all]
-                                    [--solvers superlu,pardiso]
+                                    [--solvers superlu,pardiso] [--newton modified,full]
 """
 
 from __future__ import annotations
@@ -47,7 +49,10 @@ def peak_rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def run(name, solver_name):
+NEWTON = {"modified": fracid.NewtonOptions(), "full": fracid.NewtonOptions(reuse_ratio=0.0)}
+
+
+def run(name, solver_name, newton="modified"):
     """One forward run; returns (wall [s], factorizations, time per factorization [s]) or None."""
     specimen, params, target, stop = CASES[name]
     try:
@@ -56,13 +61,16 @@ def run(name, solver_name):
         print(f"{name:8s} {solver_name:8s} unavailable: {err}")
         return None
     start = time.perf_counter()
-    result = fracid.simulate(specimen, params, target=target, stop_force_fraction=stop, linear_solver=solver)
+    result = fracid.simulate(specimen, params, target=target, stop_force_fraction=stop, linear_solver=solver,
+                             newton=NEWTON[newton])
     wall = time.perf_counter() - start
     s = result.stats
     n = DamageModel().build(specimen, params).n_free + 1
-    per_factorization = s.time_linear / max(s.factorizations, 1)
-    print(f"{name:8s} {solver_name:8s} unknowns {n:6d}  steps {s.steps:4d}  iterations {s.iterations:4d}  "
-          f"factorizations {s.factorizations:4d} x {per_factorization:6.3f} s  wall {wall:7.1f} s  "
+    per_factorization = s.time_factorizations / max(s.factorizations, 1)
+    per_solve = (s.time_linear - s.time_factorizations) / max(s.linear_solves, 1)
+    print(f"{name:8s} {newton:8s} {solver_name:8s} unknowns {n:6d}  steps {s.steps:4d}  iterations {s.iterations:4d}  "
+          f"factorizations {s.factorizations:4d} x {per_factorization:6.3f} s  solves x {per_solve:6.4f} s  "
+          f"wall {wall:7.1f} s  "
           f"wall/linear {wall / s.time_linear:5.2f}  peak RSS {peak_rss_mib():7.0f} MiB  "
           f"peak force {result.peak_force:9.1f} N  ({result.status})", flush=True)
     return wall, s.factorizations, per_factorization
@@ -72,16 +80,18 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--specimen", default="beam,dogbone", help=f"comma-separated, from {list(CASES)}, or all")
     parser.add_argument("--solvers", default="superlu,pardiso")
+    parser.add_argument("--newton", default="modified", help=f"comma-separated, from {list(NEWTON)}")
     args = parser.parse_args(argv)
     names = list(CASES) if args.specimen == "all" else args.specimen.split(",")
     for name in names:
-        runs = {solver: run(name, solver) for solver in args.solvers.split(",")}
-        runs = {solver: r for solver, r in runs.items() if r is not None}
+        runs = {(newton, solver): run(name, solver, newton) for newton in args.newton.split(",")
+                for solver in args.solvers.split(",")}
+        runs = {key: r for key, r in runs.items() if r is not None}
         if runs:
             floor = min(r[2] for r in runs.values())
-            for solver, (wall, factorizations, _) in runs.items():
-                print(f"{name:8s} {solver:8s} wall / (factorizations x fastest factorization {floor:.3f} s) = "
-                      f"{wall / (factorizations * floor):5.2f}")
+            for (newton, solver), (wall, factorizations, _) in runs.items():
+                print(f"{name:8s} {newton:8s} {solver:8s} wall / (factorizations x fastest factorization "
+                      f"{floor:.3f} s) = {wall / (factorizations * floor):5.2f}")
 
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ from fracid.fem.damage import update_history
 from fracid.fem.nonlocal_average import NonlocalAveraging, softening_coupling
 
 
-class ElementArrays(NamedTuple):
+class ElementArrays:
     """Element vectors and matrices of one evaluation.
 
     ``residual`` is (n_el, n_dof_el) with the displacement dofs first; ``tangent`` is
@@ -24,14 +24,30 @@ class ElementArrays(NamedTuple):
     norm scales that field's residual (internal forces for u, the equivalent-strain source for ebar);
     ``coupling`` holds the tangent entries between points of different elements that the integral
     model adds (None for the element-local models) [N/mm].
+
+    ``tangent`` may be given as a function of no argument: it is then computed at its first access
+    (an iteration of modified Newton needs only the residual; the tangent is half the cost of an
+    evaluation). It fills the problem's tangent buffer, so it must be taken before the next
+    evaluation of the problem.
     """
 
-    residual: np.ndarray
-    tangent: np.ndarray
-    reference: dict
-    kappa: np.ndarray
-    omega: np.ndarray
-    coupling: object = None  # scipy.sparse matrix over the free dofs, added to the assembled tangent
+    __slots__ = ("residual", "_tangent", "reference", "kappa", "omega", "coupling")
+
+    def __init__(self, residual, tangent, reference, kappa, omega, coupling=None):
+        self.residual, self._tangent, self.reference = residual, tangent, reference
+        self.kappa, self.omega, self.coupling = kappa, omega, coupling
+
+    @property
+    def tangent(self) -> np.ndarray:
+        if callable(self._tangent):
+            self._tangent = self._tangent()
+        return self._tangent
+
+    def _replace(self, **changes) -> "ElementArrays":
+        values = {name: getattr(self, name) for name in ("residual", "reference", "kappa", "omega", "coupling")}
+        values["tangent"] = self._tangent
+        values.update(changes)
+        return ElementArrays(**values)
 
 
 class ModelConstants(NamedTuple):
@@ -73,11 +89,16 @@ def _damage(law, params, const, kappa):
 
 
 def _secant_equilibrium(B, const, w, ue, omega):
-    """Shared by both models: B^T D eps at the points, the internal forces and the secant stiffness."""
+    """Shared by the models: B^T D eps at the points, the internal forces and the weights of the secant
+    stiffness (``_btdb(B * w_sec, DB)``)."""
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
     w_sec = w * (1.0 - omega) * const.E
     bt_sigma = _bt(sigma_eff, B)  # (n_el, n_q, n_u)
-    return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), _btdb(B * w_sec[..., None, None], const.DB)
+    return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), w_sec
+
+
+def _secant(B, const, w_sec):
+    return _btdb(B * w_sec[..., None, None], const.DB)
 
 
 def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
@@ -102,13 +123,18 @@ def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old,
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, ebar)
     omega, d_omega = _damage(law, params, const, kappa)
-    bt_sigma, f_u, out_tangent[:, :nu, :nu] = _secant_equilibrium(B, const, w, ue, omega)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
     f_eq = (w * eq) @ N
     f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
-    w_ue = -(w * const.E * d_omega * loading)
-    out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
-    out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
-    return ElementArrays(np.concatenate([f_u, f_e], axis=1), out_tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
+
+    def tangent():
+        out_tangent[:, :nu, :nu] = _secant(B, const, w_sec)
+        w_ue = -(w * const.E * d_omega * loading)
+        out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
+        out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
+        return out_tangent
+
+    return ElementArrays(np.concatenate([f_u, f_e], axis=1), tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
 
 
 def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
@@ -118,10 +144,15 @@ def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_ta
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, eq)
     omega, d_omega = _damage(law, params, const, kappa)
-    bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
-    softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1), _bt(d_eq, B))
-    out_tangent[:] = secant - softening
-    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+
+    def tangent():
+        softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1),
+                              _bt(d_eq, B))
+        out_tangent[:] = _secant(B, const, w_sec) - softening
+        return out_tangent
+
+    return ElementArrays(f_u, tangent, {"u": f_u}, kappa, omega)
 
 
 def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
@@ -152,7 +183,8 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
     ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
     kappa, loading = update_history(kappa_old, ebar)
     omega, d_omega = _damage(law, params, const, kappa)
-    bt_sigma, f_u, secant = _secant_equilibrium(B, const, w, ue, omega)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    secant = _secant(B, const, w_sec)
     g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
     h = _bt(d_eq, B)  # d eps_eq / d u at each point
     out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
@@ -169,5 +201,6 @@ def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
 
 def elastic_bulk(disc, const: ModelConstants, ue, out_tangent) -> ElementArrays:
     """Linear elastic material (the bulk of a discrete-crack model): internal forces and stiffness."""
-    _, f_u, out_tangent[:] = _secant_equilibrium(disc.strain_operator, const, disc.weights, ue, np.zeros(disc.weights.shape))
+    _, f_u, w_sec = _secant_equilibrium(disc.strain_operator, const, disc.weights, ue, np.zeros(disc.weights.shape))
+    out_tangent[:] = _secant(disc.strain_operator, const, w_sec)
     return ElementArrays(f_u, out_tangent, {"u": f_u}, np.zeros(disc.weights.shape), np.zeros(disc.weights.shape))

@@ -41,21 +41,24 @@ _F64 = ctypes.POINTER(ctypes.c_double)
 
 @functools.cache
 def _mkl_pardiso():
-    """The ctypes ``pardiso`` function and the C type of the handle (located once: it takes ~0.3 s)."""
+    """The ctypes ``pardiso`` function, the C type of the handle and MKL's ``MKL_Set_Num_Threads_Local``
+    (located once: it takes ~0.3 s)."""
     try:
         from pypardiso.pardiso_wrapper import PyPardisoSolver
 
         loader = PyPardisoSolver(mtype=_MTYPE)
     except (ImportError, OSError) as err:
         raise ImportError(f"the PARDISO linear solver needs pypardiso and MKL: pip install 'fracid[pardiso]' ({err})") from err
-    return loader._mkl_pardiso, loader._pt_type
+    set_threads = loader.libmkl.MKL_Set_Num_Threads_Local  # the C interface (by value)
+    set_threads.argtypes, set_threads.restype = [ctypes.c_int], ctypes.c_int
+    return loader._mkl_pardiso, loader._pt_type, set_threads
 
 
 def _default_iparm() -> np.ndarray:
     iparm = np.zeros(64, dtype=np.int32)
     iparm[0] = 1  # all values below are supplied (iparm[0] = 0 would reset them to MKL's defaults)
     iparm[1] = 2  # nested dissection ordering (METIS)
-    iparm[7] = 2  # up to two steps of iterative refinement (pivoting is only within supernodes)
+    iparm[7] = 2  # steps of iterative refinement; set per solve (_checked_solve)
     iparm[9] = 13  # pivot perturbation 1e-13
     # no scaling (iparm[10]) and no weighted matching (iparm[12]): both are computed from the values the
     # analysis sees and then reused for every later matrix of the pattern; on the peer beam (27k and 48k
@@ -107,6 +110,11 @@ class PardisoSolver:
 
     Parameters
     ----------
+    threads : int
+        MKL threads of this solver's calls (0: MKL's default, all cores). On the 2-core machines of
+        benchmarks/forward_2d.py one thread factorizes the beam's tangents as fast as two and
+        solves 3.6 times faster (2.9 ms against 10.5 ms at 10.6k unknowns), and a population
+        runs one forward run per core anyway.
     residual_rtol : float
         When PARDISO had to perturb pivots (it never stops on a zero pivot: it perturbs it and
         refines), the solution is accepted only if ``||A x - b|| <= residual_rtol ||b||``; otherwise
@@ -127,8 +135,11 @@ class PardisoSolver:
 
     name = "pardiso"
 
-    def __init__(self, *, residual_rtol: float = 1e-4):
-        self._pardiso, pt_type = _mkl_pardiso()
+    def __init__(self, *, threads: int = 1, residual_rtol: float = 1e-4):
+        if int(threads) != threads or threads < 0:
+            raise ValueError(f"threads = {threads!r}; give a non-negative integer (0: MKL's default)")
+        self.threads = int(threads)
+        self._pardiso, pt_type, self._set_threads = _mkl_pardiso()
         self._pt_type = pt_type[0]
         self.pt = np.zeros(64, dtype=pt_type[1])
         self.iparm = _default_iparm()
@@ -141,7 +152,12 @@ class PardisoSolver:
 
     def _run(self, phase, data, b, x):
         n = self._shape[0]
-        error = _call(self._pardiso, self._pt_type, self.pt, self.iparm, phase, n, data, self._indptr, self._indices, b, x)
+        previous = self._set_threads(self.threads)  # this thread's MKL threads, for this call only
+        try:
+            error = _call(self._pardiso, self._pt_type, self.pt, self.iparm, phase, n, data, self._indptr,
+                          self._indices, b, x)
+        finally:
+            self._set_threads(previous)
         if error == 0:
             return
         message = f"PARDISO phase {phase} failed with error {error} ({_ERRORS.get(error, 'unknown error')})"
@@ -175,6 +191,10 @@ class PardisoSolver:
     def _checked_solve(self, matrix, data, b, phase):
         """Phase 23 (factorize and solve) or 33 (solve with the last factorization), with the check."""
         x = np.zeros_like(b, order="F")
+        # two steps of iterative refinement where pivots were perturbed (the bordered tangent's zero
+        # diagonal on the 1D bar), none otherwise: three solves for one would make a solve cost as
+        # much as a factorization
+        self.iparm[7] = 2 if phase == 23 or self.perturbed_pivots else 0
         self._run(phase, data, b, x)
         if phase == 23:
             self.n_factorizations += 1

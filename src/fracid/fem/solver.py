@@ -40,16 +40,31 @@ class NewtonOptions:
         Relative tolerance on the residual of the diffusion equation, scaled by the norm of the
         equivalent-strain source.
     max_iterations : int
-        Iterations before an increment counts as failed.
+        Iterations with a new factorization before an increment counts as failed.
     field_rtol : mapping {field: float}
         Relative tolerances of other fields (or overriding the two above); a field named nowhere
         gets ``rtol_u``.
+    reuse_ratio : float
+        Modified Newton while the residual falls fast. The progress of an iterate is its largest
+        relative residual over the field's tolerance (converged at 1). The factorization in hand
+        (of an earlier iterate, or of the last step) solves the next iteration as long as the last
+        iteration cut the progress by at least this factor and, at that rate, would converge within
+        ``reuse_iterations`` more iterations; else the tangent at the iterate is factorized (a
+        Newton iteration). An iterate that a kept factorization made worse is dropped and Newton
+        goes on from the one before. 0: full Newton (only the first iteration of a step uses the
+        last factorization). A factorization costs 4 to 15 evaluations of the residual on the 2D
+        specimens (10k to 27k unknowns): 0.3 halves the factorizations of the beams at a tenth of
+        their tolerance in the curves (docs/speed/README.md).
+    reuse_iterations : int
+        See ``reuse_ratio``.
     """
 
     rtol_u: float = 1e-8
     rtol_ebar: float = 1e-8
     max_iterations: int = 12
     field_rtol: tuple = ()
+    reuse_ratio: float = 0.3
+    reuse_iterations: int = 6
 
     def __post_init__(self):
         named = dict(self.field_rtol.items() if hasattr(self.field_rtol, "items") else self.field_rtol)
@@ -58,8 +73,13 @@ class NewtonOptions:
                 (f"field_rtol[{field!r}]", v) for field, v in self.field_rtol]:
             if not (0.0 < value < 1.0):
                 raise ValueError(f"NewtonOptions.{name} = {value!r}; it must be in (0, 1)")
-        if int(self.max_iterations) != self.max_iterations or self.max_iterations < 1:
-            raise ValueError(f"NewtonOptions.max_iterations = {self.max_iterations!r}; it must be a positive integer")
+        for name in ("max_iterations", "reuse_iterations"):
+            value = getattr(self, name)
+            if int(value) != value or value < (1 if name == "max_iterations" else 0):
+                raise ValueError(f"NewtonOptions.{name} = {value!r}; it must be a "
+                                 f"{'positive' if name == 'max_iterations' else 'non-negative'} integer")
+        if not 0.0 <= self.reuse_ratio < 1.0:
+            raise ValueError(f"NewtonOptions.reuse_ratio = {self.reuse_ratio!r}; it must be in [0, 1) (0: full Newton)")
 
     def tolerance(self, field_name: str) -> float:
         """Relative tolerance of the residual of field ``field_name``."""
@@ -74,7 +94,8 @@ class SolverStatistics:
     steps: int = 0
     iterations: int = 0
     failed_increments: int = 0
-    time_linear: float = 0.0
+    time_linear: float = 0.0  # factorizations and solves
+    time_factorizations: float = 0.0
     time_total: float = 0.0
     linear_solves: int = 0
     factorizations: int = 0
@@ -177,10 +198,9 @@ def solve_increment(
     internal forces and tangent under the updated history equal those of the last iteration (the
     loading pattern does not change), so the first iteration of a step costs no evaluation. ``factor``,
     given with ``state``, solves the first iteration without a new factorization: the bordered tangent
-    at that state (from the direct differentiation of the last step, :mod:`fracid.fem.ddm`) or that of
-    the last iteration of the last increment, whose iterate was within the tolerance of the state.
-    The latter is one factorization less per step (169 -> 116 on the default beam) at the same
-    iteration counts: the tangent one iterate before convergence is as good a first step.
+    at that state (from the direct differentiation of the last step, :mod:`fracid.fem.ddm`) or the last
+    one factorized in the last increment. Later iterations keep a factorization while the residual
+    falls fast (``options.reuse_ratio``, modified Newton) and factorize the tangent otherwise.
 
     Returns
     -------
@@ -189,6 +209,8 @@ def solve_increment(
     arrays : ElementArrays
         Element arrays at the converged state (trial history and damage).
     iterations : int
+        Newton iterations: the factorizations of the increment, plus one if it started with ``factor``
+        (for full Newton, every iteration).
     state : tuple
         The evaluation at the converged z (for the next increment).
     factor : callable
@@ -197,36 +219,72 @@ def solve_increment(
     Raises
     ------
     IncrementFailed
-        On a non-finite residual, a singular tangent, or no convergence in ``options.max_iterations``.
+        On a non-finite residual, a singular tangent, or no convergence in ``options.max_iterations``
+        factorizations.
     """
     z = z0.copy()
     scale = max(abs(tau), 1e-300)
-    for iteration in range(options.max_iterations + 1):
+    keep = started = factor is not None and state is not None
+    fresh = 0  # new factorizations
+    accepted = None  # (z, progress) of the iterate the kept factorization last solved at
+    progress, rejected = None, False
+    for iteration in range(options.max_iterations * (options.reuse_iterations + 1) + 1):
         residual, arrays, errors, state = system.evaluate(z, tau, kappa_old, state if iteration == 0 else None)
         if not np.all(np.isfinite(residual)):
             raise IncrementFailed(f"non-finite residual at iteration {iteration}")
         if iteration > 0 and abs(residual[-1]) <= 1e-10 * scale and all(
             err <= options.tolerance(name) for name, err in errors.items()
         ):
-            return z, arrays, iteration, state, factor
-        if iteration == options.max_iterations:
+            return z, arrays, fresh + started, state, factor
+        last, progress = progress, max(err / options.tolerance(name) for name, err in errors.items())
+        if accepted is not None and progress > accepted[1]:
+            # the kept factorization made it worse: back to the iterate before, with its own tangent
+            z, progress, accepted, rejected = accepted[0].copy(), accepted[1], None, True
+            continue
+        if iteration > 0:
+            # the second iteration tries the last step's factorization on the increment's nonlinearity
+            first_try = iteration == 1 and options.reuse_ratio > 0.0
+            keep = factor is not None and not rejected and (
+                first_try or _keeps_factorization(options, progress, last))
+            rejected = False
+        if not keep and fresh >= options.max_iterations:
             break
-        t0 = time.perf_counter()
-        try:
-            if iteration == 0 and factor is not None and state is not None:
-                equilibration, solve = system.scaled_matrix_scale(), factor
-            else:
-                matrix, equilibration = system.scaled_matrix(arrays)
-                t0 = time.perf_counter()  # the assembly above is not linear-solver time
-                solve = factor = factorize(solver, matrix)
-                stats.factorizations += 1
-            dz = equilibration * solve(-residual * equilibration)
-        except SingularMatrixError as err:
-            raise IncrementFailed(f"singular tangent at iteration {iteration}: {err}") from err
-        finally:
-            stats.time_linear += time.perf_counter() - t0
-            stats.linear_solves += 1
-        stats.iterations += 1
+        accepted = (z.copy(), progress) if keep and iteration > 0 else None
+        dz, factor = _newton_step(system, arrays, residual, solver, stats, factor if keep else None, iteration)
+        fresh += not keep
         z += dz
     detail = ", ".join(f"{k}: {v:.2e}" for k, v in errors.items())
     raise IncrementFailed(f"no convergence in {options.max_iterations} iterations (relative residuals {detail})")
+
+
+def _keeps_factorization(options: NewtonOptions, progress: float, last: float | None) -> bool:
+    """Whether the next iteration may solve with the factorization in hand (modified Newton)."""
+    if last is None or options.reuse_ratio <= 0.0 or not progress <= options.reuse_ratio * last:
+        return False
+    if progress <= 1.0:
+        return True
+    rate = progress / last
+    return rate > 0.0 and np.log(progress) <= options.reuse_iterations * np.log(1.0 / rate)
+
+
+def _newton_step(system, arrays, residual, solver, stats, factor, iteration):
+    """The iteration's correction dz, solved with ``factor`` or a new factorization of the tangent at
+    ``arrays``; returns (dz, the factorization used)."""
+    t0 = time.perf_counter()
+    try:
+        if factor is not None:
+            equilibration = system.scaled_matrix_scale()
+        else:
+            matrix, equilibration = system.scaled_matrix(arrays)
+            t0 = time.perf_counter()  # the assembly above is not linear-solver time
+            factor = factorize(solver, matrix)
+            stats.factorizations += 1
+            stats.time_factorizations += time.perf_counter() - t0
+        dz = equilibration * factor(-residual * equilibration)
+    except SingularMatrixError as err:
+        raise IncrementFailed(f"singular tangent at iteration {iteration}: {err}") from err
+    finally:
+        stats.time_linear += time.perf_counter() - t0
+        stats.linear_solves += 1
+    stats.iterations += 1
+    return dz, factor
