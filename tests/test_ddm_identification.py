@@ -31,15 +31,19 @@ def test_the_differentiated_operator_returns_S_and_the_store_keeps_it(operator, 
     assert exact.sensitivities and not operator.sensitivities and exact.differentiable
     record = exact(TRUTH)
     assert record.ok and record.S.shape == (POINTS.size, 2)
-    np.testing.assert_allclose(record.y, operator(TRUTH).y, rtol=1e-10)  # the same run
+    # the same steps; the Newton iterates differ within the tolerance (the derivatives hand a factorization
+    # of the converged tangent on to the next step, where the plain run keeps an older one)
+    np.testing.assert_allclose(record.y, operator(TRUTH).y, rtol=1e-8)
     # S against central differences of the adaptive runs: d/d beta does not move the steps, and agrees
-    # to 1e-6; c moves the onset and with it the steps, which the differences also see (0.2 % at the
-    # package's step 1e-2, more at smaller steps: DDM differentiates the model, not the step rule)
+    # to 1e-6 at a relative step of 1e-3 (at 1e-2 the differences' truncation error is 8e-4, at 1e-4
+    # the runs' convergence to the Newton tolerance, 1e-9, divided by the step: 9e-6); c moves the
+    # onset and with it the steps, which the differences also see (0.2 % at the package's step 1e-2,
+    # more at smaller steps: DDM differentiates the model, not the step rule)
     def deviation(step):
         _, S_cd, _ = CentralDifferences(relative_step=step)(operator, TRUTH)
         return np.abs(S_cd - record.S).max(axis=0) / np.abs(S_cd).max(axis=0)
 
-    assert deviation(1e-4)[1] < 1e-6 and deviation(1e-2)[0] < 5e-3
+    assert deviation(1e-3)[1] < 2e-6 and deviation(1e-2)[0] < 5e-3
     with RunStore(tmp_path / "runs.sqlite") as store:
         first = StoredOperator(operator, store).differentiated()
         assert first.operator.sensitivities

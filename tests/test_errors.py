@@ -79,6 +79,10 @@ def test_newton_options_are_checked():
         fracid.NewtonOptions(rtol_u=0.0)
     with pytest.raises(ValueError, match="max_iterations"):
         fracid.NewtonOptions(max_iterations=0)
+    with pytest.raises(ValueError, match=r"reuse_ratio = 1.0; it must be in \[0, 1\)"):
+        fracid.NewtonOptions(reuse_ratio=1.0)
+    with pytest.raises(ValueError, match="reuse_iterations = -1; it must be a non-negative integer"):
+        fracid.NewtonOptions(reuse_iterations=-1)
 
 
 def test_snap_back_under_end_displacement_fails_with_partial_result():

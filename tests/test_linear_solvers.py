@@ -44,3 +44,4 @@ def test_curves_equal_those_of_superlus_own_ordering(specimen, target):
             for ordering in ("superlu", "metis")]
     np.testing.assert_allclose(runs[1].control, runs[0].control, rtol=1e-9)
     np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-6 * np.abs(runs[0].force).max())
+

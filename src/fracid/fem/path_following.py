@@ -166,7 +166,8 @@ def follow_path(
         Stop after this many converged steps.
     newton : NewtonOptions
     linear_solver : str, LinearSolver or None
-        Backend (default SuperLU).
+        Backend: ``"superlu"``, ``"pardiso"``, an instance, or None / ``"auto"`` (PARDISO where the
+        ``pardiso`` extra is installed, else SuperLU).
     observers : mapping {name: f(problem, q, arrays) -> float}, optional
         Scalar observables evaluated at every converged step (e.g. the damaged-zone width).
     field_steps : "last", "all", None or iterable of int
