@@ -11,7 +11,10 @@ factorization measured for that case): how far the run is from the sparse-solver
 ``full`` (``reuse_ratio=0``: one factorization per iteration but the first of a step).
 
     python benchmarks/forward_2d.py [--specimen beam,dogbone,peer1,peer05,dogbone1600|all]
-                                    [--solvers superlu,pardiso] [--newton modified,full]
+                                    [--solvers superlu,pardiso,superlu-own] [--newton modified,full]
+
+``superlu`` is SciPy's SuperLU in a METIS ordering when pymetis (the ``metis`` extra) is installed;
+``superlu-own`` is SuperLU in its own ordering (a plain ``pip install fracid``).
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import time
 
 import fracid
 from fracid.models import DamageModel
-from fracid.fem.linear_solvers import linear_solver
+from fracid.fem.linear_solvers import SuperLUSolver, linear_solver
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 
@@ -56,7 +59,8 @@ def run(name, solver_name, newton="modified"):
     """One forward run; returns (wall [s], factorizations, time per factorization [s]) or None."""
     specimen, params, target, stop = CASES[name]
     try:
-        solver = linear_solver(solver_name)
+        # superlu-own: SuperLU in its own ordering, what `pip install fracid` gives without the metis extra
+        solver = SuperLUSolver(ordering="superlu") if solver_name == "superlu-own" else linear_solver(solver_name)
     except (ValueError, ImportError) as err:
         print(f"{name:8s} {solver_name:8s} unavailable: {err}")
         return None

@@ -19,7 +19,7 @@ def test_metis_ordered_lu_solves_and_keeps_its_ordering_per_pattern():
     pattern = sp.random(n, n, density=0.01, random_state=4, format="csc")
     pattern = (pattern + pattern.T + sp.eye(n) * 10.0).tocsc()  # structurally symmetric, nonsymmetric values
     solver = SuperLUSolver(ordering="metis")
-    assert linear_solver().ordering == "metis"  # the default picks METIS when pymetis is there
+    assert linear_solver("superlu").ordering == "metis"  # SuperLU picks METIS when pymetis is there
     for k in range(3):
         values = sp.csc_matrix((pattern.data * rng.uniform(0.5, 1.5, pattern.nnz), pattern.indices, pattern.indptr),
                                shape=pattern.shape)
@@ -45,3 +45,19 @@ def test_curves_equal_those_of_superlus_own_ordering(specimen, target):
     np.testing.assert_allclose(runs[1].control, runs[0].control, rtol=1e-9)
     np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-6 * np.abs(runs[0].force).max())
 
+
+
+def test_runs_on_one_mesh_share_the_pattern_and_the_ordering():
+    from fracid.fem.assembly import SparsePattern
+
+    beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0)
+    solver = linear_solver("superlu")
+    assert linear_solver("superlu") is solver  # one per thread
+    model = DamageModel("gradient")
+    model.simulate(beam, fracid.DamageParameters(), target=0.02, linear_solver="superlu")
+    order = solver._order
+    model.simulate(beam, fracid.DamageParameters(c=2.0), target=0.02, linear_solver="superlu")
+    assert order is not None and solver._order is order  # METIS ran once for both runs
+    dofs = np.arange(12).reshape(3, 4)
+    assert SparsePattern.shared(12, dofs, [0], [1]) is SparsePattern.shared(12, dofs.copy(), [0], [1])
+    assert SparsePattern.shared(12, dofs, [0], [2]) is not SparsePattern.shared(12, dofs, [0], [1])

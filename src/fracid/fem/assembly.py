@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
+import threading
+
 import numpy as np
 import scipy.sparse as sp
+
+_PATTERNS: dict = {}  # SparsePattern.shared: key -> pattern, oldest first
+_PATTERNS_LOCK = threading.Lock()
 
 
 def dot(x: np.ndarray, y: np.ndarray) -> float:
@@ -66,6 +72,26 @@ class SparsePattern:
         scatter[valid] = inverse.ravel()
         self._n_element_entries = element_dofs.size * nd
         self._scatter = scatter
+
+    @classmethod
+    def shared(cls, n: int, element_dofs: np.ndarray, extra_rows=(), extra_cols=()) -> "SparsePattern":
+        """The pattern of these arguments, built once for the forward runs of a process on one mesh
+        (it is not modified after construction; a few recent patterns are kept)."""
+        arrays = [np.ascontiguousarray(a, dtype=np.int64) for a in (element_dofs, extra_rows, extra_cols)]
+        digest = hashlib.blake2b(digest_size=16)
+        for a in arrays:
+            digest.update(str(a.shape).encode())
+            digest.update(a.tobytes())
+        key = (n, digest.hexdigest())
+        with _PATTERNS_LOCK:
+            pattern = _PATTERNS.get(key)
+        if pattern is None:
+            pattern = cls(n, element_dofs, extra_rows, extra_cols)
+            with _PATTERNS_LOCK:
+                _PATTERNS[key] = pattern
+                while len(_PATTERNS) > 8:
+                    _PATTERNS.pop(next(iter(_PATTERNS)))
+        return pattern
 
     def data(self, element_values: np.ndarray, extra_values=()) -> np.ndarray:
         """CSC data array from element matrices (n_el, n_dof_el, n_dof_el) and extra entry values."""

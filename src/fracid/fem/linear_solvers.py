@@ -159,15 +159,25 @@ def factorize(solver, matrix):
 _SHARED = threading.local()
 
 
+def _per_thread(name, make):
+    """This thread's shared backend ``name``: the forward runs of a population on one mesh (one after
+    the other in a worker) share it, so its per-pattern work (PARDISO's symbolic analysis, SuperLU's
+    METIS ordering) is done once per mesh, not once per run."""
+    solver = getattr(_SHARED, name, None)
+    if solver is None:
+        solver = make()
+        setattr(_SHARED, name, solver)
+    return solver
+
+
 def _pardiso():
-    """This thread's PARDISO solver: the forward runs of a population on one mesh (one after the other
-    in a worker) share it, so its symbolic analysis is done once per mesh, not once per run."""
     from fracid.fem.pardiso import PardisoSolver  # lazy: pypardiso is an optional extra
 
-    solver = getattr(_SHARED, "pardiso", None)
-    if solver is None:
-        solver = _SHARED.pardiso = PardisoSolver()
-    return solver
+    return _per_thread("pardiso", PardisoSolver)
+
+
+def _superlu():
+    return _per_thread("superlu", SuperLUSolver)
 
 
 @functools.cache
@@ -182,10 +192,10 @@ def _has_pardiso() -> bool:
 def _fastest():
     """PARDISO where the ``pardiso`` extra is installed (2.8 times faster factorizations than SuperLU on
     the beams' tangents, docs/speed), else SuperLU (in a METIS ordering with the ``metis`` extra)."""
-    return _pardiso() if _has_pardiso() else SuperLUSolver()
+    return _pardiso() if _has_pardiso() else _superlu()
 
 
-_BACKENDS = {"auto": _fastest, "superlu": SuperLUSolver, "pardiso": _pardiso}
+_BACKENDS = {"auto": _fastest, "superlu": _superlu, "pardiso": _pardiso}
 
 
 def linear_solver(spec=None) -> LinearSolver:

@@ -124,7 +124,7 @@ class ControlledSystem:
         rows = np.concatenate([f_idx, np.full(v_idx.size, n)])
         cols = np.concatenate([np.full(f_idx.size, n), v_idx])
         self.border_values = np.concatenate([-self.problem.load_vector[f_idx], self.control[v_idx]])
-        self.pattern = SparsePattern(n + 1, self.problem.element_dofs, rows, cols)
+        self.pattern = SparsePattern.shared(n + 1, self.problem.element_dofs, rows, cols)
 
     def evaluate(self, z: np.ndarray, tau: float, kappa_old: np.ndarray, state=None):
         """Residual of the bordered system, element arrays, relative residual per field, and the
