@@ -9,11 +9,13 @@ material law and the solver never see the mesh; they work on these arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from fracid.fem.elasticity import UNIAXIAL, StrainState
-from fracid.fem.elements import gauss_line, line_linear, line_quadratic
+from fracid.fem.elements import (gauss_line, gauss_quad, gauss_triangle, line_linear, line_quadratic, quad_linear,
+                                 quad_serendipity, triangle_linear, triangle_quadratic)
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,56 +107,88 @@ def bar_discretization(vertices, areas, n_gauss: int = 3) -> MixedDiscretization
     )
 
 
-def plane_stress_discretization(nodes, cells, n_vertices: int, thickness: float, n_gauss: int = 3) -> MixedDiscretization:
-    """Mixed plane-stress quadrilaterals: 8-node serendipity displacement, 4-node bilinear ebar.
+@dataclass(frozen=True)
+class _Family:
+    """A mixed plane element: displacement (and geometry) shape functions on all its nodes, linear
+    ebar shape functions on its corners, and the quadrature rule of the reference element."""
+
+    name: str
+    n_corners: int
+    displacement: Callable
+    ebar: Callable
+    rule: Callable
+    default_order: int
+
+
+# element family by the number of nodes per cell
+_PLANE_FAMILIES = {
+    8: _Family("8-node quadrilaterals", 4, quad_serendipity, quad_linear, gauss_quad, 3),
+    6: _Family("6-node triangles", 3, triangle_quadratic, triangle_linear, gauss_triangle, 4),
+}
+
+
+def plane_stress_discretization(nodes, cells, n_vertices: int, thickness: float,
+                                n_gauss: int | None = None) -> MixedDiscretization:
+    """Mixed plane-stress elements: quadratic displacement, linear nonlocal strain on the corners.
+
+    The family follows from the width of ``cells``: 8-node serendipity quadrilaterals (Q8) with
+    bilinear 4-node ebar, or 6-node triangles (T6) with linear 3-node ebar. One family per mesh.
 
     Parameters
     ----------
     nodes : ndarray, shape (n_nodes, 2)
         Node coordinates [mm]; the element corners (vertices) come first, numbered 0..n_vertices-1,
         then the mid-edge nodes.
-    cells : ndarray of int, shape (n_el, 8)
-        Corners counterclockwise, then the mid-edge nodes of edges 0-1, 1-2, 2-3, 3-0.
+    cells : ndarray of int, shape (n_el, 8) or (n_el, 6)
+        Corners counterclockwise, then the mid-edge nodes of edges 0-1, 1-2, 2-3, 3-0 (Q8) or
+        0-1, 1-2, 2-0 (T6).
     n_vertices : int
         Number of corner nodes (ebar lives on them).
     thickness : float
         Out-of-plane thickness [mm].
-    n_gauss : int
-        Gauss points per direction (3: full integration of the quadratic element).
+    n_gauss : int, optional
+        Q8: Gauss points per direction (default 3: full integration of the quadratic element). T6:
+        polynomial degree the triangle rule integrates exactly (default 4: 6 points, since the
+        damage field varies inside the element).
 
     Notes
     -----
     Displacement dofs of node j are 2 j (x) and 2 j + 1 (y); the ebar dof of vertex v is
-    2 n_nodes + v. The geometry is isoparametric with the 8-node element (curved edges allowed).
+    2 n_nodes + v. The geometry is isoparametric with the quadratic element (curved edges allowed).
     """
     from fracid.fem.elasticity import PLANE_STRESS
-    from fracid.fem.elements import gauss_quad, quad_linear, quad_serendipity
 
     nodes = np.asarray(nodes, dtype=float)
     cells = np.asarray(cells, dtype=int)
-    if cells.ndim != 2 or cells.shape[1] != 8 or np.any(cells[:, :4] >= n_vertices):
-        raise ValueError("cells must be (n_el, 8) with the four corners (vertices < n_vertices) first")
+    family = _PLANE_FAMILIES.get(cells.shape[1]) if cells.ndim == 2 else None
+    if family is None:
+        raise ValueError(f"cells must be (n_el, 8) quadrilaterals or (n_el, 6) triangles; got shape {cells.shape}")
+    corners = cells[:, :family.n_corners]
+    if np.any(corners >= n_vertices):
+        raise ValueError(f"cells of {family.name} must list their {family.n_corners} corners first, as vertices "
+                         f"(< n_vertices = {n_vertices})")
     if not thickness > 0:
         raise ValueError(f"thickness = {thickness!r} mm; it must be positive")
-    pts, gw = gauss_quad(n_gauss)
-    Nu, dNu = quad_serendipity(pts)
-    Ne, dNe = quad_linear(pts)
-    X = nodes[cells]  # (n_el, 8, 2)
+    pts, gw = family.rule(family.default_order if n_gauss is None else n_gauss)
+    Nu, dNu = family.displacement(pts)
+    Ne, dNe = family.ebar(pts)
+    X = nodes[cells]  # (n_el, n_nodes per cell, 2)
     J = np.einsum("qai,eaj->eqij", dNu, X)  # d x_j / d xi_i
     detJ = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
     if np.any(detJ <= 0):
         bad = np.unique(np.nonzero(detJ <= 0)[0])
         raise ValueError(f"elements {bad[:10].tolist()} are inverted or degenerate (Jacobian <= 0)")
     Jinv = np.linalg.inv(J)
-    dNu_dx = np.einsum("eqij,qaj->eqai", Jinv, dNu)  # (n_el, n_q, 8, 2)
+    dNu_dx = np.einsum("eqij,qaj->eqai", Jinv, dNu)  # (n_el, n_q, n_nodes per cell, 2)
     dNe_dx = np.einsum("eqij,qaj->eqai", Jinv, dNe)
     n_el, n_q = detJ.shape
-    B = np.zeros((n_el, n_q, 3, 16))
+    n_u = 2 * cells.shape[1]
+    B = np.zeros((n_el, n_q, 3, n_u))
     B[:, :, 0, 0::2] = dNu_dx[..., 0]
     B[:, :, 1, 1::2] = dNu_dx[..., 1]
     B[:, :, 2, 0::2] = dNu_dx[..., 1]
     B[:, :, 2, 1::2] = dNu_dx[..., 0]
-    u_dofs = np.empty((n_el, 16), dtype=int)
+    u_dofs = np.empty((n_el, n_u), dtype=int)
     u_dofs[:, 0::2], u_dofs[:, 1::2] = 2 * cells, 2 * cells + 1
     return MixedDiscretization(
         strain_state=PLANE_STRESS,
@@ -163,7 +197,7 @@ def plane_stress_discretization(nodes, cells, n_vertices: int, thickness: float,
         ebar_shape=Ne,
         ebar_gradient=np.swapaxes(dNe_dx, -1, -2),
         u_dofs=u_dofs,
-        ebar_dofs=2 * nodes.shape[0] + cells[:, :4],
+        ebar_dofs=2 * nodes.shape[0] + corners,
         points=np.einsum("qa,eai->eqi", Nu, X),
         n_u_dofs=2 * nodes.shape[0],
         n_ebar_dofs=int(n_vertices),

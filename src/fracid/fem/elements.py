@@ -88,3 +88,116 @@ def quad_serendipity(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     N = np.concatenate([Nc, Nm], axis=1)
     dN = np.concatenate([dNc, np.stack([dNm_dxi, dNm_deta], axis=-1)], axis=1)
     return N, dN
+
+
+# Triangles on the reference triangle (0, 0), (1, 0), (0, 1), in area coordinates
+# L = (1 - xi - eta, xi, eta) with constant gradients; mid-edge nodes of edges 0-1, 1-2, 2-0.
+_T_GRADIENTS = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+_T_EDGES = np.array([[0, 1], [1, 2], [2, 0]])
+
+
+def _area_coordinates(points: np.ndarray) -> np.ndarray:
+    points = np.asarray(points, dtype=float)
+    return np.column_stack([1.0 - points[:, 0] - points[:, 1], points[:, 0], points[:, 1]])
+
+
+def triangle_linear(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Linear shape functions of the 3-node triangle (corners (0, 0), (1, 0), (0, 1)).
+
+    Parameters
+    ----------
+    points : ndarray, shape (n_points, 2)
+        Points (xi, eta) of the reference triangle.
+
+    Returns
+    -------
+    N : ndarray, shape (n_points, 3)
+    dN : ndarray, shape (n_points, 3, 2)
+        Derivatives with respect to (xi, eta).
+    """
+    L = _area_coordinates(points)
+    return L, np.broadcast_to(_T_GRADIENTS, (L.shape[0], 3, 2)).copy()
+
+
+def triangle_quadratic(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quadratic Lagrange shape functions of the 6-node triangle.
+
+    Corners (0, 0), (1, 0), (0, 1) counterclockwise, then the mid-edge nodes of edges 0-1, 1-2, 2-0.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n_points, 2)
+        Points (xi, eta) of the reference triangle.
+
+    Returns
+    -------
+    N : ndarray, shape (n_points, 6)
+    dN : ndarray, shape (n_points, 6, 2)
+        Derivatives with respect to (xi, eta).
+    """
+    L = _area_coordinates(points)
+    g = _T_GRADIENTS
+    Nc = L * (2.0 * L - 1.0)
+    dNc = (4.0 * L - 1.0)[:, :, None] * g[None, :, :]
+    La, Lb = L[:, _T_EDGES[:, 0]], L[:, _T_EDGES[:, 1]]
+    Nm = 4.0 * La * Lb
+    dNm = 4.0 * (La[:, :, None] * g[_T_EDGES[:, 1]][None] + Lb[:, :, None] * g[_T_EDGES[:, 0]][None])
+    return np.concatenate([Nc, Nm], axis=1), np.concatenate([dNc, dNm], axis=1)
+
+
+def _symmetric_orbits(orbits) -> tuple[np.ndarray, np.ndarray]:
+    """Points and weights of a rule given by (a, weight) orbits: a = 1/3 is the centroid, otherwise
+    the three points with area coordinates (a, a, 1 - 2 a) and its permutations."""
+    points, weights = [], []
+    for a, w in orbits:
+        L = [(a, a, a)] if a == 1.0 / 3.0 else [(1 - 2 * a, a, a), (a, 1 - 2 * a, a), (a, a, 1 - 2 * a)]
+        points += [(l2, l3) for _, l2, l3 in L]
+        weights += [w] * len(L)
+    return np.array(points), np.array(weights)
+
+
+_S10, _S15 = np.sqrt(10.0), np.sqrt(15.0)
+_R4 = np.sqrt(38.0 - 44.0 * np.sqrt(0.4))
+_R4W = np.sqrt(213125.0 - 53320.0 * _S10)
+# symmetric rules with positive weights (weights sum to 1/2): degree -> orbits (a, weight)
+_TRIANGLE_RULES = {
+    1: ((1.0 / 3.0, 0.5),),
+    2: ((1.0 / 6.0, 1.0 / 6.0),),
+    # Strang & Fix / Dunavant, 6 points
+    4: (((8.0 - _S10 + _R4) / 18.0, (620.0 + _R4W) / 7440.0), ((8.0 - _S10 - _R4) / 18.0, (620.0 - _R4W) / 7440.0)),
+    # Radon / Hammer, 7 points
+    5: ((1.0 / 3.0, 9.0 / 80.0), ((6.0 - _S15) / 21.0, (155.0 - _S15) / 2400.0),
+        ((6.0 + _S15) / 21.0, (155.0 + _S15) / 2400.0)),
+}
+
+
+def gauss_triangle(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss rule on the reference triangle (0, 0), (1, 0), (0, 1), exact for polynomials of ``degree``.
+
+    Parameters
+    ----------
+    degree : int
+        Polynomial degree integrated exactly, >= 1. Degrees 1, 2, 4 and 5 are the symmetric rules
+        of 1, 3, 6 (Strang-Fix / Dunavant) and 7 (Radon) points; degree 3 uses the 6-point rule of
+        degree 4 (positive weights); higher degrees a collapsed (Duffy) tensor Gauss-Legendre rule of
+        ((degree + 3) // 2)^2 points.
+
+    Returns
+    -------
+    points : ndarray, shape (n, 2)
+        (xi, eta) of the points.
+    weights : ndarray, shape (n,)
+        Their weights, summing to 1/2 (the area of the reference triangle).
+    """
+    if not (isinstance(degree, (int, np.integer)) and degree >= 1):
+        raise ValueError(f"degree = {degree!r}; a triangle rule needs an integer degree >= 1")
+    key = 4 if degree == 3 else int(degree)
+    if key in _TRIANGLE_RULES:
+        return _symmetric_orbits(_TRIANGLE_RULES[key])
+    # x = u, y = (1 - u) v on the unit square: dx dy = (1 - u) du dv, a polynomial of degree + 1 in u
+    n = (degree + 3) // 2
+    x, w = gauss_line(n)
+    x, w = 0.5 * (x + 1.0), 0.5 * w
+    u, v = np.meshgrid(x, x, indexing="ij")
+    weights = np.outer(w, w) * (1.0 - u)
+    return np.column_stack([u.ravel(), ((1.0 - u) * v).ravel()]), weights.ravel()

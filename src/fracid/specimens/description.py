@@ -99,6 +99,9 @@ class ZoneWidth:
     along_range: tuple = (-np.inf, np.inf)
 
 
+_PLANE_CELL_TYPES = {8: "quad8", 6: "triangle6"}  # VTK cell type of a plane mesh by nodes per cell
+
+
 def uniform(points) -> np.ndarray:
     """1 at every point (the default of a description's fields)."""
     return np.ones(np.shape(points)[:-1])
@@ -112,9 +115,12 @@ class Description:
     ----------
     nodes : ndarray, shape (n_nodes, dim)
         Node coordinates [mm]: dim 1 for a bar (quadratic elements, vertex i is node 2 i), 2 for
-        plane stress (8-node quadrilaterals, the first ``n_vertices`` nodes are the corners).
+        plane stress (8-node quadrilaterals or 6-node triangles, the first ``n_vertices`` nodes are
+        the corners).
     cells : ndarray of int
-        The vertices of each 1D element (shape (n_el, 2)) or the 8 nodes of each quadrilateral.
+        The vertices of each 1D element (shape (n_el, 2)), the 8 nodes of each quadrilateral or the
+        6 nodes of each triangle (corners first, see
+        :func:`~fracid.fem.discretization.plane_stress_discretization`).
     node_sets : mapping {name: ndarray of int}
         Named sets of nodes that the conditions below refer to.
     loads, supports : tuples of Load and Support
@@ -135,8 +141,9 @@ class Description:
         loading blocks), tensile strength relative to the material's (an imperfection), at any points.
     crack : CrackPath, optional
     zone : ZoneWidth, optional
-    cell_type : str
-        VTK cell type of the output mesh.
+    cell_type : str, optional
+        VTK cell type of the output mesh; by default that of the cells ("line3", "quad8" or
+        "triangle6").
     """
 
     nodes: np.ndarray
@@ -155,7 +162,7 @@ class Description:
     strength_factor: Callable = uniform
     crack: CrackPath | None = None
     zone: ZoneWidth | None = None
-    cell_type: str = "quad8"
+    cell_type: str | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -178,7 +185,7 @@ class Description:
         if self.dim == 1:
             el = np.arange(len(self.cells))
             return self.nodes, np.stack([2 * el, 2 * el + 2, 2 * el + 1], axis=1), "line3"
-        return self.nodes, self.cells, self.cell_type
+        return self.nodes, self.cells, self.cell_type or _PLANE_CELL_TYPES[self.cells.shape[1]]
 
 
 def discretize(description: Description) -> MixedDiscretization:

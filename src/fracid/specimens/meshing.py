@@ -1,4 +1,5 @@
-"""Structured meshes of 8-node quadrilaterals, graded towards the process zone and mapped to curved shapes."""
+"""Structured meshes of 8-node quadrilaterals (or 6-node triangles), graded towards the process zone and mapped to
+curved shapes."""
 
 from __future__ import annotations
 
@@ -10,14 +11,16 @@ import numpy as np
 
 @dataclass(frozen=True, eq=False)
 class QuadMesh:
-    """Mesh of 8-node quadrilaterals: vertices first (0..n_vertices-1), then mid-edge nodes.
+    """Mesh of 8-node quadrilaterals (or 6-node triangles): vertices first (0..n_vertices-1), then
+    mid-edge nodes.
 
     Attributes
     ----------
     nodes : ndarray, shape (n_nodes, 2)
         Coordinates [mm].
-    cells : ndarray of int, shape (n_el, 8)
-        Corners counterclockwise, then mid-edge nodes of edges 0-1, 1-2, 2-3, 3-0.
+    cells : ndarray of int, shape (n_el, 8) or (n_el, 6)
+        Corners counterclockwise, then mid-edge nodes of edges 0-1, 1-2, 2-3, 3-0 (triangles: 0-1,
+        1-2, 2-0).
     n_vertices : int
     """
 
@@ -110,6 +113,38 @@ def structured_quad8(
     keep : callable(s_centre, t_centre) -> bool array, optional
         Which grid cells exist (e.g. to cut a notch). All when None.
     """
+    ref, cells, n_vertices = _reference_quad8(s_lines, t_lines, keep)
+    return QuadMesh(nodes=_mapped(ref, mapping), cells=cells, n_vertices=n_vertices)
+
+
+def structured_tri6(
+    s_lines,
+    t_lines,
+    mapping: Callable | None = None,
+    keep: Callable | None = None,
+) -> QuadMesh:
+    """6-node triangle mesh of a tensor grid: each grid cell of :func:`structured_quad8` (same
+    arguments) split along its diagonal from (s_i, t_j) to (s_i+1, t_j+1) into two triangles.
+
+    The nodes are those of the quadrilateral mesh, then the mid-points of the diagonals (mapped from
+    the reference coordinates like the other nodes).
+    """
+    ref, quads, n_vertices = _reference_quad8(s_lines, t_lines, keep)
+    diagonal = len(ref) + np.arange(len(quads))
+    ref = np.concatenate([ref, 0.5 * (ref[quads[:, 0]] + ref[quads[:, 2]])])
+    c0, c1, c2, c3, m01, m12, m23, m30 = quads.T
+    lower = np.stack([c0, c1, c2, m01, m12, diagonal], axis=1)
+    upper = np.stack([c0, c2, c3, diagonal, m23, m30], axis=1)
+    cells = np.stack([lower, upper], axis=1).reshape(-1, 6)  # the two triangles of a grid cell side by side
+    return QuadMesh(nodes=_mapped(ref, mapping), cells=cells, n_vertices=n_vertices)
+
+
+def _mapped(ref: np.ndarray, mapping: Callable | None) -> np.ndarray:
+    return ref if mapping is None else np.column_stack(mapping(ref[:, 0], ref[:, 1]))
+
+
+def _reference_quad8(s_lines, t_lines, keep):
+    """Reference coordinates of the nodes, the cells and the number of vertices of :func:`structured_quad8`."""
     s = np.asarray(s_lines, dtype=float)
     t = np.asarray(t_lines, dtype=float)
     ns, nt = s.size, t.size
@@ -134,6 +169,5 @@ def structured_quad8(
     se = np.where(horizontal, 0.5 * (s[np.minimum(ei, ns - 2)] + s[np.minimum(ei + 1, ns - 1)]), s[ei])
     te = np.where(horizontal, t[ej], 0.5 * (t[np.minimum(ej, nt - 2)] + t[np.minimum(ej + 1, nt - 1)]))
     ref = np.concatenate([np.column_stack([sv, tv]), np.column_stack([se, te])])
-    nodes = ref if mapping is None else np.column_stack(mapping(ref[:, 0], ref[:, 1]))
     cells = np.concatenate([vertex_ids.reshape(-1, 4), used_v.size + edge_ids.reshape(-1, 4)], axis=1)
-    return QuadMesh(nodes=nodes, cells=cells, n_vertices=int(used_v.size))
+    return ref, cells, int(used_v.size)
