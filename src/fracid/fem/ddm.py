@@ -9,10 +9,11 @@ parameters x gives the bordered system of the step's consistent tangent
 
 with d r / d x taken at fixed q (the formulation's pseudo-load, which carries the history
 variables' derivatives from the last step; docs/theory.md, section 6). :class:`PathDerivatives`
-solves it by iterative refinement with the factorization of the step's last Newton iteration (the
-tangent one iterate before convergence) against the assembled converged tangent: the derivatives
-cost a pseudo-load, a few solves with p right-hand sides and the history update per step, and a
-factorization only where the refinement does not converge (2 of 75 steps on the demo beam).
+factorizes the converged bordered tangent and hands the factorization on: it is what the next
+increment's Newton iterations start with (modified Newton keeps it while the residual falls fast),
+so the derivatives cost a factorization, a pseudo-load, one solve with p right-hand sides and the
+history update per step. (Iterative refinement with the factorization modified Newton last kept, of
+an older tangent, was slower on the demo beam: 5.9 s against 4.3 s per run.)
 
 The derivatives are those of the discrete path at the steps' control values: the step sequence is
 held, as the central differences of runs that land on the same control values (``checkpoints``) see it.
@@ -68,29 +69,20 @@ class PathDerivatives:
         self.records = {key: [np.zeros(p)] for key in keys}
         self._last = (0.0, 0.0)  # force and load-point displacement of the last step
 
-    def step(self, system, z, history_old, arrays, solver, stats, factor=None):
+    def step(self, system, z, history_old, arrays, solver, stats):
         """Differentiate the converged step z (history before the step ``history_old``, element arrays
-        ``arrays`` at z); returns the factorization to start the next increment with.
-
-        ``factor``, the factorization of the step's last Newton iteration (the tangent one iterate
-        before convergence), solves the system by iterative refinement against the converged
-        tangent (assembled, not factorized): relative residual below 1e-9 in one or two solves on
-        the demo beam (73 of 75 steps), so the derivatives cost no factorization. Where the refinement
-        does not get there in ``REFINEMENTS`` solves, the converged tangent is factorized (and handed
-        on)."""
+        ``arrays`` at z); returns the factorization of the converged tangent, to start the next
+        increment with."""
         problem, rec = self.problem, self.records
         q = z[:-1]
         derivative = problem.differentiate(q, history_old, self.history_rate, self.names)
         matrix, equilibration = system.scaled_matrix(arrays)
         rhs = np.vstack([-derivative.pseudo_load, np.zeros((1, len(self.names)))]) * equilibration[:, None]
         t0 = time.perf_counter()
-        solution = _refined(matrix, rhs, factor) if factor is not None else None
-        if solution is None:
-            t1 = time.perf_counter()
-            factor = factorize(solver, matrix)
-            stats.factorizations += 1
-            stats.time_factorizations += time.perf_counter() - t1
-            solution = factor(rhs)
+        factor = factorize(solver, matrix)
+        stats.factorizations += 1
+        stats.time_factorizations += time.perf_counter() - t0
+        solution = factor(rhs)
         dz = equilibration[:, None] * solution
         stats.time_linear += time.perf_counter() - t0
         stats.linear_solves += 1
@@ -121,32 +113,3 @@ class PathDerivatives:
                    elastic_energy=rec["elastic"], dissipated_energy=rec["work"] - rec["elastic"])
         out["names"] = self.names
         return out
-
-
-#: solves of iterative refinement with the last factorization before the converged tangent is
-#: factorized instead (fewer when the rate of the first ones says they would not do)
-REFINEMENTS = 10
-
-
-def _refined(matrix, rhs, solve, rtol: float = 1e-9):
-    """x with ||matrix x - rhs|| <= rtol ||rhs|| (column by column) by iterative refinement with
-    ``solve``, an approximate inverse; None if ``REFINEMENTS`` solves would not get there.
-
-    1e-9: the derivatives then agree with those of an exact factorization to about that relative
-    level; tighter tolerances meet the rounding floor of the equilibrated system (near 1e-11) and
-    fall back to a factorization at most steps. A factorization kept by modified Newton over
-    several iterates contracts the error more slowly than one of the last iterate: the refinement
-    goes on while its rate, extrapolated, reaches the tolerance within the remaining solves."""
-    scale = np.linalg.norm(rhs, axis=0)
-    scale = np.where(scale > 0, scale, 1.0)
-    x = solve(rhs)
-    last = None
-    for remaining in range(REFINEMENTS, 0, -1):
-        error = float(np.max(np.linalg.norm(rhs - matrix @ x, axis=0) / scale))
-        if error <= rtol:
-            return x
-        if last is not None and (error >= last or np.log(error / rtol) > remaining * np.log(last / error)):
-            return None
-        last = error
-        x = x + solve(rhs - matrix @ x)
-    return None

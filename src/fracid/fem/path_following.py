@@ -243,7 +243,7 @@ def follow_path(
         tau += increment
         if derivatives is not None:
             try:
-                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats, factor)
+                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
             except SingularMatrixError as err:
                 message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
                            f"derivatives are not defined there (a bifurcation of the path): {err}")
