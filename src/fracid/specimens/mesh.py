@@ -1,0 +1,278 @@
+"""The user's own plane-stress specimen: a Gmsh mesh whose physical groups name the supports, the loaded
+edge or point, symmetry lines and the measuring points (read with meshio, the ``vtk`` extra).
+
+The mesh may be linear or quadratic, of triangles or quadrilaterals (one family per mesh): only the
+element corners are read, and fracid adds the mid-edge nodes of its quadratic elements (T6 with linear
+ebar on the corners, or Q8 with bilinear ebar) on straight edges. A group of lines or points becomes
+the node set of its corners and of the mid-edge nodes of its lines. Lengths are in the mesh's unit
+times ``scale`` [mm].
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from fracid.specimens.description import Description, Load, Measure, Support
+
+_COMPONENTS = {"x": 0, "y": 1}
+_SURFACES = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4}
+_SOLIDS = ("tetra", "hexahedron", "wedge", "pyramid")
+
+
+class MeshError(ValueError):
+    """A mesh file that fracid cannot use; the message names the file and what to change."""
+
+
+@dataclass(frozen=True)
+class MeshSpecimen:
+    """A plane-stress test described by a Gmsh mesh and the names of its physical groups.
+
+    Parameters
+    ----------
+    path : str
+        The ``.msh`` file (any format meshio reads with physical groups).
+    thickness : float
+        Out-of-plane thickness [mm].
+    supports : tuple of (group, component)
+        The ``component`` ("x" or "y") of the nodes of each group held at zero.
+    loads : tuple of (group, component) or (group, component, rigid)
+        The load pattern: a unit force along ``component`` on the group, its nodes tied together
+        (``rigid``, the default: a loading plate, or one point) or the force spread evenly.
+    controls : tuple of (name, ((group, component, weight), ...))
+        Named functionals: ``weight`` times the mean displacement of the group along the component,
+        summed (a CMOD: the right lip's x minus the left lip's x). The first is the default control.
+    symmetry : tuple of (group, component)
+        Symmetry lines: the normal ``component`` of the group's nodes held at zero.
+    symmetry_factor : float
+        Copies of the model in the whole specimen (2 for a half model).
+    scale : float
+        Millimetres per unit of the mesh's coordinates (1000 for a mesh in metres).
+    """
+
+    path: str
+    thickness: float
+    supports: tuple
+    loads: tuple
+    controls: tuple
+    symmetry: tuple = ()
+    symmetry_factor: float = 1.0
+    scale: float = 1.0
+
+    observables: ClassVar[tuple] = ()
+
+    def __post_init__(self):
+        if not (isinstance(self.thickness, (int, float)) and self.thickness > 0):
+            raise ValueError(f"MeshSpecimen.thickness = {self.thickness!r} mm; it must be positive")
+        if not self.controls:
+            raise ValueError("MeshSpecimen.controls is empty: name at least one control (a displacement to prescribe)")
+        if not self.loads:
+            raise ValueError("MeshSpecimen.loads is empty: name the group the force acts on")
+        for name, _ in self.controls:
+            if not isinstance(name, str) or not name:
+                raise ValueError(f"MeshSpecimen.controls: a control's name must be a non-empty string; got {name!r}")
+
+    @property
+    def default_control(self) -> str:
+        return self.controls[0][0]
+
+    @property
+    def control_names(self) -> tuple:
+        return tuple(name for name, _ in self.controls)
+
+    def describe(self) -> Description:
+        mesh = read_mesh(self.path)
+        groups = set(self._groups())
+        missing = sorted(groups - set(mesh.node_sets))
+        if missing:
+            raise MeshError(f"{self.path}: no physical group {', '.join(map(repr, missing))}; the file names "
+                            f"{sorted(mesh.node_sets) or 'no physical groups'}")
+        return Description(
+            nodes=mesh.nodes * self.scale, cells=mesh.cells, n_vertices=mesh.n_vertices, section=float(self.thickness),
+            node_sets=mesh.node_sets,
+            supports=tuple(Support(group, _component(component, "supports")) for group, component in self.supports),
+            loads=tuple(_load(item) for item in self.loads),
+            symmetry=tuple((group, _component(component, "symmetry")) for group, component in self.symmetry),
+            functionals={name: tuple(Measure(group, _component(component, f"controls[{name!r}]"), float(weight))
+                                     for group, component, weight in terms) for name, terms in self.controls},
+            symmetry_factor=float(self.symmetry_factor),
+        )
+
+    def _groups(self):
+        for group, *_ in (*self.supports, *self.loads, *self.symmetry):
+            yield group
+        for _, terms in self.controls:
+            for group, *_ in terms:
+                yield group
+
+    def default_target(self, scales) -> float:
+        raise ValueError(f"a mesh specimen has no default target: give target= (the final {self.default_control} "
+                         "[mm])")
+
+
+def _component(value, where) -> int:
+    if value in (0, 1):
+        return int(value)
+    try:
+        return _COMPONENTS[value]
+    except (KeyError, TypeError):
+        raise ValueError(f"MeshSpecimen.{where}: component {value!r}; use 'x' or 'y'") from None
+
+
+def _load(item) -> Load:
+    group, component, *rest = item
+    return Load(group, _component(component, "loads"), 1.0, rigid=bool(rest[0]) if rest else True)
+
+
+@dataclass(frozen=True, eq=False)
+class PlaneMesh:
+    """A plane mesh in fracid's numbering: corners first (``n_vertices``), then mid-edge nodes."""
+
+    nodes: np.ndarray
+    cells: np.ndarray
+    n_vertices: int
+    node_sets: dict
+
+
+def read_mesh(path) -> PlaneMesh:
+    """The mesh of ``path`` with fracid's quadratic elements and a node set per physical group (cached
+    while the file is unchanged)."""
+    try:
+        stat = os.stat(path)
+    except OSError as err:
+        raise MeshError(f"{path}: cannot read the mesh file ({err.strerror})") from None
+    return _read(os.fspath(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=8)
+def _read(path, mtime, size) -> PlaneMesh:
+    try:
+        import meshio
+    except ImportError as err:
+        raise ImportError(f"reading {path} needs meshio: pip install 'fracid[vtk]' ({err})") from err
+    try:
+        raw = meshio.read(path)
+    except Exception as err:  # meshio raises many types on a malformed file
+        raise MeshError(f"{path}: not a mesh meshio can read ({type(err).__name__}: {err})") from None
+    return plane_mesh(raw.points, [(block.type, block.data) for block in raw.cells], _physical_groups(raw), path)
+
+
+_DIMENSION = {"vertex": 0, "line": 1, "line3": 1, **{kind: 2 for kind in _SURFACES}}
+
+
+def _physical_groups(raw) -> dict:
+    """{group: {cell type: cell indices}} from Gmsh's physical tags (field_data name -> (tag, dim)),
+    or meshio's cell sets when the file has no tags."""
+    physical = raw.cell_data.get("gmsh:physical")
+    if physical is None or not raw.field_data:
+        return raw.cell_sets_dict
+    groups = {}
+    for name, (tag, dim) in ((n, tuple(int(v) for v in value[:2])) for n, value in raw.field_data.items()):
+        members, offset = {}, {}  # indices into the concatenation of the blocks of a type
+        for block, tags in zip(raw.cells, physical):
+            start = offset.get(block.type, 0)
+            offset[block.type] = start + len(block.data)
+            if _DIMENSION.get(block.type) == dim:
+                chosen = np.flatnonzero(np.asarray(tags) == tag)
+                if chosen.size:
+                    members.setdefault(block.type, []).append(start + chosen)
+        groups[name] = {kind: np.concatenate(parts) for kind, parts in members.items()}
+    return groups
+
+
+def plane_mesh(points, blocks, cell_sets, path="mesh") -> PlaneMesh:
+    """fracid's quadratic plane mesh from meshio's ``points``, cell ``blocks`` [(type, connectivity)]
+    and ``cell_sets`` {group: {type: cell indices}} (see :func:`read_mesh`)."""
+    points = np.asarray(points, dtype=float)
+    solids = sorted({kind for kind, _ in blocks if kind in _SOLIDS})
+    if solids:
+        raise MeshError(f"{path}: 3D elements ({', '.join(solids)}): fracid runs plane-stress meshes; mesh the "
+                        "surface only (Gmsh: 2D mesh)")
+    if points.shape[1] > 2 and np.any(np.abs(points[:, 2:]) > 1e-9 * max(np.ptp(points[:, :2]), 1.0)):
+        raise MeshError(f"{path}: nodes off the plane z = 0: a plane-stress mesh lies in the x-y plane")
+    surfaces = [(kind, data) for kind, data in blocks if kind in _SURFACES]
+    families = {_SURFACES[kind] for kind, _ in surfaces}
+    if not families:
+        raise MeshError(f"{path}: no triangles or quadrilaterals (cell types {sorted({k for k, _ in blocks})})")
+    if len(families) > 1:
+        raise MeshError(f"{path}: triangles and quadrilaterals together; mesh with one family (Gmsh: "
+                        "Mesh.RecombineAll = 1 for quadrilaterals only, 0 for triangles)")
+    n_corners = families.pop()
+    corners = np.concatenate([data[:, :n_corners] for _, data in surfaces])
+    used = np.unique(np.concatenate([data.ravel() for _, data in surfaces]))
+    unused = np.setdiff1d(np.arange(len(points)), used)
+    if unused.size:
+        node = unused[0]
+        count = f"{unused.size} nodes belong" if unused.size > 1 else "1 node belongs"
+        raise MeshError(f"{path}: {count} to no triangle or quadrilateral (node {node} at "
+                        f"{points[node, :2].tolist()}); save only the meshed surfaces (Gmsh: Mesh.SaveAll = 0 with "
+                        "physical surfaces)")
+    vertex_ids = np.unique(corners)
+    renumber = np.full(len(points), -1)
+    renumber[vertex_ids] = np.arange(vertex_ids.size)
+    vertices = points[vertex_ids, :2]
+    cells = renumber[corners]
+    cells = _counterclockwise(vertices, cells, path)
+    edges, mid = _mid_edges(cells)
+    nodes = np.vstack([vertices, 0.5 * (vertices[edges[:, 0]] + vertices[edges[:, 1]])])
+    quadratic = np.hstack([cells, vertex_ids.size + mid])
+    node_sets = _node_sets(blocks, cell_sets, renumber, edges, vertex_ids.size, path)
+    return PlaneMesh(nodes, quadratic, int(vertex_ids.size), node_sets)
+
+
+def _counterclockwise(vertices, cells, path):
+    """Cells with their corners counterclockwise (Gmsh orders them by the surface's normal)."""
+    x, y = vertices[cells, 0], vertices[cells, 1]
+    area = 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    size = np.ptp(vertices, axis=0).max()
+    degenerate = np.flatnonzero(np.abs(area) <= 1e-12 * size * size)
+    if degenerate.size:
+        raise MeshError(f"{path}: degenerate elements (zero area): {degenerate[:10].tolist()}")
+    out = cells.copy()
+    flip = area < 0
+    out[flip] = out[flip][:, ::-1]
+    return out
+
+
+def _mid_edges(cells):
+    """Unique edges (sorted vertex pairs) and, per cell, the edge of each side (0-1, 1-2, ...)."""
+    n = cells.shape[1]
+    sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=-1).reshape(-1, 2)
+    edges, index = np.unique(np.sort(sides, axis=1), axis=0, return_inverse=True)
+    return edges, index.reshape(-1, n)
+
+
+def _node_sets(blocks, cell_sets, renumber, edges, n_vertices, path) -> dict:
+    """Node set per physical group: the corners of its cells and the mid-edge nodes of its edges."""
+    by_type = {}
+    for kind, data in blocks:
+        by_type.setdefault(kind, []).append(data)
+    edge_id = {tuple(edge): k for k, edge in enumerate(edges.tolist())}
+    sets = {}
+    for group, members in cell_sets.items():
+        if group.startswith("gmsh:"):
+            continue
+        nodes = []
+        for kind, indices in members.items():
+            data = np.concatenate(by_type.get(kind, [np.zeros((0, 1), dtype=int)]))[np.asarray(indices, dtype=int)]
+            n_corners = 1 if kind == "vertex" else 2 if kind.startswith("line") else _SURFACES.get(kind)
+            if n_corners is None:
+                continue
+            ids = renumber[data[:, :n_corners]]
+            if np.any(ids < 0):
+                raise MeshError(f"{path}: physical group {group!r} has nodes that are no element corner")
+            nodes.append(ids.ravel())
+            if n_corners >= 2:
+                sides = np.stack([ids, np.roll(ids, -1, axis=1)], axis=-1).reshape(-1, 2) if n_corners > 2 else ids
+                for a, b in np.sort(sides, axis=1).tolist():
+                    k = edge_id.get((a, b))
+                    if k is None:
+                        raise MeshError(f"{path}: physical group {group!r} has a line that is no element side")
+                    nodes.append(np.array([n_vertices + k]))
+        if nodes:
+            sets[group] = np.unique(np.concatenate(nodes))
+    return sets

@@ -1,0 +1,127 @@
+"""The user's own specimen from a Gmsh mesh (fracid.specimens.mesh): physical groups become supports, loads
+and controls; linear or quadratic triangles and quadrilaterals run as T6 / Q8; bad meshes give their error."""
+
+import numpy as np
+import pytest
+
+import fracid
+from fracid.models import DamageModel
+from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh
+
+meshio = pytest.importorskip("meshio")
+
+L, H, T, E = 30.0, 6.0, 5.0, 30000.0
+
+
+def grid(nx, ny, triangles):
+    """Corners of an L x H strip, cells (linear), and the left/right edges and the origin as Gmsh groups."""
+    x, y = np.meshgrid(np.linspace(0.0, L, nx + 1), np.linspace(0.0, H, ny + 1), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    node = lambda i, j: i * (ny + 1) + j  # noqa: E731
+    quads = np.array([[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
+                      for i in range(nx) for j in range(ny)])
+    cells = np.vstack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]) if triangles else quads
+    left = np.array([[node(0, j), node(0, j + 1)] for j in range(ny)])
+    right = np.array([[node(nx, j), node(nx, j + 1)] for j in range(ny)])
+    return points, cells, left, right, np.array([[node(0, 0)]])
+
+
+def write_msh(path, points, cells, left, right, corner, kind, clockwise=False):
+    cells = cells[:, ::-1] if clockwise else cells
+    blocks = [(kind, cells), ("line", np.vstack([left, right])), ("vertex", corner)]
+    physical = [np.full(len(cells), 1), np.r_[np.full(len(left), 2), np.full(len(right), 3)], np.array([4])]
+    mesh = meshio.Mesh(points, blocks, cell_data={"gmsh:physical": physical, "gmsh:geometrical": physical},
+                       field_data={"domain": np.array([1, 2]), "left": np.array([2, 1]), "right": np.array([3, 1]),
+                                   "origin": np.array([4, 0])})
+    meshio.write(path, mesh, file_format="gmsh22", binary=False)
+    return path
+
+
+def strip(path):
+    return MeshSpecimen(str(path), thickness=T, supports=(("left", "x"), ("origin", "y")), loads=(("right", "x"),),
+                        controls=(("elongation", (("right", "x", 1.0),)),))
+
+
+@pytest.mark.parametrize("kind, clockwise", [("triangle", False), ("quad", False), ("triangle", True)])
+def test_strip_from_a_gmsh_file_is_elastic_then_damages(tmp_path, kind, clockwise):
+    points, cells, left, right, corner = grid(6, 2, kind == "triangle")
+    path = write_msh(tmp_path / "strip.msh", points, cells, left, right, corner, kind, clockwise)
+    specimen = strip(path)
+    description = specimen.describe()
+    assert description.cells.shape[1] == (6 if kind == "triangle" else 8)
+    assert len(description.nodes_of("left")) == 2 * 2 + 1  # 3 corners and 2 mid-edge nodes
+    params = fracid.DamageParameters(E=E, nu=0.2, kappa_i=1e-4, beta=300.0, c=4.0)
+    result = DamageModel().simulate(specimen, params, target=0.01, stop_force_fraction=None)
+    slope = result.force[1] / result.control[1]
+    assert slope == pytest.approx(E * H * T / L, rel=1e-9)  # uniform strain, exactly
+    assert result.peak_force == pytest.approx(1e-4 * E * H * T, rel=0.02)  # damage onset at kappa_i everywhere
+
+
+def test_groups_of_quadratic_lines_hold_the_mid_edge_nodes():
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    mesh = plane_mesh(points, [("triangle6", np.array([[0, 1, 2, 3, 4, 5]])), ("line3", np.array([[0, 1, 3]]))],
+                      {"bottom": {"line3": np.array([0])}})
+    assert mesh.n_vertices == 3 and mesh.cells.shape == (1, 6)
+    bottom = mesh.nodes[mesh.node_sets["bottom"]]
+    np.testing.assert_allclose(np.sort(bottom[:, 0]), [0.0, 1.0, 2.0])
+    np.testing.assert_allclose(bottom[:, 1], 0.0)
+
+
+def test_a_mesh_read_twice_is_read_once(tmp_path):
+    path = write_msh(tmp_path / "a.msh", *grid(2, 1, True), "triangle")
+    assert read_mesh(path) is read_mesh(path)
+
+
+@pytest.mark.parametrize("change, message", [
+    ("missing_group", r"no physical group 'top'; the file names \['domain', 'left', 'origin', 'right'\]"),
+    ("solid", r"3D elements \(tetra\)"),
+    ("mixed", "triangles and quadrilaterals together"),
+    ("unused", r"1 node belongs to no triangle or quadrilateral \(node 9 at \[50.0, 50.0\]\)"),
+    ("degenerate", r"degenerate elements \(zero area\): \[0\]"),
+    ("off_plane", "nodes off the plane z = 0"),
+])
+def test_bad_meshes_name_the_file_and_the_fault(tmp_path, change, message):
+    points, cells, left, right, corner = grid(2, 2, True)
+    kind, blocks = "triangle", None
+    if change == "solid":
+        blocks = [("tetra", np.array([[0, 1, 3, 4]]))]
+    if change == "mixed":
+        blocks = [("quad", np.array([[0, 3, 4, 1]]))]
+    if change == "unused":
+        points = np.vstack([points, [[50.0, 50.0, 0.0]]])
+    if change == "degenerate":
+        cells = cells.copy()
+        cells[0] = [0, 1, 2]  # three nodes on the line x = 0
+    if change == "off_plane":
+        points = points.copy()
+        points[4, 2] = 1.0
+    path = write_msh(tmp_path / f"{change}.msh", points, cells, left, right, corner, kind)
+    if blocks:
+        raw = meshio.read(path)
+        with pytest.raises(MeshError, match=message):
+            plane_mesh(raw.points, [(b.type, b.data) for b in raw.cells] + blocks, {})
+        return
+    specimen = strip(path)
+    if change == "missing_group":
+        specimen = MeshSpecimen(str(path), thickness=T, supports=(("top", "y"),), loads=(("right", "x"),),
+                                controls=(("elongation", (("right", "x", 1.0),)),))
+    with pytest.raises(MeshError, match=message) as err:
+        specimen.describe()
+    assert str(path) in str(err.value)
+
+
+def test_missing_and_unreadable_files(tmp_path):
+    with pytest.raises(MeshError, match="cannot read the mesh file"):
+        read_mesh(tmp_path / "none.msh")
+    bad = tmp_path / "bad.msh"
+    bad.write_text("$MeshFormat\nnonsense\n")
+    with pytest.raises(MeshError, match="not a mesh meshio can read"):
+        read_mesh(bad)
+
+
+def test_bad_specimen_fields():
+    with pytest.raises(ValueError, match="thickness"):
+        MeshSpecimen("x.msh", thickness=0.0, supports=(), loads=(("a", "x"),), controls=(("c", ()),))
+    with pytest.raises(ValueError, match="component 'z'; use 'x' or 'y'"):
+        from fracid.specimens.mesh import _component
+        _component("z", "supports")
