@@ -125,3 +125,41 @@ def test_bad_specimen_fields():
     with pytest.raises(ValueError, match="component 'z'; use 'x' or 'y'"):
         from fracid.specimens.mesh import _component
         _component("z", "supports")
+
+
+def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp_path):
+    """The half beam's mesh written as a linear quadrilateral Gmsh mesh, its node sets as line and point groups:
+    fracid rebuilds the Q8 mesh (renumbered) and the same force-CMOD curve."""
+    from fracid.specimens.beam import NotchedBeam
+
+    beam = NotchedBeam(h_fine=4.0, h_coarse=12.0)
+    d = beam.describe()
+    corners = d.cells[:, :4]
+    sides = np.stack([corners, np.roll(corners, -1, axis=1), d.cells[:, 4:]], axis=-1).reshape(-1, 3)
+    blocks, physical, field_data = [("quad", corners)], [np.zeros(len(corners), dtype=int)], {"domain": [100, 2]}
+    for tag, name in enumerate(["ligament", "support", "support_point", "loading_plate", "mouth"], start=1):
+        members = set(d.nodes_of(name).tolist())
+        lines = np.array([side[:2] for side in sides.tolist() if set(side) <= members], dtype=int).reshape(-1, 2)
+        points = np.array(sorted(v for v in members if v < d.n_vertices), dtype=int)[:, None]
+        blocks += [("line", lines), ("vertex", points)]
+        physical += [np.full(len(lines), tag), np.full(len(points), tag)]
+        field_data[name + "_lines"], field_data[name] = [tag, 1], [tag, 0]
+    physical[0][:] = 100
+    blocks = [(kind, data) for kind, data in blocks if len(data)]
+    physical = [tags for tags in physical if len(tags)]
+    xyz = np.column_stack([d.nodes[:d.n_vertices], np.zeros(d.n_vertices)])
+    path = tmp_path / "beam.msh"
+    meshio.write(path, meshio.Mesh(xyz, blocks, cell_data={"gmsh:physical": physical, "gmsh:geometrical": physical},
+                                   field_data={k: np.array(v) for k, v in field_data.items()}),
+                 file_format="gmsh22", binary=False)
+    rebuilt = MeshSpecimen(str(path), thickness=beam.thickness, supports=(("support_lines", "y"),),
+                           loads=(("loading_plate_lines", "y", True, -0.5),), symmetry=(("ligament_lines", "x"),),
+                           controls=(("cmod", (("mouth", "x", 2.0),)), ("deflection", (("loading_plate_lines", "y", -1.0),))),
+                           symmetry_factor=2.0)
+    assert len(rebuilt.describe().nodes_of("ligament_lines")) == len(d.nodes_of("ligament"))
+    params = fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=1.1e-4, alpha=0.99, beta=500.0, c=4.0, eta=10.0)
+    runs = [DamageModel().simulate(s, params, target=0.05, stop_force_fraction=None, control="cmod")
+            for s in (beam, rebuilt)]
+    assert runs[1].n_steps == runs[0].n_steps and runs[0].force[-1] < 0.97 * runs[0].peak_force  # past the peak
+    np.testing.assert_allclose(runs[1].control, runs[0].control, rtol=1e-9)
+    np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-6 * runs[0].peak_force)

@@ -40,9 +40,11 @@ class MeshSpecimen:
         Out-of-plane thickness [mm].
     supports : tuple of (group, component)
         The ``component`` ("x" or "y") of the nodes of each group held at zero.
-    loads : tuple of (group, component) or (group, component, rigid)
-        The load pattern: a unit force along ``component`` on the group, its nodes tied together
-        (``rigid``, the default: a loading plate, or one point) or the force spread evenly.
+    loads : tuple of (group, component[, rigid[, force]])
+        The load pattern: ``force`` (default 1) per unit load factor along ``component`` on the group,
+        its nodes tied together (``rigid``, the default: a loading plate, or one point) or the force
+        spread evenly. A half model that carries half the force has force 0.5 (-0.5 downwards), so that
+        the load factor is the whole specimen's force [N].
     controls : tuple of (name, ((group, component, weight), ...))
         Named functionals: ``weight`` times the mean displacement of the group along the component,
         summed (a CMOD: the right lip's x minus the left lip's x). The first is the default control.
@@ -109,6 +111,13 @@ class MeshSpecimen:
             for group, *_ in terms:
                 yield group
 
+    def default_steps(self, target: float):
+        """Adaptive steps capped at 1/60 of the target (as the notched beam), so the softening branch
+        takes tens of steps."""
+        from fracid.fem.path_following import StepOptions
+
+        return StepOptions(maximum=target / 60)
+
     def default_target(self, scales) -> float:
         raise ValueError(f"a mesh specimen has no default target: give target= (the final {self.default_control} "
                          "[mm])")
@@ -125,7 +134,12 @@ def _component(value, where) -> int:
 
 def _load(item) -> Load:
     group, component, *rest = item
-    return Load(group, _component(component, "loads"), 1.0, rigid=bool(rest[0]) if rest else True)
+    rigid = bool(rest[0]) if rest else True
+    total = float(rest[1]) if len(rest) > 1 else 1.0
+    if not (np.isfinite(total) and total != 0.0):
+        raise ValueError(f"MeshSpecimen.loads: the force of group {group!r} is {total!r} per unit load factor; "
+                         "it must be finite and non-zero")
+    return Load(group, _component(component, "loads"), total, rigid=rigid)
 
 
 @dataclass(frozen=True, eq=False)
