@@ -163,3 +163,59 @@ def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp
     assert runs[1].n_steps == runs[0].n_steps and runs[0].force[-1] < 0.97 * runs[0].peak_force  # past the peak
     np.testing.assert_allclose(runs[1].control, runs[0].control, rtol=1e-9)
     np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-6 * runs[0].peak_force)
+
+
+CONFIG = """
+[model]
+type = "gradient-damage"
+[model.parameters]
+E = 30000.0
+kappa_i = 1e-4
+beta = 300.0
+c = 4.0
+
+[specimen]
+type = "mesh"
+file = "strip.msh"
+thickness = 5.0
+supports = [{group = "left", component = "x"}, {group = "origin", component = "y"}]
+loads = [{group = "right", component = "x"}]
+[specimen.controls]
+elongation = [{group = "right", component = "x"}]
+
+[simulate]
+target = 0.01
+stop_force_fraction = 0.5
+"""
+
+
+def test_a_mesh_specimen_runs_from_the_command_line(tmp_path):
+    from fracid import cli
+
+    write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
+    (tmp_path / "strip.toml").write_text(CONFIG)
+    assert cli.main(["simulate", str(tmp_path / "strip.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert any((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize("replace, words", [
+    ('file = "strip.msh"', ["specimen.file", "file not found"]),
+    ('{group = "left", component = "x"}', ["specimen.supports[0].component", "must be one of 'x', 'y'"]),
+    ('loads = [{group = "right", component = "x"}]', ["specimen.file", "no physical group 'top'"]),
+    ('elongation = [{group = "right", component = "x"}]', ["specimen.controls.elongation[0].weight", "non-zero"]),
+    ('thickness = 5.0', ["specimen.thickness", "must be a number > 0"]),
+])
+def test_bad_mesh_configs_name_the_key(tmp_path, replace, words):
+    from fracid.config import ConfigError, load_config
+
+    write_msh(tmp_path / "strip.msh", *grid(2, 1, True), "triangle")
+    broken = {'file = "strip.msh"': 'file = "none.msh"',
+              '{group = "left", component = "x"}': '{group = "left", component = "z"}',
+              'loads = [{group = "right", component = "x"}]': 'loads = [{group = "top", component = "x"}]',
+              'elongation = [{group = "right", component = "x"}]': 'elongation = [{group = "right", component = "x", weight = 0}]',
+              'thickness = 5.0': 'thickness = -5.0'}[replace]
+    (tmp_path / "bad.toml").write_text(CONFIG.replace(replace, broken))
+    with pytest.raises(ConfigError) as err:
+        load_config(tmp_path / "bad.toml", purpose="simulate")
+    for word in words:
+        assert word in str(err.value)

@@ -167,6 +167,9 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
     default_name = "global" if quantity == "force" else quantity
     name = ck.string(f"{prefix}.name", raw.get("name", default_name), "must be a non-empty string")
     overrides = ()
+    if "specimen" in raw and specimen.type == "mesh":
+        ck.fail(f"{prefix}.specimen", raw["specimen"], "a mesh specimen takes no per-experiment overrides yet; "
+                "run the experiments of different meshes from configurations of their own")
     if "specimen" in raw:
         cls = _specimen_class(specimen.type)
         fields = [f.name for f in dataclasses.fields(cls)]

@@ -8,6 +8,8 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
+
 from fracid.config.checker import _Checker, _read_toml
 from fracid.config.experiments import _data_limit_text, _experiments
 from fracid.config.identify import _identify
@@ -60,7 +62,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     raw = ck.table("", _read_toml(path), _TOP_KEYS)
     base = path.parent
     model = _model(ck, raw.get("model"))
-    specimen = _specimen(ck, raw.get("specimen"))
+    specimen = _specimen(ck, raw.get("specimen"), base)
     _check_model_runs_on(ck, model, specimen)
     experiments = _experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
@@ -101,7 +103,11 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
     cls = _specimen_class(specimen.type)
     for prefix, options, given in variants:
         built = cls(**options)
-        if specimen.type == "bar":
+        if specimen.type == "mesh":
+            h = _smallest_side(built.describe())
+            size = f"specimen.file = {built.path!r}: its smallest element side, {h:.3g} mm,"
+            advice = "refine the mesh where the crack runs to sides <= l/2"
+        elif specimen.type == "bar":
             h = built.length / built.n_elements
             key, default = _field_key(prefix, "n_elements", options, given)
             size = f"{key} = {built.n_elements}{default}: the element size length / n_elements = {h:.3g} mm"
@@ -116,6 +122,12 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
         if h > length:
             ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
                     f"the damage band is not resolved and the results depend on the mesh; {advice}")
+
+
+def _smallest_side(description) -> float:
+    """The shortest element side of a plane mesh [mm] (corner to corner)."""
+    corners = description.nodes[description.cells[:, :(3 if description.cells.shape[1] == 6 else 4)]]
+    return float(np.min(np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=-1)))
 
 
 def _model_parameters(model: ModelConfig):

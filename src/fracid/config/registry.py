@@ -24,6 +24,10 @@ def _model_of(kind: str):
 
 
 def _specimen_class(kind: str):
+    if kind == "mesh":  # the user's own (fracid.config.mesh_section), not a built-in geometry
+        from fracid.specimens.mesh import MeshSpecimen
+
+        return MeshSpecimen
     return SPECIMENS[kind]
 
 

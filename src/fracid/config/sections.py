@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 
 from fracid.config.checker import _bytes, _Checker, _show
+from fracid.config.mesh_section import MESH_TYPE, mesh_specimen
 from fracid.config.registry import _SPECIMENS, _model_of, _model_types, _specimen_class
 from fracid.config.schema import (
     _MODEL_KEYS,
@@ -86,6 +87,11 @@ def _model(ck: _Checker, raw) -> ModelConfig:
 def _check_model_runs_on(ck: _Checker, model: ModelConfig, specimen) -> None:
     from fracid.models import runs_on
 
+    if specimen.type == MESH_TYPE:
+        built = _specimen_class(specimen.type)(**dict(specimen.options))
+        if not runs_on(_model_of(model.type), built):
+            ck.fail("model.type", model.type, f"does not run on this mesh specimen: {_model_of(model.type).why_not(built)}")
+        return
     if not runs_on(_model_of(model.type), _specimen_class(specimen.type)):
         fits = [kind for kind in _SPECIMENS if runs_on(_model_of(model.type), _specimen_class(kind))]
         ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it; it runs on "
@@ -179,14 +185,17 @@ def _check_specimen_size(ck: _Checker, prefix: str, kind: str, cls, options: dic
             "use a larger h_fine (a few elements per internal length l = sqrt(2 c) are enough)")
 
 
-def _specimen(ck: _Checker, raw) -> SpecimenConfig:
+def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
+    types = (*_SPECIMENS, MESH_TYPE)
     if raw is None:
-        ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in _SPECIMENS))
+        ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in types))
     if not isinstance(raw, dict):
         ck.fail("specimen", raw, "must be a table (section)")
     if "type" not in raw:
-        ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in _SPECIMENS))
-    kind = ck.choice("specimen.type", raw["type"], tuple(_SPECIMENS))
+        ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in types))
+    kind = ck.choice("specimen.type", raw["type"], types)
+    if kind == MESH_TYPE:
+        return mesh_specimen(ck, raw, base if base is not None else ck.path.parent)
     cls = _specimen_class(kind)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     ck.table("specimen", raw, ("type", "control", *fields))

@@ -1,0 +1,131 @@
+"""``[specimen] type = "mesh"``: the user's own plane-stress test from a Gmsh mesh and the names of its
+physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
+
+.. code-block:: toml
+
+    [specimen]
+    type = "mesh"
+    file = "beam.msh"                  # relative to the configuration file
+    thickness = 50.0                   # [mm]
+    scale = 1.0                        # mm per unit of the mesh (1000 for a mesh in metres)
+    symmetry_factor = 2.0              # a half model
+    control = "cmod"                   # default: the first control
+    supports = [{group = "support", component = "y"}]
+    loads = [{group = "plate", component = "y", force = -0.5, rigid = true}]
+    symmetry = [{group = "ligament", component = "x"}]
+    [specimen.controls]
+    cmod = [{group = "mouth", component = "x", weight = 2.0}]
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from fracid.config.checker import ConfigError, _Checker
+from fracid.config.schema import SpecimenConfig
+
+MESH_TYPE = "mesh"
+_KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls")
+_COMPONENT = "must be 'x' or 'y'"
+
+
+def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
+    """The validated ``[specimen]`` of a mesh: the file is read and every group named is checked."""
+    ck.table("specimen", raw, _KEYS)
+    for key in ("file", "thickness", "supports", "loads", "controls"):
+        if key not in raw:
+            ck.missing(f"specimen.{key}", _ALLOWED[key])
+    options = {
+        "path": str(ck.file("specimen.file", raw["file"], base)),
+        "thickness": ck.number("specimen.thickness", raw["thickness"], "must be a number > 0 [mm]", lambda v: v > 0),
+        "scale": ck.number("specimen.scale", raw.get("scale", 1.0), "must be a number > 0 (mm per mesh unit)",
+                           lambda v: v > 0),
+        "symmetry_factor": ck.number("specimen.symmetry_factor", raw.get("symmetry_factor", 1.0),
+                                     "must be a number >= 1 (copies of the model in the specimen)", lambda v: v >= 1),
+        "supports": _group_list(ck, "specimen.supports", raw["supports"]),
+        "loads": _loads(ck, raw["loads"]),
+        "symmetry": _group_list(ck, "specimen.symmetry", raw.get("symmetry", [])),
+        "controls": _controls(ck, raw["controls"]),
+    }
+    names = tuple(name for name, _ in options["controls"])
+    control = ck.choice("specimen.control", raw.get("control", names[0]), names)
+    _check_mesh(ck, options)
+    return SpecimenConfig(type=MESH_TYPE, control=control, options=tuple(options.items()))
+
+
+_ALLOWED = {
+    "file": "a Gmsh .msh file with physical groups, relative to the config file",
+    "thickness": "the out-of-plane thickness [mm]",
+    "supports": "a list of {group, component}: the nodes held at zero",
+    "loads": "a list of {group, component, force = 1.0, rigid = true}",
+    "controls": "a table of named lists of {group, component, weight = 1.0} (e.g. cmod = [...])",
+}
+
+
+def _items(ck, key, value, allowed):
+    if not isinstance(value, list) or not all(isinstance(item, dict) for item in value):
+        ck.fail(key, value, f"must be a list of tables {allowed}")
+    return value
+
+
+def _group_component(ck, where, item, extra=()) -> tuple:
+    """(group, component) of one table ``{group, component, *extra}``."""
+    ck.table(where, item, ("group", "component", *extra))
+    for name in ("group", "component"):
+        if name not in item:
+            ck.missing(f"{where}.{name}", "a physical group name" if name == "group" else _COMPONENT)
+    return (ck.string(f"{where}.group", item["group"], "must be a physical group name"),
+            ck.choice(f"{where}.component", item["component"], ("x", "y")))
+
+
+def _group_list(ck, key, value) -> tuple:
+    return tuple(_group_component(ck, f"{key}[{i}]", item)
+                 for i, item in enumerate(_items(ck, key, value, "{group, component}")))
+
+
+def _loads(ck, value) -> tuple:
+    key = "specimen.loads"
+    if not _items(ck, key, value, "{group, component, force, rigid}"):
+        ck.fail(key, value, "must name at least one group the force acts on")
+    out = []
+    for i, item in enumerate(value):
+        where = f"{key}[{i}]"
+        group, component = _group_component(ck, where, item, ("force", "rigid"))
+        force = ck.number(f"{where}.force", item.get("force", 1.0), "must be a non-zero number [N per unit load factor]",
+                          lambda v: v != 0)
+        rigid = item.get("rigid", True)
+        if not isinstance(rigid, bool):
+            ck.fail(f"{where}.rigid", rigid, "must be true (the group's nodes move together) or false (force spread)")
+        out.append((group, component, rigid, force))
+    return tuple(out)
+
+
+def _controls(ck, value) -> tuple:
+    key = "specimen.controls"
+    if not isinstance(value, dict) or not value:
+        ck.fail(key, value, "must be a table of named controls, e.g. cmod = [{group = 'mouth', component = 'x'}]")
+    out = []
+    for name, terms in value.items():
+        where = f"{key}.{name}"
+        if not _items(ck, where, terms, "{group, component, weight}"):
+            ck.fail(where, terms, "must list at least one {group, component, weight}")
+        measured = []
+        for i, item in enumerate(terms):
+            group, component = _group_component(ck, f"{where}[{i}]", item, ("weight",))
+            weight = ck.number(f"{where}[{i}].weight", item.get("weight", 1.0), "must be a non-zero number",
+                               lambda v: v != 0)
+            measured.append((group, component, weight))
+        out.append((name, tuple(measured)))
+    return tuple(out)
+
+
+def _check_mesh(ck: _Checker, options: dict) -> None:
+    """Read the mesh and describe the specimen once: a bad mesh or a group it lacks is a config error."""
+    from fracid.specimens.mesh import MeshSpecimen
+
+    try:
+        MeshSpecimen(**options).describe()
+    except ImportError as err:
+        raise ConfigError(f"{ck.path}: specimen.file: {err}") from None
+    except ValueError as err:
+        raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {err}") from None
