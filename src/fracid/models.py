@@ -251,7 +251,7 @@ class CrackBandModel(_CrackModel):
             width = np.full(len(d.cells), float(self.band_width))
         crackable = 1.0
         if d.crack.nodes is not None:
-            on_path = (d.nodes_of(d.crack.nodes)[None, None, :] == d.cells[:, :4, None]).any(axis=2).sum(axis=1) >= 2
+            on_path = (d.nodes_of(d.crack.nodes)[None, None, :] == d.corners[:, :, None]).any(axis=2).sum(axis=1) >= 2
             crackable = np.repeat(on_path[:, None], disc.weights.shape[1], axis=1).astype(float)
         if d.crack.mirrored and self.band_width is None:
             width = 2.0 * width

@@ -32,7 +32,7 @@ def crack_edges(nodes, cells, u_dofs, path_nodes, normal: int):
     Parameters
     ----------
     nodes, cells : ndarray
-        Mesh (8-node quadrilaterals).
+        Mesh (8-node quadrilaterals or 6-node triangles).
     u_dofs : ndarray of int, shape (n_el, n_u)
         Displacement dofs of each element.
     path_nodes : array_like of int

@@ -169,6 +169,13 @@ class Description:
     def dim(self) -> int:
         return self.nodes.shape[1]
 
+    @property
+    def corners(self) -> np.ndarray:
+        """The corner nodes of each plane cell (3 of a T6, 4 of a Q8), or the two vertices of a bar element."""
+        if self.dim == 1:
+            return self.cells
+        return self.cells[:, :3] if self.cells.shape[1] == 6 else self.cells[:, :4]
+
     def nodes_of(self, name: str) -> np.ndarray:
         try:
             return np.asarray(self.node_sets[name], dtype=int)
