@@ -155,7 +155,7 @@ def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp
     rebuilt = MeshSpecimen(str(path), thickness=beam.thickness, supports=(("support_lines", "y"),),
                            loads=(("loading_plate_lines", "y", True, -0.5),), symmetry=(("ligament_lines", "x"),),
                            controls=(("cmod", (("mouth", "x", 2.0),)), ("deflection", (("loading_plate_lines", "y", -1.0),))),
-                           symmetry_factor=2.0)
+                           symmetry_factor=2.0, crack=("ligament_lines", "x", beam.h_fine))
     assert len(rebuilt.describe().nodes_of("ligament_lines")) == len(d.nodes_of("ligament"))
     params = fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=1.1e-4, alpha=0.99, beta=500.0, c=4.0, eta=10.0)
     runs = [DamageModel().simulate(s, params, target=0.05, stop_force_fraction=None, control="cmod")
@@ -163,6 +163,22 @@ def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp
     assert runs[1].n_steps == runs[0].n_steps and runs[0].force[-1] < 0.97 * runs[0].peak_force  # past the peak
     np.testing.assert_allclose(runs[1].control, runs[0].control, rtol=1e-9)
     np.testing.assert_allclose(runs[1].force, runs[0].force, rtol=0, atol=1e-6 * runs[0].peak_force)
+    widths = [run.observables["fpz_width"] for run in runs]
+    assert widths[0][-1] > 0
+    np.testing.assert_allclose(widths[1], widths[0], rtol=0, atol=1e-6 * widths[0].max())
+    # the discrete cohesive crack opens along the same line; the built-in beam then rests on a roller at the
+    # support's centre and spreads the load over the plate (rigid plates would clamp the cracked halves)
+    from dataclasses import replace
+
+    from fracid.fem.cohesive import CohesiveParameters
+    from fracid.models import CohesiveCrackModel
+
+    open_crack = replace(rebuilt, supports=(("support_point", "y"),), loads=(("loading_plate_lines", "y", False, -0.5),))
+    hordijk = CohesiveParameters(E=37000.0, nu=0.2, ft=3.0, Gf=0.1)
+    cracks = [CohesiveCrackModel().simulate(s, hordijk, target=0.05, stop_force_fraction=None, control="cmod",
+                                            steps=beam.default_steps(0.05)) for s in (beam, open_crack)]
+    assert cracks[1].n_steps == cracks[0].n_steps
+    np.testing.assert_allclose(cracks[1].force, cracks[0].force, rtol=0, atol=1e-6 * cracks[0].peak_force)
 
 
 CONFIG = """

@@ -8,7 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from fracid.config.checker import _bytes, _Checker
-from fracid.config.registry import _SPECIMENS, _specimen_class
+from fracid.config.registry import _specimen_class, _specimen_observables
 from fracid.config.schema import (
     _CONTROL_UNITS,
     _DECIMALS,
@@ -81,7 +81,7 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
             ck.missing(f"{prefix}.{name}", _REQUIRED_TEXT[name])
         return raw[name]
 
-    _, observables = _SPECIMENS[specimen.type]
+    observables = _specimen_observables(specimen)
     quantity = ck.choice(f"{prefix}.quantity", raw.get("quantity", "force"), ("force", *observables))
     file = ck.file(f"{prefix}.file", required("file"), base)
     control_column = ck.string(f"{prefix}.control_column", required("control_column"), "must be a column name")

@@ -13,6 +13,8 @@ physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
     supports = [{group = "support", component = "y"}]
     loads = [{group = "plate", component = "y", force = -0.5, rigid = true}]
     symmetry = [{group = "ligament", component = "x"}]
+    crack = {group = "ligament", component = "x"}   # the crack line (x = const), the FPZ width across it;
+                                                    # element_size = 2.0 sets a cohesive crack's penalty
     [specimen.controls]
     cmod = [{group = "mouth", component = "x", weight = 2.0}]
 """
@@ -25,7 +27,8 @@ from fracid.config.checker import ConfigError, _Checker
 from fracid.config.schema import SpecimenConfig
 
 MESH_TYPE = "mesh"
-_KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls")
+_KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
+         "crack")
 _COMPONENT = "must be 'x' or 'y'"
 
 
@@ -46,6 +49,7 @@ def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
         "loads": _loads(ck, raw["loads"]),
         "symmetry": _group_list(ck, "specimen.symmetry", raw.get("symmetry", [])),
         "controls": _controls(ck, raw["controls"]),
+        "crack": _crack(ck, raw["crack"]) if "crack" in raw else (),
     }
     names = tuple(name for name, _ in options["controls"])
     control = ck.choice("specimen.control", raw.get("control", names[0]), names)
@@ -117,6 +121,15 @@ def _controls(ck, value) -> tuple:
             measured.append((group, component, weight))
         out.append((name, tuple(measured)))
     return tuple(out)
+
+
+def _crack(ck, value) -> tuple:
+    group, component = _group_component(ck, "specimen.crack", value, ("element_size",))
+    if "element_size" not in value:
+        return group, component
+    size = ck.number("specimen.crack.element_size", value["element_size"], "must be a number > 0 [mm]",
+                     lambda v: v > 0)
+    return group, component, size
 
 
 def _check_mesh(ck: _Checker, options: dict) -> None:

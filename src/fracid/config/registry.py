@@ -33,3 +33,10 @@ def _specimen_class(kind: str):
 
 #: specimen type -> (controls, the first being the default; local observables [mm])
 _SPECIMENS = {kind: (cls.controls, cls.observables) for kind, cls in SPECIMENS.items()}
+
+
+def _specimen_observables(specimen) -> tuple:
+    """The local observables of a validated ``[specimen]`` (a mesh's depend on its crack line)."""
+    if specimen.type == "mesh":
+        return _specimen_class("mesh")(**dict(specimen.options)).observables
+    return _SPECIMENS[specimen.type][1]

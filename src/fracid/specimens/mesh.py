@@ -13,11 +13,10 @@ from __future__ import annotations
 import functools
 import os
 from dataclasses import dataclass
-from typing import ClassVar
 
 import numpy as np
 
-from fracid.specimens.description import Description, Load, Measure, Support
+from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 
 _COMPONENTS = {"x": 0, "y": 1}
 _SURFACES = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4}
@@ -54,6 +53,12 @@ class MeshSpecimen:
         Copies of the model in the whole specimen (2 for a half model).
     scale : float
         Millimetres per unit of the mesh's coordinates (1000 for a mesh in metres).
+    crack : tuple (group, component[, element_size]) or ()
+        The straight line the crack runs along (its normal ``component``: "x" for a line x = const;
+        ``element_size`` [mm] sets a discrete crack's penalty, default the shortest side on the line):
+        the discrete cohesive crack opens there when the line is also a symmetry line of the model,
+        the crack band lies on it, and the damage models record the width of their damaged zone
+        across it (observable ``fpz_width``, doubled on a symmetry line).
     """
 
     path: str
@@ -64,8 +69,7 @@ class MeshSpecimen:
     symmetry: tuple = ()
     symmetry_factor: float = 1.0
     scale: float = 1.0
-
-    observables: ClassVar[tuple] = ()
+    crack: tuple = ()
 
     def __post_init__(self):
         if not (isinstance(self.thickness, (int, float)) and self.thickness > 0):
@@ -77,6 +81,11 @@ class MeshSpecimen:
         for name, _ in self.controls:
             if not isinstance(name, str) or not name:
                 raise ValueError(f"MeshSpecimen.controls: a control's name must be a non-empty string; got {name!r}")
+
+    @property
+    def observables(self) -> tuple:
+        """The local observables its damage models record: the damaged-zone width across the crack line."""
+        return ("fpz_width",) if self.crack else ()
 
     @property
     def default_control(self) -> str:
@@ -102,10 +111,29 @@ class MeshSpecimen:
             functionals={name: tuple(Measure(group, _component(component, f"controls[{name!r}]"), float(weight))
                                      for group, component, weight in terms) for name, terms in self.controls},
             symmetry_factor=float(self.symmetry_factor),
+            **self._crack(mesh),
         )
 
+    def _crack(self, mesh) -> dict:
+        """The crack path, the zone-width line and the symmetry plane along it (if it is one)."""
+        if not self.crack:
+            return {}
+        group, component, *size = self.crack
+        normal = _component(component, "crack")
+        line = mesh.nodes[mesh.node_sets[group]] * self.scale
+        coordinate = float(np.mean(line[:, normal]))
+        if np.ptp(line[:, normal]) > 1e-9 * max(np.ptp(mesh.nodes) * self.scale, 1.0):
+            raise MeshError(f"{self.path}: the crack group {group!r} is not a straight line "
+                            f"{'xy'[normal]} = const")
+        mirrored = any(g == group and _component(c, "symmetry") == normal for g, c in self.symmetry)
+        along = line[:, 1 - normal]
+        element_size = float(size[0]) if size else None
+        return {"crack": CrackPath(group, normal=normal, mirrored=mirrored, element_size=element_size),
+                "zone": ZoneWidth("fpz_width", axis=normal, mirror=mirrored, along_range=(along.min(), along.max())),
+                "symmetry_planes": ((normal, coordinate),) if mirrored else ()}
+
     def _groups(self):
-        for group, *_ in (*self.supports, *self.loads, *self.symmetry):
+        for group, *_ in (*self.supports, *self.loads, *self.symmetry, *([self.crack] if self.crack else [])):
             yield group
         for _, terms in self.controls:
             for group, *_ in terms:
