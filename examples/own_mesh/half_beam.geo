@@ -5,14 +5,16 @@
 // The beam is symmetric about mid-span: only x >= 0 is meshed. Lengths in mm.
 //
 //     y
-//     ^  loading_plate (x <= plate/2, y = D)
-//  D  +==+-------------------------------------------+
-//     |  :                                           |
-//     |  : <- ligament (x = 0, a0 <= y <= D)          |
-//  a0 +--+                                           |
-//       |<- notch flank (x = notch/2), free          |
-//   0   o-----------------------------[====]---------+--> x
-//     mouth (notch/2, 0)       support (S/2 +- plate/2)  L/2
+//     ^ loading_plate (0 <= x <= plate/2, y = D)
+//  D  +==+------------------------------------------------+
+//     |                                                   |
+//     | <- ligament (x = 0, a0 <= y <= D): symmetry line, |
+//     |    the crack runs along it                        |
+//  a0 +-+                                                 |
+//       | <- notch flank (x = notch/2), free              |
+//   0   o--------------------------------[===^===]--------+--> x
+//     mouth (notch/2, 0)          support (S/2 +- plate/2), L/2
+//                                 support_point ^ (S/2, 0)
 //
 // Mesh it with
 //     gmsh half_beam.geo -2 -format msh22 -o half_beam.msh
@@ -42,18 +44,20 @@ Point(6) = {plate/2, D, 0};        // loading plate, right end
 Point(7) = {0, D, 0};              // mid-span, top
 Point(8) = {0, a0, 0};             // notch tip on the symmetry line
 Point(9) = {notch/2, a0, 0};       // notch tip corner
+Point(10) = {S/2, 0, 0};           // support plate, centre (a roller for the open-crack models)
 
 Line(1) = {1, 2};   // bottom, free
-Line(2) = {2, 3};   // support plate
+Line(2) = {2, 10};  // support plate, left half
+Line(10) = {10, 3}; // support plate, right half
 Line(3) = {3, 4};   // bottom, free
 Line(4) = {4, 5};   // end of the beam, free
 Line(5) = {5, 6};   // top, free
 Line(6) = {6, 7};   // loading plate
-Line(7) = {7, 8};   // ligament (symmetry line above the notch)
+Line(7) = {7, 8};   // ligament (symmetry line above the notch, the crack line)
 Line(8) = {8, 9};   // notch tip, free
 Line(9) = {9, 1};   // notch flank, free
 
-Curve Loop(1) = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+Curve Loop(1) = {1, 2, 10, 3, 4, 5, 6, 7, 8, 9};
 Plane Surface(1) = {1};
 
 // element size: h_fine within fine_width of the ligament, growing to h_far; h_plate at the support
@@ -67,7 +71,7 @@ Field[2].SizeMax = h_far;
 Field[2].DistMin = fine_width;
 Field[2].DistMax = fine_width + 30.0;
 Field[3] = Distance;
-Field[3].CurvesList = {2};
+Field[3].CurvesList = {2, 10};
 Field[3].Sampling = 20;
 Field[4] = Threshold;
 Field[4].InField = 3;
@@ -90,6 +94,7 @@ Mesh.SaveAll = 0;         // save only the physical groups: no orphan nodes
 // the names fracid's identify.toml refers to
 Physical Surface("domain") = {1};
 Physical Curve("ligament") = {7};       // symmetry: u_x = 0
-Physical Curve("support") = {2};        // u_y = 0
+Physical Curve("support") = {2, 10};    // u_y = 0 over the support plate
+Physical Point("support_point") = {10}; // u_y = 0 at its centre only: the support of the open-crack models
 Physical Curve("loading_plate") = {6};  // rigid plate carrying the load; its y displacement is the deflection
 Physical Point("mouth") = {1};          // CMOD = 2 u_x(mouth)
