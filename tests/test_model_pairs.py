@@ -5,22 +5,22 @@ import pytest
 
 from fracid.fem.cohesive import CohesiveParameters
 from fracid.models import MODEL_TYPES, CohesiveCrackModel, CrackBandModel, model_from_type, runs_on
-from fracid.specimens import SPECIMENS, BarWithWeakZone, DogBone, NotchedBeam, TensionStrip
+from fracid.specimens import SPECIMENS, BarWithWeakZone, DogBone, NotchedBeam, TensionStrip, WedgeSplitting
 
 # model type -> specimens it runs on (the README's table of pairs)
 PAIRS = {
-    "gradient-damage": {BarWithWeakZone, NotchedBeam, DogBone},
-    "local-damage": {BarWithWeakZone, NotchedBeam, DogBone},
-    "integral-damage": {BarWithWeakZone, NotchedBeam, DogBone},
-    "cohesive-crack": {NotchedBeam, DogBone},
-    "crack-band": {NotchedBeam, DogBone, TensionStrip},
+    "gradient-damage": {BarWithWeakZone, NotchedBeam, DogBone, WedgeSplitting},
+    "local-damage": {BarWithWeakZone, NotchedBeam, DogBone, WedgeSplitting},
+    "integral-damage": {BarWithWeakZone, NotchedBeam, DogBone, WedgeSplitting},
+    "cohesive-crack": {NotchedBeam, DogBone, WedgeSplitting},
+    "crack-band": {NotchedBeam, DogBone, TensionStrip, WedgeSplitting},
 }
 
 
 @pytest.mark.parametrize("kind", sorted(MODEL_TYPES))
 def test_the_table_of_pairs(kind):
     specimens = [BarWithWeakZone(n_elements=20), NotchedBeam(h_fine=5.0, h_coarse=10.0), DogBone(size=50.0, h_fine=5.0),
-                 TensionStrip()]
+                 TensionStrip(), WedgeSplitting(h_fine=10.0, h_coarse=40.0)]
     model = model_from_type(kind)
     assert {type(s) for s in specimens if runs_on(model, s)} == PAIRS[kind]
     for specimen in specimens:

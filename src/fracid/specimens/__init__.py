@@ -10,7 +10,8 @@ from fracid.specimens.bar import BarWithWeakZone
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 from fracid.specimens.strip import TensionStrip
+from fracid.specimens.wedge import WedgeSplitting
 
-SPECIMENS = {"notched-beam": NotchedBeam, "dogbone": DogBone, "bar": BarWithWeakZone}
+SPECIMENS = {"notched-beam": NotchedBeam, "dogbone": DogBone, "bar": BarWithWeakZone, "wedge-splitting": WedgeSplitting}
 
-__all__ = ["BarWithWeakZone", "DogBone", "NotchedBeam", "SPECIMENS", "TensionStrip"]
+__all__ = ["BarWithWeakZone", "DogBone", "NotchedBeam", "SPECIMENS", "TensionStrip", "WedgeSplitting"]

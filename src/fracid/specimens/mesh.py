@@ -96,7 +96,10 @@ class MeshSpecimen:
         return tuple(name for name, _ in self.controls)
 
     def describe(self) -> Description:
-        mesh = read_mesh(self.path)
+        return self.describe_mesh(read_mesh(self.path))
+
+    def describe_mesh(self, mesh: PlaneMesh) -> Description:
+        """The description of this test on ``mesh`` (its node sets named as the groups here)."""
         groups = set(self._groups())
         missing = sorted(groups - set(mesh.node_sets))
         if missing:
