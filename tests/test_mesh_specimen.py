@@ -267,3 +267,22 @@ def test_the_triangle_meshed_beam_matches_the_built_in_q8_beam(tmp_path):
     assert abs(triangles.peak_force / built_in.peak_force - 1.0) < 5e-3
     difference = np.interp(points, triangles.control, triangles.force) - np.interp(points, built_in.control, built_in.force)
     assert np.max(np.abs(difference)) < 1.5e-2 * built_in.peak_force
+
+
+def test_twin_identification_of_c_and_beta_on_a_triangle_meshed_beam(tmp_path):
+    """Noise-free CMOD data of the gradient model on the beam meshed with triangles at (c, beta) = (4, 500):
+    Gauss-Newton with the exact sensitivities from (6, 400) finds them back within 1 %."""
+    from fracid.inverse.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.gauss_newton import gauss_newton
+    from fracid.specimens.beam import NotchedBeam
+
+    specimen = beam_msh(NotchedBeam(h_fine=4.0, h_coarse=12.0), tmp_path / "beam.msh", triangles=True)
+    operator = ForwardOperator([Observation(specimen, np.linspace(0.01, 0.08, 10), control="cmod")], PEER,
+                               ("c", "beta"))
+    truth = np.array([4.0, 500.0])
+    y = operator(truth).y
+    std = 0.01 * np.abs(y).max()
+    result = gauss_newton(operator.differentiated(), y, np.eye(y.size) * std**2, np.array([6.0, 400.0]),
+                          np.diag([3.0, 200.0]) ** 2, bounds=(np.array([1.0, 100.0]), np.array([20.0, 2000.0])),
+                          tol=1e-3)
+    np.testing.assert_allclose(result.x, truth, rtol=1e-2)
