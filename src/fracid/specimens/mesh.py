@@ -321,3 +321,39 @@ def _node_sets(blocks, cell_sets, renumber, edges, n_vertices, path) -> dict:
         if nodes:
             sets[group] = np.unique(np.concatenate(nodes))
     return sets
+
+
+def write_gmsh(description: Description, path, triangles: bool = False) -> None:
+    """Write a plane description's mesh as a linear Gmsh 2.2 file whose physical groups are its node sets,
+    to start one's own specimen from a built-in one (and to check the mesh reader against it).
+
+    The cells are the corners of the quadrilaterals, or each split in two triangles along its diagonal
+    0-2 (``triangles``). A node set becomes a group of the element sides whose three nodes it holds
+    (dimension 1), its other corners a group of points named ``<set>_points`` (or ``<set>`` when it
+    has no side: a point set).
+    """
+    import meshio
+
+    d = description
+    corners = d.corners
+    if corners.shape[1] != 4 or d.cells.shape[1] != 8:
+        raise ValueError("write_gmsh writes the meshes of 8-node quadrilaterals")
+    sides = np.stack([corners, np.roll(corners, -1, axis=1), d.cells[:, 4:]], axis=-1).reshape(-1, 3)
+    cells = np.vstack([corners[:, [0, 1, 2]], corners[:, [0, 2, 3]]]) if triangles else corners
+    blocks, physical, names = [("triangle" if triangles else "quad", cells)], [np.full(len(cells), 1)], {}
+    for name in sorted(d.node_sets):
+        members = np.zeros(len(d.nodes), dtype=bool)
+        members[d.nodes_of(name)] = True
+        lines = sides[members[sides].all(axis=1)][:, :2]
+        alone = np.setdiff1d(np.flatnonzero(members[:d.n_vertices]), lines)
+        for kind, data, dim, label in (("line", lines, 1, name), ("vertex", alone[:, None], 0,
+                                                                   name if not len(lines) else f"{name}_points")):
+            if len(data):
+                tag = len(names) + 2
+                blocks.append((kind, data))
+                physical.append(np.full(len(data), tag))
+                names[label] = [tag, dim]
+    points = np.column_stack([d.nodes[:d.n_vertices], np.zeros(d.n_vertices)])
+    mesh = meshio.Mesh(points, blocks, cell_data={"gmsh:physical": physical, "gmsh:geometrical": physical},
+                       field_data={"domain": np.array([1, 2]), **{k: np.array(v) for k, v in names.items()}})
+    meshio.write(path, mesh, file_format="gmsh22", binary=False)
