@@ -265,3 +265,13 @@ def test_twin_identification_of_c_and_beta_on_a_triangle_meshed_beam(tmp_path):
                           np.diag([3.0, 200.0]) ** 2, bounds=(np.array([1.0, 100.0]), np.array([20.0, 2000.0])),
                           tol=1e-3)
     np.testing.assert_allclose(result.x, truth, rtol=1e-2)
+
+
+def test_an_edited_mesh_file_is_another_specimen(tmp_path):
+    from fracid.store import key_for
+
+    path = write_msh(tmp_path / "strip.msh", *grid(2, 1, True), "triangle")
+    first = strip(path)
+    assert first == strip(path) and key_for(s=first) == key_for(s=strip(path))
+    write_msh(path, *grid(3, 1, True), "triangle")
+    assert key_for(s=strip(path)) != key_for(s=first)  # the run store keys differ

@@ -11,6 +11,7 @@ times ``scale`` [mm].
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
 from dataclasses import dataclass
 
@@ -53,6 +54,9 @@ class MeshSpecimen:
         Copies of the model in the whole specimen (2 for a half model).
     scale : float
         Millimetres per unit of the mesh's coordinates (1000 for a mesh in metres).
+    checksum : str
+        SHA-256 of the mesh file, computed when the specimen is made (do not give it): it is part of
+        the specimen's identity, so the run store does not reuse runs of an edited mesh.
     crack : tuple (group, component[, element_size]) or ()
         The straight line the crack runs along (its normal ``component``: "x" for a line x = const;
         ``element_size`` [mm] sets a discrete crack's penalty, default the shortest side on the line):
@@ -70,8 +74,12 @@ class MeshSpecimen:
     symmetry_factor: float = 1.0
     scale: float = 1.0
     crack: tuple = ()
+    checksum: str = ""
 
     def __post_init__(self):
+        if not self.checksum and os.path.isfile(self.path):
+            with open(self.path, "rb") as handle:
+                object.__setattr__(self, "checksum", hashlib.sha256(handle.read()).hexdigest())
         if not (isinstance(self.thickness, (int, float)) and self.thickness > 0):
             raise ValueError(f"MeshSpecimen.thickness = {self.thickness!r} mm; it must be positive")
         if not self.controls:
