@@ -275,3 +275,28 @@ def test_an_edited_mesh_file_is_another_specimen(tmp_path):
     assert first == strip(path) and key_for(s=first) == key_for(s=strip(path))
     write_msh(path, *grid(3, 1, True), "triangle")
     assert key_for(s=strip(path)) != key_for(s=first)  # the run store keys differ
+
+
+def test_regions_of_their_own_stiffness_stay_elastic():
+    """The left half of the strip is a stiff elastic block (5 E, no damage): springs in series, and the damage
+    only in the right half."""
+    points, cells, left, right, corner = grid(6, 2, False)
+    centres = points[cells, 0].mean(axis=1)
+    blocks = [("quad", cells), ("line", left), ("line", right), ("vertex", corner)]
+    groups = {"steel": {"quad": np.flatnonzero(centres < L / 2)}, "left": {"line": np.arange(len(left))},
+              "right": {"line": np.arange(len(left), len(left) + len(right))}, "origin": {"vertex": np.array([0])}}
+    blocks = [blocks[0], ("line", np.vstack([left, right])), blocks[3]]
+    specimen = MeshSpecimen("strip", thickness=T, supports=(("left", "x"), ("origin", "y")), loads=(("right", "x"),),
+                            controls=(("elongation", (("right", "x", 1.0),)),), regions=(("steel", 5.0, False),))
+    description = specimen.describe_mesh(plane_mesh(points, blocks, groups))
+    params = fracid.DamageParameters(E=E, nu=0.0, kappa_i=1e-4, beta=300.0, c=4.0)  # nu 0: no lateral mismatch
+    result = DamageModel().simulate(description, params, target=0.006, stop_force_fraction=None,
+                                    control="elongation", steps=specimen.default_steps(0.006))
+    slope = result.force[1] / result.control[1]
+    assert slope == pytest.approx(H * T / (0.5 * L / (5 * E) + 0.5 * L / E), rel=1e-9)
+    kappa = result.fields[result.n_steps]["kappa"]
+    steel = np.flatnonzero(centres < L / 2)
+    assert np.all(kappa[steel] <= 1e-4 * 1.0001) and np.max(kappa) > 2e-4  # only the concrete half damaged
+    with pytest.raises(MeshError, match="region 'left' is no physical surface"):
+        MeshSpecimen("strip", thickness=T, supports=(), loads=(("right", "x"),), controls=(("e", (("right", "x", 1.0),)),),
+                     regions=(("left", 5.0, False),)).describe_mesh(plane_mesh(points, blocks, groups))

@@ -13,6 +13,7 @@ physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
     supports = [{group = "support", component = "y"}]
     loads = [{group = "plate", component = "y", force = -0.5, rigid = true}]
     symmetry = [{group = "ligament", component = "x"}]
+    regions = [{group = "platen", stiffness_factor = 5.8, damageable = false}]  # a steel platen
     crack = {group = "ligament", component = "x"}   # the crack line (x = const), the FPZ width across it;
                                                     # element_size = 2.0 sets a cohesive crack's penalty
     [specimen.controls]
@@ -28,7 +29,7 @@ from fracid.config.schema import SpecimenConfig
 
 MESH_TYPE = "mesh"
 _KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
-         "crack")
+         "crack", "regions")
 _COMPONENT = "must be 'x' or 'y'"
 
 
@@ -50,6 +51,7 @@ def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
         "symmetry": _group_list(ck, "specimen.symmetry", raw.get("symmetry", [])),
         "controls": _controls(ck, raw["controls"]),
         "crack": _crack(ck, raw["crack"]) if "crack" in raw else (),
+        "regions": _regions(ck, raw.get("regions", [])),
     }
     names = tuple(name for name, _ in options["controls"])
     control = ck.choice("specimen.control", raw.get("control", names[0]), names)
@@ -130,6 +132,24 @@ def _crack(ck, value) -> tuple:
     size = ck.number("specimen.crack.element_size", value["element_size"], "must be a number > 0 [mm]",
                      lambda v: v > 0)
     return group, component, size
+
+
+def _regions(ck, value) -> tuple:
+    key = "specimen.regions"
+    out = []
+    for i, item in enumerate(_items(ck, key, value, "{group, stiffness_factor, damageable}")):
+        where = f"{key}[{i}]"
+        ck.table(where, item, ("group", "stiffness_factor", "damageable"))
+        if "group" not in item:
+            ck.missing(f"{where}.group", "a physical surface's name")
+        group = ck.string(f"{where}.group", item["group"], "must be a physical surface's name")
+        factor = ck.number(f"{where}.stiffness_factor", item.get("stiffness_factor", 1.0),
+                           "must be a number > 0 (Young's modulus relative to the material's)", lambda v: v > 0)
+        damageable = item.get("damageable", True)
+        if not isinstance(damageable, bool):
+            ck.fail(f"{where}.damageable", damageable, "must be true or false (false: stays elastic, e.g. steel)")
+        out.append((group, factor, damageable))
+    return tuple(out)
 
 
 def _check_mesh(ck: _Checker, options: dict) -> None:

@@ -136,7 +136,7 @@ class Description:
         Copies of the model in the whole specimen.
     symmetry_planes : tuple of (axis, coordinate)
         Symmetry planes of a half or quarter model.
-    stiffness_factor, damageable, strength_factor : callable (points (..., dim)) -> ndarray (...)
+    stiffness_factor, damageable, strength_factor : callable (points (..., dim)) -> ndarray (...), or ndarray (n_el,)
         Young's modulus relative to the material's, 1 where the material may soften (0 in elastic
         loading blocks), tensile strength relative to the material's (an imperfection), at any points.
     crack : CrackPath, optional
@@ -252,5 +252,8 @@ def _functional(d: Description, terms, rigid: dict) -> dict:
 
 
 def at_points(function, disc) -> np.ndarray:
-    """A description's field (stiffness, damageable, strength) at the integration points."""
-    return np.broadcast_to(np.asarray(function(disc.points), dtype=float), disc.weights.shape)
+    """A description's field (stiffness, damageable, strength) at the integration points: a function of
+    the points, or an array of one value per element (a mesh's regions)."""
+    if callable(function):
+        return np.broadcast_to(np.asarray(function(disc.points), dtype=float), disc.weights.shape)
+    return np.broadcast_to(np.asarray(function, dtype=float)[:, None], disc.weights.shape)

@@ -54,6 +54,9 @@ class MeshSpecimen:
         Copies of the model in the whole specimen (2 for a half model).
     scale : float
         Millimetres per unit of the mesh's coordinates (1000 for a mesh in metres).
+    regions : tuple of (group, stiffness_factor, damageable)
+        Physical surfaces of other materials: Young's modulus relative to the material's, and whether
+        they may damage (false for steel platens or loading blocks). Elsewhere 1 and true.
     checksum : str
         SHA-256 of the mesh file, computed when the specimen is made (do not give it): it is part of
         the specimen's identity, so the run store does not reuse runs of an edited mesh.
@@ -74,6 +77,7 @@ class MeshSpecimen:
     symmetry_factor: float = 1.0
     scale: float = 1.0
     crack: tuple = ()
+    regions: tuple = ()
     checksum: str = ""
 
     def __post_init__(self):
@@ -122,8 +126,24 @@ class MeshSpecimen:
             functionals={name: tuple(Measure(group, _component(component, f"controls[{name!r}]"), float(weight))
                                      for group, component, weight in terms) for name, terms in self.controls},
             symmetry_factor=float(self.symmetry_factor),
-            **self._crack(mesh),
+            **self._crack(mesh), **self._regions(mesh),
         )
+
+    def _regions(self, mesh) -> dict:
+        """Per-element stiffness factor and damageability of the regions."""
+        if not self.regions:
+            return {}
+        stiffness, damageable = np.ones(len(mesh.cells)), np.ones(len(mesh.cells))
+        for group, factor, damages in self.regions:
+            cells = mesh.cell_sets.get(group)
+            if cells is None:
+                raise MeshError(f"{self.path}: region {group!r} is no physical surface (regions are groups of "
+                                f"triangles or quadrilaterals; the file's are {sorted(mesh.cell_sets)})")
+            if not (np.isfinite(factor) and factor > 0):
+                raise ValueError(f"MeshSpecimen.regions: the stiffness factor of {group!r} is {factor!r}; it must be "
+                                 "positive")
+            stiffness[cells], damageable[cells] = float(factor), float(bool(damages))
+        return {"stiffness_factor": stiffness, "damageable": damageable}
 
     def _crack(self, mesh) -> dict:
         """The crack path, the zone-width line and the symmetry plane along it (if it is one)."""
@@ -144,7 +164,8 @@ class MeshSpecimen:
                 "symmetry_planes": ((normal, coordinate),) if mirrored else ()}
 
     def _groups(self):
-        for group, *_ in (*self.supports, *self.loads, *self.symmetry, *([self.crack] if self.crack else [])):
+        for group, *_ in (*self.supports, *self.loads, *self.symmetry, *self.regions,
+                          *([self.crack] if self.crack else [])):
             yield group
         for _, terms in self.controls:
             for group, *_ in terms:
@@ -189,6 +210,7 @@ class PlaneMesh:
     cells: np.ndarray
     n_vertices: int
     node_sets: dict
+    cell_sets: dict  # group of surfaces -> indices of its cells
 
 
 def read_mesh(path) -> PlaneMesh:
@@ -274,7 +296,19 @@ def plane_mesh(points, blocks, cell_sets, path="mesh") -> PlaneMesh:
     nodes = np.vstack([vertices, 0.5 * (vertices[edges[:, 0]] + vertices[edges[:, 1]])])
     quadratic = np.hstack([cells, vertex_ids.size + mid])
     node_sets = _node_sets(blocks, cell_sets, renumber, edges, vertex_ids.size, path)
-    return PlaneMesh(nodes, quadratic, int(vertex_ids.size), node_sets)
+    return PlaneMesh(nodes, quadratic, int(vertex_ids.size), node_sets, _cell_sets(surfaces, cell_sets))
+
+
+def _cell_sets(surfaces, groups) -> dict:
+    """{group: indices of its cells in the order of ``surfaces``} for the groups of surfaces."""
+    positions, start = {}, 0
+    for kind, data in surfaces:
+        positions.setdefault(kind, []).append(np.arange(start, start + len(data)))
+        start += len(data)
+    positions = {kind: np.concatenate(parts) for kind, parts in positions.items()}
+    return {group: np.unique(np.concatenate([positions[kind][np.asarray(idx, dtype=int)]
+                                             for kind, idx in members.items() if kind in positions]))
+            for group, members in groups.items() if any(kind in positions for kind in members)}
 
 
 def _counterclockwise(vertices, cells, path):
