@@ -193,6 +193,9 @@ elongation = [{group = "right", component = "x"}]
 [simulate]
 target = 0.01
 stop_force_fraction = 0.5
+
+[output]
+vtk_steps = [3]
 """
 
 
@@ -202,7 +205,7 @@ def test_a_mesh_specimen_runs_from_the_command_line(tmp_path):
     write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
     (tmp_path / "strip.toml").write_text(CONFIG)
     assert cli.main(["simulate", str(tmp_path / "strip.toml"), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert any((tmp_path / "out").iterdir())
+    assert (tmp_path / "out" / "curve.csv").exists() and any((tmp_path / "out").rglob("*.vtu"))
 
 
 @pytest.mark.parametrize("replace, words", [
@@ -300,3 +303,64 @@ def test_regions_of_their_own_stiffness_stay_elastic():
     with pytest.raises(MeshError, match="region 'left' is no physical surface"):
         MeshSpecimen("strip", thickness=T, supports=(), loads=(("right", "x"),), controls=(("e", (("right", "x", 1.0),)),),
                      regions=(("left", 5.0, False),)).describe_mesh(plane_mesh(points, blocks, groups))
+
+
+IDENTIFY = """
+[model]
+type = "gradient-damage"
+[model.parameters]
+E = 30000.0
+kappa_i = 1e-4
+c = 4.0
+
+[specimen]
+type = "mesh"
+file = "strip.msh"
+thickness = 5.0
+supports = [{group = "left", component = "x"}, {group = "origin", component = "y"}]
+loads = [{group = "right", component = "x"}]
+[specimen.controls]
+elongation = [{group = "right", component = "x"}]
+
+[[experiments]]
+file = "curve.csv"
+control_column = "elongation"
+control_unit = "mm"
+force_unit = "N"
+kind = "single"
+force_columns = ["force"]
+std = 0.5
+n_points = 8
+
+[identify]
+parameters = ["beta"]
+[identify.bounds]
+beta = [100.0, 1000.0]
+[identify.knn]
+n = 6
+k = 2
+[identify.kalman]
+max_iterations = 3
+
+[output]
+directory = "results"
+"""
+
+
+def test_identify_with_a_mesh_specimen_writes_result_report_and_vtk(tmp_path):
+    """fracid identify on a mesh specimen as on a built-in one: a twin of beta = 300 found back."""
+    from fracid import cli
+
+    path = write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
+    truth = DamageModel().simulate(strip(path), fracid.DamageParameters(E=E, kappa_i=1e-4, c=4.0, beta=300.0),
+                                   target=0.012, stop_force_fraction=None, checkpoints=np.linspace(0.002, 0.012, 8))
+    (tmp_path / "curve.csv").write_text("elongation,force\n" + "".join(
+        f"{x:.9g},{f:.9g}\n" for x, f in zip(truth.control[1:], truth.force[1:])))
+    (tmp_path / "strip.toml").write_text(IDENTIFY)
+    assert cli.main(["identify", str(tmp_path / "strip.toml"), "--quiet", "--workers", "1"]) == 0
+    import json
+
+    out = tmp_path / "results"
+    result = json.loads((out / "result.json").read_text())
+    assert result["names"] == ["beta"] and abs(result["x"][0] / 300.0 - 1.0) < 0.05
+    assert any(out.rglob("*.html"))
