@@ -493,11 +493,12 @@ INTERRUPTED = ["interrupted", "run the same command again"]
                  id="sigterm"),
 ])
 def test_signal_during_identify(sig, status, words, workers, group, when, curve, tmp_path):
-    """Ctrl-C or SIGTERM during the KNN stage (a population of 200 runs, longer than the wait), once a few runs
+    """Ctrl-C or SIGTERM during the KNN stage (a population of 1000 runs, longer than the wait), once a few runs
     are stored, or (``when = "starting"``) just after the run store is opened, while the workers start.
     ``group``: the signal goes to the whole process group, workers included, as Ctrl-C in a terminal does."""
     write_csv(tmp_path / "bar.csv", *curve)
-    (tmp_path / "cfg.toml").write_text(bar_config(n="200"))
+    # 1000 runs: the forward runs got 3x faster, and 200 of them could end before the signal on a busy machine
+    (tmp_path / "cfg.toml").write_text(bar_config(n="1000"))
     proc = subprocess.Popen([*FRACID, "identify", "cfg.toml", "--out", "out", "--workers", workers, "--quiet"],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
                             start_new_session=group)
