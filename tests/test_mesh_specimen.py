@@ -364,3 +364,23 @@ def test_identify_with_a_mesh_specimen_writes_result_report_and_vtk(tmp_path):
     result = json.loads((out / "result.json").read_text())
     assert result["names"] == ["beta"] and abs(result["x"][0] / 300.0 - 1.0) < 0.05
     assert any(out.rglob("*.html"))
+
+
+def test_study_on_a_mesh_specimen_gives_its_verdict(tmp_path):
+    """fracid study on a mesh specimen as on a built-in one: multi-start, noisy replicates and a verdict."""
+    from fracid import cli
+    import json
+
+    path = write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
+    truth = DamageModel().simulate(strip(path), fracid.DamageParameters(E=E, kappa_i=1e-4, c=4.0, beta=300.0),
+                                   target=0.012, stop_force_fraction=None, checkpoints=np.linspace(0.002, 0.012, 8))
+    (tmp_path / "curve.csv").write_text("elongation,force\n" + "".join(
+        f"{x:.9g},{f:.9g}\n" for x, f in zip(truth.control[1:], truth.force[1:])))
+    (tmp_path / "strip.toml").write_text(IDENTIFY + "\n[study]\nstarts = 2\nreplicates = 2\n")
+    assert cli.main(["study", str(tmp_path / "strip.toml"), "--quiet", "--workers", "2"]) == 0
+    study = json.loads((tmp_path / "results" / "study.json").read_text())
+    [verdict] = study["verdict"]["parameters"]
+    assert verdict["name"] == "beta" and verdict["status"] == "identified"
+    assert len(study["multi_start"]["ends"]) == 2 and len(study["stability"]["estimates"]) == 2
+    assert (tmp_path / "results" / "report.html").exists() and not (tmp_path / "results" / "size_effect.csv").exists()
+    assert cli.main(["size-effect", str(tmp_path / "strip.toml"), "--quiet"]) == 2  # no size to scale: a message

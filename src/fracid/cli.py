@@ -216,13 +216,16 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
     from dataclasses import replace
 
     from fracid.config import build_experiment_data, build_model, build_specimen
-    from fracid.inverse.size_effect import compare_size_effect, nominal_strength, specimen_size
+    from fracid.inverse.size_effect import (compare_size_effect, has_nominal_strength, nominal_strength,
+                                            specimen_size)
 
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
         if exp.quantity != "force":
             continue
         specimen = build_specimen(cfg, exp)
+        if not has_nominal_strength(specimen):
+            return None  # a mesh specimen: no size to scale (the study's log says it was skipped)
         D = specimen_size(specimen)
         specimens[D] = specimen
         measured.setdefault(D, []).append(nominal_strength(specimen, float(np.max(build_experiment_data(cfg, exp).y))))
@@ -239,6 +242,13 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
             raise UsageError(f"--sizes {D:g}: not a valid {type(base).__name__}.{size_field} ({err})") from None
     return compare_size_effect(params, specimens, measured, calibrated, model=build_model(cfg), executor=executor,
                                progress=False if quiet else None)
+
+
+def _has_size(cfg) -> bool:
+    from fracid.config import build_specimen
+    from fracid.inverse.size_effect import has_nominal_strength
+
+    return has_nominal_strength(build_specimen(cfg))
 
 
 #: subcommands that run part of the study: [study] settings they override
@@ -263,6 +273,9 @@ def run_study_command(args) -> int:
         size = None
         if args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
+            if size is None and not _has_size(cfg):
+                _say(args, "size effect: skipped (the specimen declares no characteristic size and nominal "
+                           "section: a mesh specimen has none)")
     if size is not None:
         size.save(out)
     written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
@@ -303,13 +316,17 @@ def run_sensitivity_command(args) -> int:
 
 
 def run_size_effect_command(args) -> int:
-    from fracid.config import build_parameters
+    from fracid.config import build_parameters, build_specimen
     from fracid.report.figures import size_effect_figure, to_png
 
     cfg = _load(args, args.config, "simulate")
     out = _out_dir(args, cfg)
     with _working_in(args, out), _executor(args) as executor:
         size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
+    if size is None and not _has_size(cfg):
+        print(f"fracid: size-effect: the specimen {type(build_specimen(cfg)).__name__} declares no characteristic size "
+              "and nominal section (a mesh specimen has none): use a built-in specimen", file=sys.stderr)
+        return 2
     if size is None:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
               "[experiments.specimen] sizes", file=sys.stderr)

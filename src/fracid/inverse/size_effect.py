@@ -247,6 +247,11 @@ def _size_and_section(specimen) -> tuple[float, float]:
                         "characteristic_size and nominal_section); use a DogBone, a NotchedBeam or a BarWithWeakZone") from None
 
 
+def has_nominal_strength(specimen) -> bool:
+    """Whether ``specimen`` declares a characteristic size and a nominal section (a mesh specimen does not)."""
+    return hasattr(specimen, "characteristic_size") and hasattr(specimen, "nominal_section")
+
+
 def specimen_size(specimen) -> float:
     """Characteristic size D [mm]: ``size`` of a DogBone, ``depth`` of a NotchedBeam, ``length`` of a bar.
 
