@@ -3,9 +3,10 @@
 The posterior of :mod:`fracid.inverse.posterior` lives on the unit cube of
 :class:`~fracid.inverse.knn.ParameterSpace` (where the prior, uniform or log-uniform between the bounds,
 is uniform). A proposal is a defensive mixture (Hesterberg 1995): a share ``defensive`` of the prior
-itself, which bounds every importance weight by the likelihood over that share, and Gaussian
-components fitted to the weighted samples, so that a curved valley (the c-beta banana) is covered
-by several local ellipses instead of one. Draws are kept inside the cube by rejection; the mass of the
+itself, which bounds every importance weight by the likelihood over that share, and Student-t
+components (``dof`` degrees of freedom: heavier tails than the target, as importance sampling needs)
+fitted to the weighted samples, so that a curved valley (the c-beta banana) is covered by several
+local ellipses instead of one. Draws are kept inside the cube by rejection; the mass of the
 mixture inside the cube (``inside``) makes the density of the kept draws exact.
 """
 
@@ -14,18 +15,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import logsumexp
+from scipy.special import gammaln, logsumexp
 
 __all__ = ["GaussianMixture", "fit_mixture", "weighted_covariance"]
 
 #: draws used to measure a mixture's mass inside the unit cube
 _MASS_DRAWS = 20_000
+#: degrees of freedom of the Student-t components
+DOF = 4.0
 
 
 @dataclass(frozen=True)
 class GaussianMixture:
-    """``defensive`` x uniform(unit cube) + (1 - defensive) x sum_k weights[k] N(means[k], covs[k]),
-    restricted to the unit cube.
+    """``defensive`` x uniform(unit cube) + (1 - defensive) x sum_k weights[k] t_dof(means[k], covs[k]),
+    restricted to the unit cube (``covs``: the scale matrices of the Student-t components).
 
     Attributes
     ----------
@@ -70,7 +73,7 @@ class GaussianMixture:
         parts = [np.log(self.defensive) + np.zeros(len(u))] if self.defensive > 0 else []
         for w, mean, cov in zip(self.weights, self.means, self.covs):
             if w > 0:
-                parts.append(np.log((1.0 - self.defensive) * w) + _gaussian_logpdf(u, mean, cov))
+                parts.append(np.log((1.0 - self.defensive) * w) + _student_logpdf(u, mean, cov))
         density = logsumexp(np.vstack(parts), axis=0) - np.log(self.inside)
         return np.where(np.all((u >= 0.0) & (u <= 1.0), axis=1), density, -np.inf)
 
@@ -80,14 +83,17 @@ class GaussianMixture:
         component = rng.choice(len(self.weights), size=n, p=self.weights)
         normal = rng.standard_normal((n, p))
         factors = np.linalg.cholesky(self.covs)
-        draws = self.means[component] + np.einsum("nij,nj->ni", factors[component], normal)
+        scale = np.sqrt(DOF / rng.chisquare(DOF, size=n))
+        draws = self.means[component] + scale[:, None] * np.einsum("nij,nj->ni", factors[component], normal)
         return np.where(uniform[:, None], rng.random((n, p)), draws)
 
 
-def _gaussian_logpdf(u, mean, cov) -> np.ndarray:
-    factor = np.linalg.cholesky(cov)
+def _student_logpdf(u, mean, scale) -> np.ndarray:
+    p = len(mean)
+    factor = np.linalg.cholesky(scale)
     z = np.linalg.solve(factor, (u - mean).T)
-    return -0.5 * np.sum(z * z, axis=0) - np.sum(np.log(np.diag(factor))) - 0.5 * len(mean) * np.log(2 * np.pi)
+    return (gammaln((DOF + p) / 2) - gammaln(DOF / 2) - 0.5 * p * np.log(DOF * np.pi) - np.sum(np.log(np.diag(factor)))
+            - 0.5 * (DOF + p) * np.log1p(np.sum(z * z, axis=0) / DOF))
 
 
 def weighted_covariance(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,110 @@
+"""Adaptive importance sampling of the posterior (fracid.inverse.posterior) against posteriors known by quadrature:
+a curved (banana) valley, a bounded one, failed runs, reproducible draws."""
+
+import numpy as np
+import pytest
+
+from fracid.inverse.knn import ParameterSpace
+from fracid.inverse.forward_operator import RunRecord
+from fracid.inverse.posterior import PosteriorSettings, posterior, weighted_quantile
+
+BANANA_Y = np.array([0.0, 0.5, 0.3])
+BANANA_C = np.diag([0.5, 0.1, 0.6]) ** 2
+
+
+def banana(x, needed=None):
+    """y = (a, b + 2 a^2, a + b): a curved valley in (a, b)."""
+    return np.array([x[0], x[1] + 2.0 * x[0] ** 2, x[0] + x[1]])
+
+
+def grid_moments(model, y, C, space, n=(401, 501)):
+    """Posterior mean, std and 5/95 % quantiles on a fine grid of the bounds (the prior uniform there)."""
+    axes = [np.linspace(lo, hi, k) for lo, hi, k in zip(space.lower, space.upper, n)]
+    a, b = np.meshgrid(*axes, indexing="ij")
+    outputs = np.array([model(x) for x in np.column_stack([a.ravel(), b.ravel()])])
+    r = outputs - y
+    ll = -0.5 * np.einsum("ni,ij,nj->n", r, np.linalg.inv(C), r)
+    p = np.exp(ll - ll.max())
+    p /= p.sum()
+    pts = np.column_stack([a.ravel(), b.ravel()])
+    mean = p @ pts
+    std = np.sqrt(p @ (pts - mean) ** 2)
+    q = np.array([[weighted_quantile(pts[:, j], p, [0.05, 0.95])] for j in range(2)]).reshape(2, 2)
+    return mean, std, q
+
+
+def gaussian_seed(model, x, C):
+    """A Gauss-Newton-like Gaussian at x: (J^T C^-1 J)^-1 by central differences."""
+    J = np.column_stack([(model(x + e) - model(x - e)) / 2e-6 for e in np.eye(len(x)) * 1e-6])
+    return np.linalg.inv(J.T @ np.linalg.solve(C, J))
+
+
+@pytest.mark.parametrize("lower, upper", [((-2.0, -3.0), (2.0, 2.0)),  # the valley well inside the bounds
+                                          ((0.0, -3.0), (2.0, 2.0))])  # cut by the bound a >= 0: not a Gaussian
+def test_banana_posterior_matches_quadrature(lower, upper):
+    space = ParameterSpace(("a", "b"), lower, upper)
+    mean, std, q = grid_moments(banana, BANANA_Y, BANANA_C, space)
+    x0 = np.array([max(0.05, lower[0]), 0.4])
+    settings = PosteriorSettings(samples_per_round=200, max_rounds=20, target_ess=1500)
+    result = posterior(banana, BANANA_Y, BANANA_C, space, x0, gaussian_seed(banana, x0, BANANA_C), settings=settings)
+    assert result.converged and result.failed == 0 and result.weights.sum() == pytest.approx(1.0)
+    np.testing.assert_array_less(np.abs(result.mean - mean) / std, 0.1)
+    np.testing.assert_allclose(result.std, std, rtol=0.1)
+    # the 5 and 95 % quantiles, as masses (a tail quantile where the density is low is noisy as a value)
+    below = [[result.weights[result.x[:, j] < q[j, k]].sum() for k in range(2)] for j in range(2)]
+    np.testing.assert_allclose(below, [[0.05, 0.95]] * 2, atol=0.02)
+    assert result.credible_intervals(0.9).shape == (2, 2)
+    assert np.all(result.x >= space.lower) and np.all(result.x <= space.upper)
+
+
+def test_failed_runs_get_no_weight_and_are_counted():
+    """Runs fail where a < -0.5 (a tenth of the mass or so): they are counted, and the posterior is the
+    one of the model where it runs (quadrature with the failed region cut out)."""
+
+    def fragile(x, needed=None):
+        if x[0] < -0.5:
+            return RunRecord(np.asarray(x), np.full(3, np.nan), status="failed", error="diverged")
+        return banana(x)
+
+    space = ParameterSpace(("a", "b"), (-2.0, -3.0), (2.0, 2.0))
+    settings = PosteriorSettings(samples_per_round=200, max_rounds=20, target_ess=1000)
+    x0 = np.array([0.05, 0.4])
+    result = posterior(fragile, BANANA_Y, BANANA_C, space, x0, gaussian_seed(banana, x0, BANANA_C), settings=settings)
+    assert result.failed > 0 and np.all(result.weights[result.x[:, 0] < -0.5] == 0.0)
+    cut = ParameterSpace(("a", "b"), (-0.5, -3.0), (2.0, 2.0))
+    mean, std, _ = grid_moments(banana, BANANA_Y, BANANA_C, cut)
+    np.testing.assert_array_less(np.abs(result.mean - mean) / std, 0.1)
+    assert result.history[0]["failed"] >= 0 and sum(h["failed"] for h in result.history) == result.failed
+
+
+def test_the_same_seed_draws_the_same_points():
+    """A rerun draws the same points, so that a run store gives back every run (resumable)."""
+    space = ParameterSpace(("a", "b"), (-2.0, -3.0), (2.0, 2.0))
+    x0, settings = np.array([0.05, 0.4]), PosteriorSettings(samples_per_round=50, max_rounds=3, target_ess=1e9)
+    C0 = gaussian_seed(banana, x0, BANANA_C)
+    first = posterior(banana, BANANA_Y, BANANA_C, space, x0, C0, settings=settings)
+    again = posterior(banana, BANANA_Y, BANANA_C, space, x0, C0, settings=settings)
+    np.testing.assert_array_equal(first.x, again.x)
+    assert not first.converged and "below the target" in first.status and first.rounds == 3
+
+
+def test_log_scale_prior_is_log_uniform():
+    """A flat likelihood: the posterior is the prior, log-uniform on [1, 100] for a log-scaled parameter,
+    so its median is 10."""
+    space = ParameterSpace(("k",), (1.0,), (100.0,), log=(True,))
+    flat = lambda x, needed=None: np.array([0.0])  # noqa: E731
+    result = posterior(flat, np.array([0.0]), np.eye(1), space, np.array([10.0]), np.eye(1) * 100.0,
+                       settings=PosteriorSettings(samples_per_round=500, max_rounds=4, target_ess=1500))
+    assert weighted_quantile(result.x[:, 0], result.weights, 0.5)[0] == pytest.approx(10.0, rel=0.1)
+
+
+@pytest.mark.parametrize("key, value", [("defensive", 1.0), ("samples_per_round", 1), ("target_ess", 0.5),
+                                        ("inflation", 0.0)])
+def test_bad_settings_are_refused(key, value):
+    with pytest.raises(ValueError, match=key):
+        PosteriorSettings(**{key: value})
+
+
+def test_weighted_quantile_of_equal_weights_is_the_median():
+    values = np.array([3.0, 1.0, 2.0])
+    assert weighted_quantile(values, np.ones(3) / 3, 0.5)[0] == pytest.approx(2.0)
