@@ -487,11 +487,15 @@ def _stored_runs(store: Path) -> int:
 INTERRUPTED = ["interrupted", "run the same command again"]
 
 
+def _as_in_a_terminal():
+    """In the child: SIGINT handled as in a terminal's foreground job. A test run started in the background by a
+    shell without job control (``pytest ... &`` in a script) ignores SIGINT, its children inherit that, and
+    Python then leaves SIGINT ignored: Ctrl-C could not be tested."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig, status, words, workers, group, when", [
-    # known issue (2026-11-25): in 3 full clean-clone CI runs Ctrl-C during the KNN stage with --workers 1 was not
-    # honoured within 15 s (never when the test runs alone, 8 of 8): to investigate next session
-    pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", id="sigint",
-                 marks=pytest.mark.xfail(reason="Ctrl-C during KNN sometimes not honoured in the full suite", strict=False)),
+    pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", id="sigint"),
     pytest.param(signal.SIGTERM, 143, ["terminated (SIGTERM)", "run the same command again"], "1", False, "stored",
                  id="sigterm"),
 ])
@@ -504,7 +508,7 @@ def test_signal_during_identify(sig, status, words, workers, group, when, curve,
     (tmp_path / "cfg.toml").write_text(bar_config(n="1000"))
     proc = subprocess.Popen([*FRACID, "identify", "cfg.toml", "--out", "out", "--workers", workers, "--quiet"],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
-                            start_new_session=group)
+                            start_new_session=group, preexec_fn=_as_in_a_terminal)
     try:
         store, start = tmp_path / "out" / "runs.sqlite", time.monotonic()
         while time.monotonic() - start < 60 and proc.poll() is None:
