@@ -2,6 +2,8 @@
 
     fracid simulate CONFIG    forward analysis: curve (CSV), plot (PNG), fields (VTK)
     fracid identify CONFIG    KNN + Kalman filter: result (JSON), fitted curves (CSV), figures, HTML report
+    fracid posterior CONFIG   identify, then weighted samples of the parameters given the data (adaptive
+                              importance sampling on the exact model): CSV, JSON, figures, HTML page
     fracid study CONFIG       the whole strategy: KNN, sensitivity, uniqueness, Kalman filter, multi-start,
                               stability, prediction of held-out data, size effect; a verdict per parameter
     fracid uniqueness CONFIG  KNN, objective maps and valley, Kalman filter, multi-start (no replicates)
@@ -43,6 +45,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("simulate", "forward analysis of the configured specimen"),
                        ("identify", "identify parameters from measured data (KNN + Kalman filter)"),
+                       ("posterior", "identify, then sample the parameters given the data on the exact model"),
                        ("study", "identification with uniqueness, stability and prediction checks, and a verdict"),
                        ("uniqueness", "the study's uniqueness stages only: objective maps, valley, multi-start"),
                        ("stability", "the study's stability stage only: identification on noisy replicates"),
@@ -158,21 +161,35 @@ def run_simulate(args) -> int:
     return 0
 
 
-def run_identify(args, config_path=None) -> int:
+def _identify_job(args, config_path):
+    """The configuration and what the identification is built of: data, operator, space, settings."""
+    from types import SimpleNamespace
+
     from fracid.config import build_data, build_operator, build_space, identify_settings
+
+    cfg = _load(args, config_path, "identify")
+    data = build_data(cfg)
+    return SimpleNamespace(cfg=cfg, data=data, operator=build_operator(cfg, data), space=build_space(cfg),
+                           settings=identify_settings(cfg))
+
+
+def _identification(args, job, store, executor):
+    """The identification of ``fracid identify`` (its runs through ``store``), timed."""
     from fracid.inverse.strategy import identify_data
+
+    _say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names)))
+    start = time.perf_counter()
+    result = identify_data(job.operator, job.data, job.space, executor=executor, store=store,
+                           progress=_progress(args), retry_failed=args.retry_failed, **job.settings)
+    result.runs["wall_seconds"] = time.perf_counter() - start
+    return result
+
+
+def _write_identification(args, job, out, result) -> None:
+    """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
     from fracid.report.html import write_report
 
-    cfg = _load(args, config_path or args.config, "identify")
-    data = build_data(cfg)
-    operator, space, settings = build_operator(cfg, data), build_space(cfg), identify_settings(cfg)
-    out = _out_dir(args, cfg)
-    _say(args, _stage_costs(settings, data.n_y, len(space.names)))
-    start = time.perf_counter()
-    with _working_in(args, out, store=True) as store, _executor(args) as executor:
-        result = identify_data(operator, data, space, executor=executor, store=store, progress=_progress(args),
-                               retry_failed=args.retry_failed, **settings)
-    result.runs["wall_seconds"] = time.perf_counter() - start
+    data = job.data
     result.save(out / "result.json")
     header = "control_mm,measured,std,computed,block"
     block_of = np.empty(data.y.size, dtype=object)
@@ -181,8 +198,8 @@ def run_identify(args, config_path=None) -> int:
     rows = [f"{c:.9g},{y:.9g},{s:.9g},{f:.9g},{blk}" for c, y, s, f, blk in
             zip(data.control, data.y, data.std, result.y_fit, block_of)]
     (out / "fit.csv").write_text("\n".join([header, *rows]) + "\n")
-    write_report(out / "report.html", result, control=data.control, title=f"fracid identification: {Path(cfg.path).name}",
-                 data_notes=data.notes)
+    write_report(out / "report.html", result, control=data.control,
+                 title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes)
     _write_figures(out / "figures", result, data.control)
     _say(args, result.summary())
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
@@ -191,10 +208,48 @@ def run_identify(args, config_path=None) -> int:
                f"{result.runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, figures/*.png")
     for text in result.warnings():
         _warn(text)
+
+
+def run_identify(args, config_path=None) -> int:
+    job = _identify_job(args, config_path or args.config)
+    out = _out_dir(args, job.cfg)
+    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+        result = _identification(args, job, store, executor)
+    _write_identification(args, job, out, result)
     if not np.all(np.isfinite(result.x)) or not np.all(np.isfinite(result.y_fit)):
         print(f"fracid: the identification gave no finite result ({result.status}); see {out / 'report.html'}",
               file=sys.stderr)
         return 3
+    return 0
+
+
+def run_posterior_command(args) -> int:
+    """``fracid identify``, then the posterior of the parameters sampled from its Gaussian on the exact model."""
+    from fracid.config import posterior_settings
+    from fracid.exits import FAILED
+    from fracid.inverse.runs import StoredOperator
+    from fracid.report.posterior import sample_posterior, write_posterior
+
+    job = _identify_job(args, args.config)
+    settings = posterior_settings(job.cfg)
+    out = _out_dir(args, job.cfg)
+    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+        result = _identification(args, job, store, executor)
+        _write_identification(args, job, out, result)
+        if not (np.all(np.isfinite(result.x)) and np.all(np.isfinite(result.C))):
+            print(f"fracid: posterior: the identification gave no finite estimate and covariance ({result.status}), "
+                  f"and the sampler starts from them; see {out / 'report.html'}", file=sys.stderr)
+            return FAILED
+        evaluate = StoredOperator(job.operator, store, study="posterior", retry_failed=args.retry_failed)
+        post = sample_posterior(evaluate, job.data, job.space, result, settings, executor=executor,
+                                progress=_progress(args), log=lambda text: _say(args, text))
+    written = write_posterior(out, post, data=job.data, fit=result.y_fit, log_axes=job.space.log,
+                              title=f"fracid posterior: {Path(job.cfg.path).name}")
+    _say(args, post.summary())
+    _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
+               f"the run store, {post.failed} failed)\nwrote in {out}: " + ", ".join(written))
+    if not post.converged:
+        _warn(f"posterior: {post.status}")
     return 0
 
 
@@ -382,6 +437,8 @@ def _dispatch(args) -> int:
         return run_simulate(args)
     if args.command == "identify":
         return run_identify(args)
+    if args.command == "posterior":
+        return run_posterior_command(args)
     if args.command in _STUDY_PARTS:
         return run_study_command(args)
     if args.command == "sensitivity":

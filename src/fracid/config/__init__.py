@@ -9,7 +9,8 @@ one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
 resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
-:func:`build_operator`, :func:`build_space`, :func:`identify_settings`, :func:`simulate_settings`)
+:func:`build_operator`, :func:`build_space`, :func:`identify_settings`, :func:`simulate_settings`,
+:func:`posterior_settings`)
 are pure functions of the validated :class:`Config`.
 
 Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
@@ -24,9 +25,9 @@ elements larger than the internal length l = sqrt(2 c)) are returned in ``Config
 The package's modules, each importing only those listed before it: :mod:`~fracid.config.registry`
 (the model and specimen types), :mod:`~fracid.config.schema` (the schema and the validated
 dataclasses), :mod:`~fracid.config.checker` (TOML reading and value checks),
-:mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments` and
-:mod:`~fracid.config.identify` (one validator per section), :mod:`~fracid.config.loading`
-(:func:`load_config`) and :mod:`~fracid.config.builders`.
+:mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments`,
+:mod:`~fracid.config.identify` and :mod:`~fracid.config.posterior` (one validator per section),
+:mod:`~fracid.config.loading` (:func:`load_config`) and :mod:`~fracid.config.builders`.
 
 Example
 -------
@@ -51,6 +52,7 @@ from fracid.config.builders import (
     build_space,
     build_specimen,
     identify_settings,
+    posterior_settings,
     simulate_settings,
     study_settings,
 )
@@ -72,6 +74,7 @@ from fracid.config.schema import (
     KnnConfig,
     ModelConfig,
     OutputConfig,
+    PosteriorConfig,
     SimulateConfig,
     SpecimenConfig,
     StudyConfig,
@@ -101,4 +104,6 @@ __all__ = [
     "build_experiment_data",
     "study_settings",
     "StudyConfig",
+    "posterior_settings",
+    "PosteriorConfig",
 ]

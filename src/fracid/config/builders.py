@@ -181,6 +181,16 @@ def study_settings(cfg: Config) -> dict:
             "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior}
 
 
+def posterior_settings(cfg: Config):
+    """The :class:`~fracid.inverse.posterior.PosteriorSettings` of ``[posterior]`` (its defaults when the
+    section is absent)."""
+    import dataclasses
+
+    from fracid.inverse.posterior import PosteriorSettings
+
+    return PosteriorSettings(**dataclasses.asdict(cfg.posterior))
+
+
 def build_space(cfg: Config):
     """The parameter space of the KNN population: identified names, bounds, log flags."""
     from fracid.inverse.knn import ParameterSpace

@@ -13,6 +13,7 @@ import numpy as np
 from fracid.config.checker import _Checker, _read_toml
 from fracid.config.experiments import _data_limit_text, _experiments
 from fracid.config.identify import _identify
+from fracid.config.posterior import _posterior
 from fracid.config.registry import _model_of, _specimen_class
 from fracid.config.schema import (
     _PURPOSES,
@@ -75,9 +76,11 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     output = _output(ck, raw.get("output"), base)
     simulate = _simulate(ck, raw.get("simulate"))
     study = _study(ck, raw.get("study"))
+    posterior = _posterior(ck, raw.get("posterior"))
     _mesh_warnings(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
-                  identify=identify, output=output, simulate=simulate, study=study, warnings=tuple(ck.warnings))
+                  identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,
+                  warnings=tuple(ck.warnings))
 
 
 def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:

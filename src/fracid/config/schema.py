@@ -108,6 +108,17 @@ present they are always validated. Every other key is optional unless marked *re
     prior = "knn"                       # Kalman prior covariance: "knn" (neighbours' spread, default)
                                         #   | "bounds" (uniform over the bounds: the data's information only)
 
+    [posterior]                         # optional: the sampler of `fracid posterior` (adaptive importance
+                                        #   sampling on the exact model, prior uniform between the bounds)
+    samples_per_round = 200             # integer >= 2: forward runs per round (side by side), default 200
+    max_rounds = 10                     # integer >= 1, default 10 (runs at most: samples_per_round x max_rounds)
+    target_ess = 500.0                  # > 1: stop at this effective sample size, default 500
+    components = 8                      # integer >= 1: Gaussian components of the adapted proposals, default 8
+    defensive = 0.1                     # 0 <= d < 1: share of the prior in every proposal, default 0.1
+    inflation = 2.0                     # > 0: std multiplier of the first proposal around the Kalman
+                                        #   estimate, default 2
+    seed = 0                            # integer >= 0: seed of the draws (same seed: same runs, reused)
+
     [output]                            # optional
     directory = "results"               # default "results", relative to this file unless absolute
     vtk_steps = []                      # integers >= 0: steps whose fields go to VTK (simulate)
@@ -143,7 +154,7 @@ _METHODS = ("sobol", "lhs", "grid")
 _RESTARTS = ("linearize", "prior-mean")
 _PURPOSES = ("identify", "simulate")
 
-_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study")
+_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study", "posterior")
 _MODEL_KEYS = ("type", "parameters")
 _EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                     "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
@@ -160,6 +171,7 @@ _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
+_POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
 _ROLES = ("calibration", "prediction")
 #: Kalman steps per pass when [identify.kalman] groups is not given. One observation per step costs
 #: 2 p + 1 partial runs per observation (a 30-point curve: over 100 full-run equivalents per pass);
@@ -338,6 +350,20 @@ class StudyConfig:
 
 
 @dataclass(frozen=True)
+class PosteriorConfig:
+    """``[posterior]``: the settings of :class:`~fracid.inverse.posterior.PosteriorSettings` (the same
+    defaults; the tests check that they agree)."""
+
+    samples_per_round: int = 200
+    max_rounds: int = 10
+    target_ess: float = 500.0
+    components: int = 8
+    defensive: float = 0.1
+    inflation: float = 2.0
+    seed: int = 0
+
+
+@dataclass(frozen=True)
 class Config:
     """A validated configuration (see the module docstring for the schema)."""
 
@@ -350,6 +376,7 @@ class Config:
     output: OutputConfig
     simulate: SimulateConfig
     study: StudyConfig = StudyConfig()
+    posterior: PosteriorConfig = PosteriorConfig()
     warnings: tuple = ()  # of str: valid but probably unintended settings, for the user to read
 
     @property

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from fracid.inverse.mixture import GaussianMixture, fit_mixture, weighted_covariance
-from fracid.inverse.sensitivity import evaluate_points
+from fracid.inverse.sensitivity import ForwardRunError, evaluate_points
 
 __all__ = ["PosteriorResult", "PosteriorSettings", "posterior", "weighted_quantile"]
 
@@ -68,7 +68,8 @@ class PosteriorSettings:
     def __post_init__(self):
         checks = [("samples_per_round", self.samples_per_round >= 2), ("max_rounds", self.max_rounds >= 1),
                   ("target_ess", self.target_ess > 1), ("components", self.components >= 1),
-                  ("defensive", 0.0 <= self.defensive < 1.0), ("inflation", self.inflation > 0)]
+                  ("defensive", 0.0 <= self.defensive < 1.0), ("inflation", self.inflation > 0),
+                  ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0)]
         for name, ok in checks:
             if not ok:
                 raise ValueError(f"posterior setting {name} = {getattr(self, name)!r} is out of range")
@@ -102,6 +103,8 @@ class PosteriorResult:
     estimate, estimate_cov : ndarray
         The Gaussian the sampler started from (the identification's estimate and covariance).
     bounds : (ndarray, ndarray)
+    log : tuple of bool
+        Per parameter: whether its prior is log-uniform (a log axis in plots).
     units : dict
     status : str
         ``"converged"`` (ESS reached) or ``"ESS ... below the target ..."``.
@@ -122,6 +125,7 @@ class PosteriorResult:
     estimate: np.ndarray
     estimate_cov: np.ndarray
     bounds: tuple
+    log: tuple = ()
     units: dict = field(default_factory=dict)
     status: str = ""
     history: list = field(default_factory=list)
@@ -257,6 +261,11 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     Returns
     -------
     PosteriorResult
+
+    Raises
+    ------
+    ForwardRunError
+        When every forward run failed or lacked outputs (nothing to weigh).
     """
     y_exp, C_exp = np.asarray(y_exp, float), np.asarray(C_exp, float)
     factor = np.linalg.cholesky(C_exp)
@@ -284,14 +293,14 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         proposal = fit_mixture(u_all, weights, settings.components, defensive=settings.defensive, rng=rng)
     failed = int(np.sum(~np.isfinite(loglik)))
     if not np.any(weights > 0):
-        raise RuntimeError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh")
+        raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh")
     status = "converged" if ess >= settings.target_ess else (
         f"ESS {ess:.0f} below the target {settings.target_ess:g} after {len(proposals)} rounds: the intervals are "
         "rough; raise max_rounds or samples_per_round")
     lower, upper = space.lower, space.upper
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
                            np.sqrt(np.diag(C_exp)), ess, len(proposals), failed, np.asarray(x0, float),
-                           np.asarray(C0, float), (lower, upper), status=status, history=history)
+                           np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
 
 
 def _amis_weights(u, loglik, proposals, sizes) -> tuple[np.ndarray, float]:

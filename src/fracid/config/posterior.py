@@ -1,0 +1,42 @@
+"""Validation of the ``[posterior]`` section: the settings of the sampler of ``fracid posterior``
+(:class:`~fracid.inverse.posterior.PosteriorSettings`); every key is optional."""
+
+from __future__ import annotations
+
+from fracid.config.checker import _Checker
+from fracid.config.schema import _POSTERIOR_KEYS, PosteriorConfig
+
+
+def _posterior(ck: _Checker, raw) -> PosteriorConfig:
+    raw = ck.table("posterior", {} if raw is None else raw, _POSTERIOR_KEYS)
+    default = PosteriorConfig()
+
+    def given(name):
+        return raw.get(name, getattr(default, name))
+
+    config = PosteriorConfig(
+        samples_per_round=ck.integer("posterior.samples_per_round", given("samples_per_round"),
+                                     "must be an integer >= 2 (forward runs per round)", lambda v: v >= 2),
+        max_rounds=ck.integer("posterior.max_rounds", given("max_rounds"), "must be an integer >= 1 (rounds at most)",
+                              lambda v: v >= 1),
+        target_ess=ck.number("posterior.target_ess", given("target_ess"),
+                             "must be a number > 1 (effective sample size at which the sampler stops)",
+                             lambda v: v > 1),
+        components=ck.integer("posterior.components", given("components"),
+                              "must be an integer >= 1 (Gaussian components of the adapted proposals)",
+                              lambda v: v >= 1),
+        defensive=ck.number("posterior.defensive", given("defensive"),
+                            "must be a number with 0 <= d < 1 (share of the prior in every proposal)",
+                            lambda v: 0 <= v < 1),
+        inflation=ck.number("posterior.inflation", given("inflation"),
+                            "must be a number > 0 (std multiplier of the first proposal around the Kalman estimate)",
+                            lambda v: v > 0),
+        seed=ck.integer("posterior.seed", given("seed"), "must be an integer >= 0", lambda v: v >= 0),
+    )
+    total = config.samples_per_round * config.max_rounds
+    if config.target_ess > total:
+        ck.warn(f"posterior.target_ess = {config.target_ess:g} is above the {total} draws at most "
+                f"(samples_per_round {config.samples_per_round} x max_rounds {config.max_rounds}): the effective "
+                "sample size never exceeds the number of draws, so the sampler runs every round and reports "
+                "the target as not reached; raise max_rounds or samples_per_round, or lower target_ess")
+    return config
