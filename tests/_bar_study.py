@@ -62,3 +62,19 @@ def stored_rows(path) -> int:
             return len(store)
     except (sqlite3.DatabaseError, FileNotFoundError):
         return 0
+
+
+#: a [posterior] section small enough for tests (3 rounds of 40 runs)
+SMALL_POSTERIOR = "\n[posterior]\nsamples_per_round = 40\nmax_rounds = 3\ntarget_ess = 30\n"
+
+
+def run_bar_command(directory, command, extra="", workers="1"):
+    """``fracid COMMAND`` on the bar study written in ``directory`` with ``extra`` appended to its
+    configuration (asserting exit status 0): (config, output directory)."""
+    from fracid import cli
+
+    config = write_bar_study(directory)
+    config.write_text(config.read_text() + extra)
+    out = directory / "out"
+    assert cli.main([command, str(config), "--out", str(out), "--workers", workers, "--quiet"]) == 0
+    return config, out

@@ -11,23 +11,17 @@ import sys
 import numpy as np
 import pytest
 
-from _bar_study import write_bar_study
+from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli, exits
 from fracid.inverse.posterior import PosteriorSettings, weighted_quantile
 
-SMALL = "\n[posterior]\nsamples_per_round = 40\nmax_rounds = 3\ntarget_ess = 30\n"
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     """The bar study with a small [posterior] section, run once: (config, output directory)."""
-    directory = tmp_path_factory.mktemp("posterior")
-    config = write_bar_study(directory)
-    config.write_text(config.read_text() + SMALL)
-    out = directory / "out"
-    assert cli.main(["posterior", str(config), "--out", str(out), "--workers", "1", "--quiet"]) == 0
-    return config, out
+    return run_bar_command(tmp_path_factory.mktemp("posterior"), "posterior", SMALL_POSTERIOR)
 
 
 def _draws(out):
@@ -128,7 +122,7 @@ def test_all_runs_failed_is_a_computation_failure():
     from fracid.inverse.forward_operator import RunRecord
     from fracid.inverse.knn import ParameterSpace
     from fracid.inverse.sensitivity import ForwardRunError
-    from fracid.report.posterior import sample_posterior
+    from fracid.inverse.posterior import sample_posterior
 
     def failing(x, needed=None):
         return RunRecord(np.asarray(x), np.full(2, np.nan), status="failed", error="diverged")

@@ -228,7 +228,8 @@ def run_posterior_command(args) -> int:
     from fracid.config import posterior_settings
     from fracid.exits import FAILED
     from fracid.inverse.runs import StoredOperator
-    from fracid.report.posterior import sample_posterior, write_posterior
+    from fracid.inverse.posterior import sample_posterior
+    from fracid.report.posterior import write_posterior
 
     job = _identify_job(args, args.config)
     settings = posterior_settings(job.cfg)
@@ -306,8 +307,10 @@ def _has_size(cfg) -> bool:
     return has_nominal_strength(build_specimen(cfg))
 
 
-#: subcommands that run part of the study: [study] settings they override
-_STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0}, "stability": {"starts": 0}}
+#: subcommands that run part of the study: [study] settings they override (only the full study samples
+#: the posterior of [study] posterior = true)
+_STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0, "posterior": None},
+                "stability": {"starts": 0, "posterior": None}}
 
 
 def run_study_command(args) -> int:
@@ -319,6 +322,8 @@ def run_study_command(args) -> int:
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     settings = StudySettings().replace(**{**study_settings(cfg), **_STUDY_PARTS[args.command]})
+    if cfg.study.posterior and settings.posterior is None:
+        _say(args, f"posterior: skipped ([study] posterior = true is for `fracid study`, not `fracid {args.command}`)")
     held_out = build_held_out(cfg) if args.command == "study" else []
     out = _out_dir(args, cfg)
     with _working_in(args, out, store=True) as store, _executor(args) as executor:
@@ -336,9 +341,14 @@ def run_study_command(args) -> int:
     written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
                           size_effect=size.figure_arguments() if size is not None else None)
     _say(args, study.summary())
-    _say(args, f"wrote in {out}: " + ", ".join(str(Path(p).relative_to(out)) for p in written))
+    _say(args, f"wrote in {out}: " + ", ".join(p if isinstance(p, str) else str(Path(p).relative_to(out))
+                                              for p in written))
     for text in study.identification.warnings():
         _warn(text)
+    if study.posterior is not None and not study.posterior.converged:
+        _warn(f"posterior: {study.posterior.status}")
+    elif settings.posterior is not None and study.posterior is None:
+        _warn("posterior: not sampled (see the notes of verdict.txt); the verdict reads the Gaussian std")
     return 0
 
 

@@ -175,10 +175,13 @@ def build_held_out(cfg: Config) -> list:
 
 
 def study_settings(cfg: Config) -> dict:
-    """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``."""
+    """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``;
+    ``posterior`` is the :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``,
+    None otherwise."""
     study = cfg.study
     return {**identify_settings(cfg), "starts": study.starts, "replicates": study.replicates,
-            "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior}
+            "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior,
+            "posterior": posterior_settings(cfg) if study.posterior else None}
 
 
 def posterior_settings(cfg: Config):

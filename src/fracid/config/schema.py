@@ -107,6 +107,9 @@ present they are always validated. Every other key is optional unless marked *re
     tolerance = 0.1                     # largest relative std called "identified", default 0.1
     prior = "knn"                       # Kalman prior covariance: "knn" (neighbours' spread, default)
                                         #   | "bounds" (uniform over the bounds: the data's information only)
+    posterior = false                   # true: `fracid study` also samples the posterior with the
+                                        #   [posterior] settings; the verdict then uses its 90 % credible
+                                        #   intervals instead of the Gaussian std (default false)
 
     [posterior]                         # optional: the sampler of `fracid posterior` (adaptive importance
                                         #   sampling on the exact model, prior uniform between the bounds)
@@ -170,7 +173,7 @@ _KNN_KEYS = ("n", "method", "k", "seed")
 _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
-_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior")
+_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
 _POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
 _ROLES = ("calibration", "prediction")
 #: Kalman steps per pass when [identify.kalman] groups is not given. One observation per step costs
@@ -340,13 +343,15 @@ class SimulateConfig:
 
 @dataclass(frozen=True)
 class StudyConfig:
-    """``[study]``: multi-start points, noisy replicates, their seed, and the tolerance of the verdict."""
+    """``[study]``: multi-start points, noisy replicates, their seed, the tolerance of the verdict, the
+    Kalman prior, and whether ``fracid study`` samples the posterior (its verdict then reads it)."""
 
     starts: int = 3
     replicates: int = 5
     seed: int = 0
     tolerance: float = 0.1
     prior: str = "knn"
+    posterior: bool = False
 
 
 @dataclass(frozen=True)

@@ -250,4 +250,14 @@ def _study(ck: _Checker, raw) -> StudyConfig:
                             "must be a number with 0 < t < 1 (largest relative std called identified)",
                             lambda v: 0 < v < 1),
         prior=ck.choice("study.prior", raw.get("prior", "knn"), ("knn", "bounds")),
+        posterior=_flag(ck, "study.posterior", raw.get("posterior", False),
+                        "must be true (fracid study also samples the posterior with the [posterior] settings, and "
+                        "the verdict reads its credible intervals) or false (the default: the Gaussian std only)"),
     )
+
+
+def _flag(ck: _Checker, key: str, value, allowed: str) -> bool:
+    """A TOML boolean (true or false; not 1, 0 or a string)."""
+    if not isinstance(value, bool):
+        ck.fail(key, value, allowed)
+    return value

@@ -32,7 +32,7 @@ from scipy.special import logsumexp
 from fracid.inverse.mixture import GaussianMixture, fit_mixture, weighted_covariance
 from fracid.inverse.sensitivity import ForwardRunError, evaluate_points
 
-__all__ = ["PosteriorResult", "PosteriorSettings", "posterior", "weighted_quantile"]
+__all__ = ["PosteriorResult", "PosteriorSettings", "posterior", "sample_posterior", "weighted_quantile"]
 
 
 @dataclass(frozen=True)
@@ -293,7 +293,9 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         proposal = fit_mixture(u_all, weights, settings.components, defensive=settings.defensive, rng=rng)
     failed = int(np.sum(~np.isfinite(loglik)))
     if not np.any(weights > 0):
-        raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh")
+        raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh. "
+                              "Check the bounds of [identify.bounds] (the prior) and the forward runs of the "
+                              "identification; failed runs are stored: --retry-failed runs them again")
     status = "converged" if ess >= settings.target_ess else (
         f"ESS {ess:.0f} below the target {settings.target_ess:g} after {len(proposals)} rounds: the intervals are "
         "rough; raise max_rounds or samples_per_round")
@@ -301,6 +303,41 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
                            np.sqrt(np.diag(C_exp)), ess, len(proposals), failed, np.asarray(x0, float),
                            np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
+
+
+def sample_posterior(evaluate, data, space, identification, settings, *, executor=None, progress=None, log=None):
+    """The posterior of the identified parameters given ``data``, started from the identification's Gaussian.
+
+    Parameters
+    ----------
+    evaluate : StoredOperator or callable
+        The forward operator (through the run store: every draw is stored and reused by a rerun).
+    data : ExperimentalData
+        Measured values ``y`` and their ``covariance``.
+    space : ParameterSpace
+        Names and bounds: the prior is uniform (log-uniform where configured) between the bounds.
+    identification : IdentificationResult
+        Its ``x`` and ``C`` seed the sampler; its ``units`` label the result.
+    settings : PosteriorSettings
+    executor : Executor, optional
+    progress : bool or None
+        Progress bar: None on a terminal only, False never.
+    log : callable, optional
+        ``log(text)``: a line before the sampler starts and one per round.
+
+    Returns and raises as :func:`posterior`; the result carries the identification's units.
+    """
+    from fracid.progress import batch_progress, progress_bar
+
+    total = settings.samples_per_round * settings.max_rounds
+    if log is not None:
+        log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of {settings.samples_per_round}), "
+            f"until the effective sample size reaches {settings.target_ess:g} ([posterior] settings)")
+    with progress_bar(total, "posterior", progress) as bar:
+        result = posterior(evaluate, data.y, data.covariance, space, identification.x, identification.C,
+                           settings=settings, executor=executor, progress=batch_progress(bar), log=log)
+    result.units = dict(identification.units or {})
+    return result
 
 
 def _amis_weights(u, loglik, proposals, sizes) -> tuple[np.ndarray, float]:

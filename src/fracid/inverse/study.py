@@ -5,6 +5,12 @@ KNN over a population (overview, prior) -> sensitivity along the load history at
 population) -> Kalman filter -> multi-start check -> stability under noise -> prediction of data not
 used for calibration -> verdict. The sensitivities need a point, which is why they follow the KNN
 search rather than precede it; every other stage runs in the order of the thesis's strategy (docs/theory.md, section 4.4).
+
+When asked (``StudySettings.posterior``), the posterior of the parameters is sampled on the exact model
+(:func:`fracid.inverse.posterior.posterior`, started from the Kalman filter's Gaussian) after the checks
+and predictions, its runs through the same run store under the label "posterior" (those of ``fracid
+posterior`` in the same directory: either reuses the other's runs); the verdict then reads its 90 %
+credible intervals instead of the Gaussian std (:mod:`fracid.inverse.verdict`) and says so.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.method import identification_bounds
+from fracid.inverse.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
 from fracid.inverse.stability import stability as stability_check
 from fracid.inverse.runs import StoredOperator
@@ -81,7 +88,11 @@ def describe_data(operator) -> DataDescription:
 
 @dataclass
 class StudyResult:
-    """Everything a study computed; :meth:`save` writes it, :func:`fracid.report.study` reports it."""
+    """Everything a study computed; :meth:`save` writes it, :func:`fracid.report.study` reports it.
+
+    ``posterior`` is the sampled :class:`~fracid.inverse.posterior.PosteriorResult` when the study was
+    asked for one and it could be sampled, None otherwise.
+    """
 
     identification: object
     sensitivity: object
@@ -94,6 +105,7 @@ class StudyResult:
     timings: dict = field(default_factory=dict)
     runs: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    posterior: object = None
 
     @property
     def names(self) -> list:
@@ -106,6 +118,9 @@ class StudyResult:
 
     def summary(self) -> str:
         lines = ["Verdict:", self.verdict.text(self.identification.units)]
+        if self.posterior is not None:
+            first = self.posterior.summary().splitlines()[0]
+            lines += [f"Verdict measure: {self.verdict.measure} (std-equivalent: half-width / 1.645)", f"P{first[1:]}"]
         if self.runs:
             lines.append(self.runs_text())
         ident = self.identification
@@ -146,6 +161,9 @@ class StudyResult:
                                "relative_rms": p.relative_rms if p.status == "ok" else None,
                                "chi2_per_point": p.chi2_per_point if p.status == "ok" else None}
                               for p in self.predictions]
+        if self.posterior is not None:
+            out["posterior"] = {**self.posterior.to_dict(), "interval_90_label": "equal-tailed 90 % credible "
+                                "interval (weighted 5 % and 95 % quantiles of the importance-weighted draws)"}
         return json.loads(json.dumps(out, allow_nan=True).replace("NaN", "null").replace("Infinity", "null"))
 
     def save(self, directory) -> Path:
@@ -166,6 +184,8 @@ class StudyResult:
             np.savetxt(directory / "sensitivity.csv", table, delimiter=",", header=",".join(cols), comments="")
         if self.stability is not None:
             np.savetxt(directory / "stability.csv", self.stability.estimates, delimiter=",", header=header, comments="")
+        if self.posterior is not None:
+            self.posterior.save_csv(directory / "posterior.csv")
         return directory
 
 
@@ -195,6 +215,10 @@ class StudySettings:
         Seed of the replicates' noise.
     tolerance : float
         Largest relative standard deviation std / |estimate| called identified [-] (0.1: 10 %).
+    posterior : PosteriorSettings or None
+        Sample the posterior on the exact model with these settings after the checks, and give the
+        verdict from its 90 % credible intervals; None (default): no posterior, the verdict from the
+        Gaussian std.
     """
 
     knn: KnnSettings = KnnSettings()
@@ -204,10 +228,13 @@ class StudySettings:
     replicates: int = 5
     noise_seed: int = 0
     tolerance: float = 0.1
+    posterior: PosteriorSettings | None = None
 
     def __post_init__(self):
         if self.prior not in ("knn", "bounds"):
             raise ValueError(f"prior = {self.prior!r}; choose 'knn' or 'bounds'")
+        if self.posterior is not None and not isinstance(self.posterior, PosteriorSettings):
+            raise TypeError(f"posterior = {self.posterior!r}: give PosteriorSettings(...) or None")
 
     @property
     def identification(self) -> KnnKalman:
@@ -264,7 +291,9 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
 
     Every forward run goes through ``store`` (when given). A failed forward run never ends the
     study: the stage that met it records it (``StudyResult.runs`` counts the failures of every stage,
-    ``notes`` says which checks could not be made).
+    ``notes`` says which checks could not be made). The same holds for the posterior
+    (``settings.posterior``): when it cannot be sampled, a note says why and the verdict reads the
+    Gaussian std.
     """
     if data.y.size != operator.n_outputs:
         raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
@@ -346,11 +375,38 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
         predictions.append(predict(op, held, ident.x, ident.C, executor=executor, name=name))
     if held_out:
         stage("prediction")
+    post = None
+    if settings.posterior is not None:
+        post = _posterior_stage(operator, data, space, ident, settings.posterior, store=store, executor=executor,
+                                progress=progress, log=log, retry_failed=retry_failed, runs=runs, notes=notes)
+        stage("posterior")
     if runs["KNN"][1]:
         notes.insert(0, f"{runs['KNN'][1]} of {runs['KNN'][0]} KNN runs failed (they rank last; see population.csv)")
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
-                                 tolerance=settings.tolerance, multi_start=ms, stability=st)
-    return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes)
+                                 tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=post)
+    return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes,
+                       posterior=post)
+
+
+def _posterior_stage(operator, data, space, ident, settings, *, store, executor, progress, log, retry_failed, runs,
+                     notes):
+    """The posterior sampled from the identification's Gaussian (runs stored under the label "posterior"),
+    or None with a note when there is no finite Gaussian to start from or every run failed."""
+    if not (np.all(np.isfinite(ident.x)) and np.all(np.isfinite(ident.C))):
+        notes.append("posterior skipped: the identification gave no finite estimate and covariance to start the "
+                     "sampler from; the verdict reads the Gaussian std")
+        return None
+    evaluate = StoredOperator(operator, store, study="posterior", retry_failed=retry_failed)
+    try:
+        post = sample_posterior(evaluate, data, space, ident, settings, executor=executor, progress=progress, log=log)
+    except ForwardRunError as err:
+        runs["posterior"] = (evaluate.computed + evaluate.reused, evaluate.failed)
+        notes.append(f"posterior skipped: {err}; the verdict reads the Gaussian std")
+        return None
+    runs["posterior"] = (len(post.x), post.failed)
+    if not post.converged:
+        notes.append(f"posterior: {post.status}")
+    return post
 
 
 @contextmanager

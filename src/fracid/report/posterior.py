@@ -3,7 +3,7 @@ plot, posterior predictive band), its JSON, and a self-contained HTML page setti
 Gaussian beside the sampled posterior.
 
 The sampler itself is :func:`fracid.inverse.posterior.posterior`; here it is only started from an
-identification (:func:`sample_posterior`) and written out (:func:`write_posterior`).
+identification (:func:`fracid.inverse.posterior.sample_posterior`) and written out (:func:`write_posterior`).
 
 Units: control [mm], force [N], parameters in the units of the result (``PosteriorResult.units``).
 """
@@ -29,7 +29,7 @@ from fracid.report.figures import (
     to_png,
 )
 
-__all__ = ["GAUSSIAN_90", "corner_figure", "posterior_dict", "predictive_figure", "sample_posterior",
+__all__ = ["GAUSSIAN_90", "comparison_table", "corner_figure", "posterior_dict", "predictive_figure", "statistics_table",
            "write_posterior", "write_posterior_page"]
 
 #: half-width of the Gaussian 90 % interval in standard deviations (the 95 % quantile of the normal)
@@ -46,55 +46,6 @@ POSTERIOR_INTERVAL = ("posterior: equal-tailed 90 % credible interval (weighted 
 
 
 # ------------------------------------------------------------------------------------ sampling
-
-
-def sample_posterior(evaluate, data, space, identification, settings, *, executor=None, progress=None, log=None):
-    """The posterior of the identified parameters given ``data``, started from the identification's Gaussian.
-
-    Parameters
-    ----------
-    evaluate : StoredOperator or callable
-        The forward operator (through the run store: every draw is stored and reused by a rerun).
-    data : ExperimentalData
-        Measured values ``y`` and their ``covariance``.
-    space : ParameterSpace
-        Names and bounds: the prior is uniform (log-uniform where configured) between the bounds.
-    identification : IdentificationResult
-        Its ``x`` and ``C`` seed the sampler; its ``units`` label the result.
-    settings : PosteriorSettings
-    executor : Executor, optional
-    progress : bool or None
-        Progress bar: None on a terminal only, False never.
-    log : callable, optional
-        ``log(text)``: a line before the sampler starts and one per round.
-
-    Returns
-    -------
-    PosteriorResult
-
-    Raises
-    ------
-    ForwardRunError
-        When every forward run failed (nothing to weigh).
-    """
-    from fracid.inverse.posterior import posterior
-    from fracid.inverse.sensitivity import ForwardRunError
-    from fracid.progress import batch_progress, progress_bar
-
-    total = settings.samples_per_round * settings.max_rounds
-    if log is not None:
-        log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of {settings.samples_per_round}), "
-            f"until the effective sample size reaches {settings.target_ess:g} ([posterior] settings)")
-    with progress_bar(total, "posterior", progress) as bar:
-        try:
-            result = posterior(evaluate, data.y, data.covariance, space, identification.x, identification.C,
-                               settings=settings, executor=executor, progress=batch_progress(bar), log=log)
-        except ForwardRunError as err:
-            raise ForwardRunError(f"{err}. Check the bounds of [identify.bounds] (the prior) and the forward "
-                                  "runs of the identification; failed runs are stored: --retry-failed runs them "
-                                  "again") from None
-    result.units = dict(identification.units or {})
-    return result
 
 
 # ------------------------------------------------------------------------------------ helpers
@@ -369,27 +320,40 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     return [*written, "posterior.html", *skipped]
 
 
+def comparison_table(result) -> str:
+    """HTML table: per parameter, the Kalman filter's estimate, std and Gaussian 90 % interval beside the
+    posterior's mean, std and 90 % credible interval."""
+    from fracid.report.html import _num, _table
+
+    rows = []
+    for name, entry in posterior_dict(result)["parameters"].items():
+        kf, post = entry["kalman_filter"], entry["posterior"]
+        rows.append([name, entry["unit"], _num(kf["estimate"], 5), _num(kf["std"], 3),
+                     f"[{_num(kf['interval_90'][0], 5)}, {_num(kf['interval_90'][1], 5)}]",
+                     _num(post["mean"], 5), _num(post["std"], 3),
+                     f"[{_num(post['interval_90'][0], 5)}, {_num(post['interval_90'][1], 5)}]"])
+    return _table(["parameter", "unit", "Kalman filter estimate", "Kalman filter std",
+                   "Kalman filter 90 % interval (estimate +- 1.645 std)", "posterior mean", "posterior std",
+                   "posterior 90 % credible interval"], rows, text_columns=(0, 1))
+
+
+def statistics_table(result) -> str:
+    """HTML table of the sampler's draws, rounds, effective sample size, failed runs and status."""
+    from fracid.report.html import _num, _table
+
+    return _table(["", ""], [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
+                             ["effective sample size (ESS)", _num(result.ess, 4)], ["failed runs", result.failed],
+                             ["status", result.status]], text_columns=(0, 1))
+
+
 def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid posterior") -> Path:
     """A self-contained HTML page: the Kalman filter's Gaussian estimate beside the posterior per
     parameter, the sampler's statistics and rounds, and the figures ``pngs`` (``corner`` and
     ``posterior_predictive`` PNG bytes) embedded."""
     from fracid.report.html import _e, _image, _num, _table, generated_now, write_document
 
-    info = posterior_dict(result)
-    rows = []
-    for name, entry in info["parameters"].items():
-        kf, post = entry["kalman_filter"], entry["posterior"]
-        rows.append([name, entry["unit"], _num(kf["estimate"], 5), _num(kf["std"], 3),
-                     f"[{_num(kf['interval_90'][0], 5)}, {_num(kf['interval_90'][1], 5)}]",
-                     _num(post["mean"], 5), _num(post["std"], 3),
-                     f"[{_num(post['interval_90'][0], 5)}, {_num(post['interval_90'][1], 5)}]"])
-    table = _table(["parameter", "unit", "Kalman filter estimate", "Kalman filter std",
-                    "Kalman filter 90 % interval (estimate +- 1.645 std)", "posterior mean", "posterior std",
-                    "posterior 90 % credible interval"], rows, text_columns=(0, 1))
+    table, stats = comparison_table(result), statistics_table(result)
     status = _e(result.status) if result.converged else f'<span class="warn">{_e(result.status)}</span>'
-    stats = _table(["", ""], [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
-                              ["effective sample size (ESS)", _num(result.ess, 4)], ["failed runs", result.failed]],
-                   text_columns=(0,))
     history = _table(["round", "draws", "failed", "ESS after the round", "proposal components"],
                      [[h.get("round", k) + 1, h.get("draws", ""), h.get("failed", ""), _num(h.get("ess"), 4),
                        h.get("components", "")] for k, h in enumerate(result.history)])

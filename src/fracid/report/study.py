@@ -2,7 +2,11 @@
 
 :func:`write_study` writes the JSON and CSV tables of the study, its figures as PNG files and one
 HTML report: the identification report of :func:`fracid.report.html.write_report` followed by the
-study's sections (verdict, sensitivity, uniqueness, multi-start, stability, predictions, size effect).
+study's sections (verdict, posterior, sensitivity, uniqueness, multi-start, stability, predictions, size
+effect). A study with a sampled posterior also gets the files of ``fracid posterior``
+(:func:`fracid.report.posterior.write_posterior`: posterior.csv, .json, .nc, .html and the corner and
+predictive figures), and its report a "Posterior" section: the Kalman filter's and the posterior's
+90 % intervals side by side, the sampler's statistics and those two figures.
 """
 
 from __future__ import annotations
@@ -14,6 +18,8 @@ import numpy as np
 from fracid.report.figures import (_ESTIMATE, _MEASURED, _NEIGHBOUR, _new_figure, _parameter_axis, parameter_label,
                                    parameter_units, sensitivity_figure, size_effect_figure, to_png)
 from fracid.report.html import _e, _image, _table, write_report
+from fracid.report.posterior import (comparison_table, corner_figure, predictive_figure, statistics_table,
+                                     write_posterior)
 
 
 def valley_figure(maps, multi_start=None, truth=None, names=None):
@@ -107,20 +113,61 @@ def study_figures(study, control=None, truth=None, size_effect=None) -> dict:
 
 def _verdict_section(study) -> str:
     units = {**parameter_units(), **(study.identification.units or {})}
-    rows = [[v.name, v.status, f"{v.value:.5g}", f"{v.std:.3g}", f"{v.std / abs(v.value):.1%}",
+    rows = [[v.name, v.status, f"{v.value:.5g}", f"{v.std:.3g}", f"{v.std / abs(v.value):.1%}", v.measure,
              f"{v.partner} ({v.correlation:+.3f})" if v.partner else "", f"{v.variance_removed:.0%}",
              "; ".join(v.remarks + tuple(f"would help: {s}" for s in v.suggestions))] for v in study.verdict.parameters]
-    table = _table(["parameter", "verdict", "estimate", "std", "std/|x|", "most correlated with", "prior variance removed",
-                    "remarks"], rows, text_columns=(0, 1, 5, 7))
+    table = _table(["parameter", "verdict", "estimate", "std", "std/|x|", "measure", "most correlated with",
+                    "prior variance removed", "remarks"], rows, text_columns=(0, 1, 5, 6, 8))
+    if getattr(study, "posterior", None) is not None:
+        table = ("<p>Measure: the posterior's equal-tailed 90 % credible interval (see Posterior below). Estimate: the "
+                 "posterior mean; std: the interval's half-width / 1.645 (its standard deviation if the posterior were "
+                 "normal); correlations: the weighted covariance of the draws.</p>" + table)
     text = "<pre>" + _e(study.verdict.text(units)) + "</pre>"
     runs = f"<p>{_e(study.runs_text())}</p>" if getattr(study, "runs", None) else ""
     notes = "".join(f"<li>{_e(n)}</li>" for n in getattr(study, "notes", ()))
     return table + text + runs + (f'<ul class="notes">{notes}</ul>' if notes else "")
 
 
-def study_sections(study, figures: dict) -> list:
-    """(heading, HTML) sections of a study for :func:`~fracid.report.html.write_report`."""
+def _posterior_section(post, pngs: dict) -> str:
+    """The Kalman filter's Gaussian beside the sampled posterior, the sampler's statistics and its figures."""
+    table, stats = comparison_table(post), statistics_table(post)
+    status = _e(post.status) if post.converged else f'<span class="warn">{_e(post.status)}</span>'
+    text = ("<p>Adaptive importance sampling on the exact forward model (every draw one forward run, stored in "
+            "runs.sqlite under the label \"posterior\"), started from the Kalman filter's Gaussian, prior uniform "
+            "between the bounds of [identify.bounds] (log-uniform where log-scaled), with the [posterior] settings. "
+            f"Status: {status}. The draws and their weights are in posterior.csv, the numbers in posterior.json; "
+            '<a href="posterior.html">posterior.html</a> shows the sampler\'s rounds too.</p>')
+    figures = [_image(pngs["corner"], "corner plot",
+                      "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and "
+                      "pair (below: 2D histogram), with the Kalman filter's Gaussian in red (normal curve; 1 and 2 "
+                      "std ellipses; x its estimate; orange +: the posterior mean).")]
+    if pngs.get("posterior_predictive") is not None:
+        figures.append(_image(pngs["posterior_predictive"], "posterior predictive",
+                              "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without "
+                              "measurement noise), its median, and the Kalman filter's fit (dashed)."))
+    return text + table + stats + "".join(figures)
+
+
+def posterior_pngs(study, data=None) -> dict:
+    """The corner and predictive figures of the study's posterior as PNG bytes (empty without one)."""
+    post = getattr(study, "posterior", None)
+    if post is None:
+        return {}
+    control = None if data is None else data.control
+    blocks = None if data is None else data.blocks
+    return {"corner": to_png(corner_figure(post)),
+            "posterior_predictive": to_png(predictive_figure(post, control, blocks, study.identification.y_fit))}
+
+
+def study_sections(study, figures: dict, posterior_figures: dict | None = None) -> list:
+    """(heading, HTML) sections of a study for :func:`~fracid.report.html.write_report`.
+
+    ``posterior_figures``: the PNG bytes of the posterior's ``corner`` and ``posterior_predictive``
+    figures (drawn here when the study has a posterior and they are not given)."""
     sections = [("Verdict", _verdict_section(study))]
+    if getattr(study, "posterior", None) is not None:
+        pngs = posterior_figures or posterior_pngs(study)
+        sections.append(("Posterior", _posterior_section(study.posterior, pngs)))
     captions = {
         "sensitivity": "Normalised sensitivities along the load history and the share of each parameter's prior "
                        "(bounds) variance removed by the data up to each point.",
@@ -145,9 +192,10 @@ def study_sections(study, figures: dict) -> list:
 
 
 def write_study(directory, study, data, *, title="fracid study", truth=None, size_effect=None) -> list:
-    """Write the study's JSON/CSV tables, figures (PNG) and HTML report into ``directory``.
+    """Write the study's JSON/CSV tables, figures (PNG) and HTML report into ``directory``; with a
+    posterior, also the files of :func:`~fracid.report.posterior.write_posterior`.
 
-    Returns the paths written.
+    Returns the paths written; a note in brackets (a string, not a path) for a posterior file skipped.
     """
     directory = Path(directory)
     study.save(directory)
@@ -159,7 +207,19 @@ def write_study(directory, study, data, *, title="fracid study", truth=None, siz
             path = directory / "figures" / f"{name}.png"
             path.write_bytes(to_png(fig))
             written.append(path)
+    pngs, notes = None, []
+    if getattr(study, "posterior", None) is not None:
+        post = study.posterior
+        for item in write_posterior(directory, post, data=data, fit=study.identification.y_fit,
+                                    title=f"{title}: posterior"):  # log axes: the posterior's own (its space's)
+            if item.startswith("("):
+                notes.append(item)
+            else:
+                written.append(directory / item)
+        pngs = {name: (directory / "figures" / f"{name}.png").read_bytes()
+                for name in ("corner", "posterior_predictive")}
     report = write_report(directory / "report.html", study.identification,
                           control=None if data is None else data.control, title=title,
-                          data_notes=() if data is None else data.notes, extra_sections=study_sections(study, figs))
-    return written + [report]
+                          data_notes=() if data is None else data.notes,
+                          extra_sections=study_sections(study, figs, pngs))
+    return written + [report] + notes
