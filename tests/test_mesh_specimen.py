@@ -347,16 +347,21 @@ directory = "results"
 """
 
 
+def write_strip_twin(directory, config: str) -> None:
+    """strip.msh (triangles), curve.csv (its elongation-force curve at beta = 300) and strip.toml (``config``)."""
+    path = write_msh(directory / "strip.msh", *grid(6, 2, True), "triangle")
+    truth = DamageModel().simulate(strip(path), fracid.DamageParameters(E=E, kappa_i=1e-4, c=4.0, beta=300.0),
+                                   target=0.012, stop_force_fraction=None, checkpoints=np.linspace(0.002, 0.012, 8))
+    (directory / "curve.csv").write_text("elongation,force\n" + "".join(
+        f"{x:.9g},{f:.9g}\n" for x, f in zip(truth.control[1:], truth.force[1:])))
+    (directory / "strip.toml").write_text(config)
+
+
 def test_identify_with_a_mesh_specimen_writes_result_report_and_vtk(tmp_path):
     """fracid identify on a mesh specimen as on a built-in one: a twin of beta = 300 found back."""
     from fracid import cli
 
-    path = write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
-    truth = DamageModel().simulate(strip(path), fracid.DamageParameters(E=E, kappa_i=1e-4, c=4.0, beta=300.0),
-                                   target=0.012, stop_force_fraction=None, checkpoints=np.linspace(0.002, 0.012, 8))
-    (tmp_path / "curve.csv").write_text("elongation,force\n" + "".join(
-        f"{x:.9g},{f:.9g}\n" for x, f in zip(truth.control[1:], truth.force[1:])))
-    (tmp_path / "strip.toml").write_text(IDENTIFY)
+    write_strip_twin(tmp_path, IDENTIFY)
     assert cli.main(["identify", str(tmp_path / "strip.toml"), "--quiet", "--workers", "1"]) == 0
     import json
 
@@ -371,12 +376,7 @@ def test_study_on_a_mesh_specimen_gives_its_verdict(tmp_path):
     from fracid import cli
     import json
 
-    path = write_msh(tmp_path / "strip.msh", *grid(6, 2, True), "triangle")
-    truth = DamageModel().simulate(strip(path), fracid.DamageParameters(E=E, kappa_i=1e-4, c=4.0, beta=300.0),
-                                   target=0.012, stop_force_fraction=None, checkpoints=np.linspace(0.002, 0.012, 8))
-    (tmp_path / "curve.csv").write_text("elongation,force\n" + "".join(
-        f"{x:.9g},{f:.9g}\n" for x, f in zip(truth.control[1:], truth.force[1:])))
-    (tmp_path / "strip.toml").write_text(IDENTIFY + "\n[study]\nstarts = 2\nreplicates = 2\n")
+    write_strip_twin(tmp_path, IDENTIFY + "\n[study]\nstarts = 2\nreplicates = 2\n")
     assert cli.main(["study", str(tmp_path / "strip.toml"), "--quiet", "--workers", "2"]) == 0
     study = json.loads((tmp_path / "results" / "study.json").read_text())
     [verdict] = study["verdict"]["parameters"]

@@ -244,7 +244,7 @@ def run_posterior_command(args) -> int:
         evaluate = StoredOperator(job.operator, store, study="posterior", retry_failed=args.retry_failed)
         post = sample_posterior(evaluate, job.data, job.space, result, settings, executor=executor,
                                 progress=_progress(args), log=lambda text: _say(args, text))
-    written = write_posterior(out, post, data=job.data, fit=result.y_fit, log_axes=job.space.log,
+    written = write_posterior(out, post, data=job.data, fit=result.y_fit,
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     _say(args, post.summary())
     _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "

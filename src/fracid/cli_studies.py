@@ -29,16 +29,13 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
     from dataclasses import replace
 
     from fracid.config import build_experiment_data, build_model, build_specimen
-    from fracid.inverse.size_effect import (compare_size_effect, has_nominal_strength, nominal_strength,
-                                            specimen_size)
+    from fracid.inverse.size_effect import compare_size_effect, nominal_strength, specimen_size
 
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
         if exp.quantity != "force":
             continue
         specimen = build_specimen(cfg, exp)
-        if not has_nominal_strength(specimen):
-            return None  # a mesh specimen: no size to scale (the study's log says it was skipped)
         D = specimen_size(specimen)
         specimens[D] = specimen
         measured.setdefault(D, []).append(nominal_strength(specimen, float(np.max(build_experiment_data(cfg, exp).y))))
@@ -88,11 +85,11 @@ def run_study_command(args) -> int:
                           progress=_progress(args), log=lambda text: _say(args, text),
                           retry_failed=args.retry_failed)
         size = None
-        if args.command == "study":
+        if args.command == "study" and not _has_size(cfg):
+            _say(args, "size effect: skipped (the specimen declares no characteristic size and nominal "
+                       "section: a mesh specimen has none)")
+        elif args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
-            if size is None and not _has_size(cfg):
-                _say(args, "size effect: skipped (the specimen declares no characteristic size and nominal "
-                           "section: a mesh specimen has none)")
     if size is not None:
         size.save(out)
     written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
@@ -142,13 +139,13 @@ def run_size_effect_command(args) -> int:
     from fracid.report.figures import size_effect_figure, to_png
 
     cfg = _load(args, args.config, "simulate")
-    out = _out_dir(args, cfg)
-    with _working_in(args, out), _executor(args) as executor:
-        size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
-    if size is None and not _has_size(cfg):
+    if not _has_size(cfg):
         print(f"fracid: size-effect: the specimen {type(build_specimen(cfg)).__name__} declares no characteristic size "
               "and nominal section (a mesh specimen has none): use a built-in specimen", file=sys.stderr)
         return 2
+    out = _out_dir(args, cfg)
+    with _working_in(args, out), _executor(args) as executor:
+        size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
     if size is None:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
               "[experiments.specimen] sizes", file=sys.stderr)

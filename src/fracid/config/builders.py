@@ -187,11 +187,7 @@ def study_settings(cfg: Config) -> dict:
 def posterior_settings(cfg: Config):
     """The :class:`~fracid.inverse.posterior.PosteriorSettings` of ``[posterior]`` (its defaults when the
     section is absent)."""
-    import dataclasses
-
-    from fracid.inverse.posterior import PosteriorSettings
-
-    return PosteriorSettings(**dataclasses.asdict(cfg.posterior))
+    return cfg.posterior
 
 
 def build_space(cfg: Config):

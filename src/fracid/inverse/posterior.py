@@ -226,8 +226,10 @@ def _log_likelihood(records, y_exp, factor):
 def _first_proposal(space, x0, C0, settings, rng) -> GaussianMixture:
     """The estimate's Gaussian in unit-cube coordinates (linearised map), its std times ``inflation``."""
     u0 = np.clip(space.to_unit(x0)[0], 1e-6, 1 - 1e-6)
-    step = 1e-6 * np.maximum(np.abs(x0), 1e-12)
-    jac = (space.to_unit(x0 + step)[0] - space.to_unit(x0 - step)[0]) / (2 * step)
+    log = np.array(space.log, dtype=bool)
+    ratio = np.where(log, space.upper, 1.0) / np.where(log, space.lower, 1.0)
+    span = np.where(log, np.log(ratio), space.upper - space.lower)
+    jac = 1.0 / np.where(log, x0 * span, span)  # du/dx of ParameterSpace.to_unit
     cov = settings.inflation**2 * (jac[:, None] * np.asarray(C0, float) * jac[None, :])
     cov = cov + 1e-10 * np.eye(len(u0))
     return GaussianMixture(np.ones(1), u0[None], cov[None], settings.defensive).with_mass(rng)
@@ -271,17 +273,20 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     factor = np.linalg.cholesky(C_exp)
     rng = np.random.default_rng(settings.seed)
     proposal = _first_proposal(space, np.asarray(x0, float), C0, settings, rng)
-    proposals, sizes, history = [], [], []
+    proposals, densities, sizes, history = [], [], [], []
     u_all, loglik, outputs = np.empty((0, len(space.names))), np.empty(0), np.empty((0, len(y_exp)))
     weights, ess = np.empty(0), 0.0
     for round_ in range(settings.max_rounds):
         u = proposal.sample(rng, settings.samples_per_round)
         records = evaluate_points(evaluate, space.from_unit(u), None, executor)
         ll, y = _log_likelihood(records, y_exp, factor)
+        # every proposal's log density at every draw: the earlier ones at the new draws, the new one at all
+        densities = [np.concatenate([row, q.logpdf(u)]) for row, q in zip(densities, proposals)]
         proposals.append(proposal)
         sizes.append(len(u))
         u_all, loglik, outputs = np.vstack([u_all, u]), np.concatenate([loglik, ll]), np.vstack([outputs, y])
-        weights, ess = _amis_weights(u_all, loglik, proposals, sizes)
+        densities.append(proposal.logpdf(u_all))
+        weights, ess = _amis_weights(np.vstack(densities), loglik, sizes)
         history.append({"round": round_, "draws": len(u), "failed": int(np.sum(~np.isfinite(ll))), "ess": ess,
                         "components": len(proposal.weights)})
         if progress is not None:
@@ -340,12 +345,13 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
     return result
 
 
-def _amis_weights(u, loglik, proposals, sizes) -> tuple[np.ndarray, float]:
-    """Deterministic-mixture weights of all draws against all proposals so far, normalised, and their ESS."""
+def _amis_weights(densities, loglik, sizes) -> tuple[np.ndarray, float]:
+    """Deterministic-mixture weights of all draws against all proposals so far (``densities``: the log density
+    of proposal t at draw i, shape (rounds, draws); ``sizes``: the draws of each), normalised, and their ESS."""
     n = np.array(sizes, float)
-    log_q = logsumexp(np.vstack([q.logpdf(u) for q in proposals]) + np.log(n / n.sum())[:, None], axis=0)
+    log_q = logsumexp(densities + np.log(n / n.sum())[:, None], axis=0)
     log_w = np.where(np.isfinite(loglik), loglik - log_q, -np.inf)
     if not np.any(np.isfinite(log_w)):
-        return np.zeros(len(u)), 0.0
+        return np.zeros(len(loglik)), 0.0
     w = np.exp(log_w - logsumexp(log_w))
     return w, float(1.0 / np.sum(w**2)) if math.isfinite(np.sum(w**2)) else 0.0

@@ -176,18 +176,9 @@ def fit_figure(result, control=None) -> Figure:
     y_exp = _float_array(result.y_exp, np.nan)
     std = _float_array(result.std_exp, np.nan)
     y_fit = _float_array(result.y_fit, np.nan) if result.y_fit is not None else np.full_like(y_exp, np.nan)
-    if control is not None:
-        control = _float_array(control, np.nan)
-        if control.shape != y_exp.shape:
-            raise ValueError(f"control has {control.size} values but the result holds {y_exp.size} measured values")
-    blocks = result_blocks(result)
-    ncols = 1 if len(blocks) == 1 else 2
-    nrows = math.ceil(len(blocks) / ncols)
-    fig = _new_figure(6.4 * ncols, 4.0 * nrows)
-    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
-    for ax, (name, start, stop) in zip(axes, blocks):
-        part = slice(start, stop)
-        x = control[part] if control is not None else np.arange(stop - start, dtype=float)
+    fig, panels = block_panels(result_blocks(result), None if control is None else _float_array(control, np.nan),
+                               y_exp.size)
+    for ax, name, part, x in panels:
         y, s, fit = y_exp[part], std[part], y_fit[part]
         sort = np.argsort(x, kind="stable")
         ax.fill_between(x[sort], (y - 2 * s)[sort], (y + 2 * s)[sort], color=_MEASURED, alpha=0.2, lw=0,
@@ -195,14 +186,38 @@ def fit_figure(result, control=None) -> Figure:
         ax.plot(x, y, "o", color=_MEASURED, ms=3.5, label="measured")
         if np.any(np.isfinite(fit)):
             ax.plot(x[sort], fit[sort], "-", color=_COMPUTED, lw=1.6, label="computed at the estimate")
-        ax.set_xlabel("control [mm]" if control is not None else "point index in the block [-]")
-        ax.set_ylabel(block_quantity(name))
-        ax.set_title(name)
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize="small")
+        finish_block_panel(ax, name, control is not None)
+    return fig
+
+
+def block_panels(blocks, control, n_values: int):
+    """A figure of one panel per data block (two columns beyond one block, unused panels hidden).
+
+    Returns the figure and, per block, ``(ax, name, part, x)``: ``part`` the block's slice of y and ``x``
+    its control values [mm], or the point index in the block when ``control`` is None. Raises ValueError
+    when ``control`` does not hold ``n_values`` values. :func:`finish_block_panel` labels a panel.
+    """
+    if control is not None and np.shape(control) != (n_values,):
+        raise ValueError(f"control has {np.size(control)} values but the result holds {n_values} measured values")
+    ncols = 1 if len(blocks) == 1 else 2
+    nrows = math.ceil(len(blocks) / ncols)
+    fig = _new_figure(6.4 * ncols, 4.0 * nrows)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax in axes[len(blocks):]:
         ax.set_visible(False)
-    return fig
+    panels = [(ax, name, slice(start, stop),
+               control[start:stop] if control is not None else np.arange(stop - start, dtype=float))
+              for ax, (name, start, stop) in zip(axes, blocks)]
+    return fig, panels
+
+
+def finish_block_panel(ax, name: str, has_control: bool) -> None:
+    """Axis labels (control or point index, the block's quantity), title, grid and legend of a block's panel."""
+    ax.set_xlabel("control [mm]" if has_control else "point index in the block [-]")
+    ax.set_ylabel(block_quantity(name))
+    ax.set_title(name)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
 
 
 def kalman_figure(result) -> Figure | None:

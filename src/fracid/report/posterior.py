@@ -19,12 +19,14 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from fracid.inverse.verdict import Z_90
 from fracid.report.figures import (
     _COMPUTED,
     _MEASURED,
     _ellipse,
     _new_figure,
-    block_quantity,
+    block_panels,
+    finish_block_panel,
     parameter_units,
     to_png,
 )
@@ -33,7 +35,7 @@ __all__ = ["GAUSSIAN_90", "comparison_table", "corner_figure", "posterior_dict",
            "write_posterior", "write_posterior_page"]
 
 #: half-width of the Gaussian 90 % interval in standard deviations (the 95 % quantile of the normal)
-GAUSSIAN_90 = 1.6448536269514722
+GAUSSIAN_90 = Z_90
 
 _POSTERIOR = "#1f77b4"
 _GAUSSIAN = _COMPUTED
@@ -43,9 +45,6 @@ _MEAN = "#ff7f0e"
 KALMAN_INTERVAL = "Kalman filter: Gaussian 90 % interval, estimate +- 1.645 std"
 POSTERIOR_INTERVAL = ("posterior: equal-tailed 90 % credible interval (weighted 5 % and 95 % quantiles of the "
                       "importance-weighted draws)")
-
-
-# ------------------------------------------------------------------------------------ sampling
 
 
 # ------------------------------------------------------------------------------------ helpers
@@ -218,18 +217,9 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
     std = np.asarray(result.std_exp, float)
     lower, median, upper = result.predictive_band(0.9)
     fit = None if fit is None else np.asarray(fit, float)
-    if control is not None:
-        control = np.asarray(control, float)
-        if control.shape != y_exp.shape:
-            raise ValueError(f"control has {control.size} values but the result holds {y_exp.size} measured values")
     blocks = [(str(b[0]), int(b[1]), int(b[2])) for b in (blocks or [])] or [("data", 0, y_exp.size)]
-    ncols = 1 if len(blocks) == 1 else 2
-    nrows = math.ceil(len(blocks) / ncols)
-    fig = _new_figure(6.4 * ncols, 4.0 * nrows)
-    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
-    for ax, (name, start, stop) in zip(axes, blocks):
-        part = slice(start, stop)
-        xs = control[part] if control is not None else np.arange(stop - start, dtype=float)
+    fig, panels = block_panels(blocks, None if control is None else np.asarray(control, float), y_exp.size)
+    for ax, name, part, xs in panels:
         order = np.argsort(xs, kind="stable")
         ax.fill_between(xs[order], lower[part][order], upper[part][order], color=_POSTERIOR, alpha=0.25, lw=0,
                         label="posterior 90 % band of the computed curve")
@@ -238,13 +228,7 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
             ax.plot(xs[order], fit[part][order], "--", color=_GAUSSIAN, lw=1.4, label="Kalman filter fit")
         ax.errorbar(xs, y_exp[part], yerr=std[part], fmt="o", color=_MEASURED, ms=3.5, capsize=2, lw=1,
                     label="measured +- std", zorder=3)
-        ax.set_xlabel("control [mm]" if control is not None else "point index in the block [-]")
-        ax.set_ylabel(block_quantity(name))
-        ax.set_title(name)
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize="small")
-    for ax in axes[len(blocks):]:
-        ax.set_visible(False)
+        finish_block_panel(ax, name, control is not None)
     return fig
 
 
