@@ -13,7 +13,7 @@ FLOORS = {
     "inverse": 3,
     "report": 4,
     "config": 5,
-    "cli": 6, "cli_studies": 6, "exits": 6, "lock": 6, "__main__": 6, "__init__": 6,
+    "cli": 6, "cli_studies": 6, "exits": 6, "lock": 6, "outputs": 6, "__main__": 6, "__init__": 6,
 }
 
 

@@ -3,11 +3,33 @@
 Units throughout: N, mm, MPa (N/mm^2); the gradient parameter ``c`` in mm^2.
 """
 
-from fracid.fem.parameters import DamageParameters
-from fracid.fem.path_following import ConvergenceError, PathResult, StepOptions, follow_path
-from fracid.fem.solver import NewtonOptions
-from fracid.specimens.bar import BarWithWeakZone
-from fracid.forward import simulate
+import importlib
+
+# imported when first used (PEP 562), so that `fracid` on the command line starts at once and a Ctrl-C
+# while it starts finds the command's handler, not a half-imported scipy
+_EXPORTS = {
+    "BarWithWeakZone": "fracid.specimens.bar",
+    "ConvergenceError": "fracid.fem.path_following",
+    "DamageParameters": "fracid.fem.parameters",
+    "NewtonOptions": "fracid.fem.solver",
+    "PathResult": "fracid.fem.path_following",
+    "StepOptions": "fracid.fem.path_following",
+    "follow_path": "fracid.fem.path_following",
+    "simulate": "fracid.forward",
+}
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(_EXPORTS[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'fracid' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted([*globals(), *_EXPORTS])
+
 
 __all__ = [
     "BarWithWeakZone",

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import signal
 import sys
 import time
 import traceback
@@ -83,12 +82,27 @@ def _load(args, path, purpose):
 
 
 def _out_dir(args, cfg) -> Path:
-    out = args.out if args.out is not None else Path(cfg.output.directory)
+    """The output directory, made if needed, once the command's outputs are known to replace neither an
+    input of the run nor a file fracid did not write (:func:`fracid.outputs.claim_outputs`)."""
+    from fracid.outputs import claim_outputs
+
+    out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
     if out.exists() and not out.is_dir():
         raise NotADirectoryError(20, "not a directory", str(out))
     out.mkdir(parents=True, exist_ok=True)
+    claim_outputs(out, args.command, _inputs(cfg))
     args.out_dir = out
     return out
+
+
+def _inputs(cfg):
+    """(what it is, path) of every file the run reads: the configuration, the data files, a mesh."""
+    yield "the configuration", Path(cfg.path)
+    for exp in cfg.experiments:
+        yield f"experiments[{exp.index}].file", Path(exp.file)
+    mesh = dict(cfg.specimen.options).get("path")
+    if mesh is not None:
+        yield "specimen.file", Path(mesh)
 
 
 @contextlib.contextmanager
@@ -188,16 +202,15 @@ def _identification(args, job, store, executor):
 def _write_identification(args, job, out, result) -> None:
     """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
     from fracid.report.html import write_report
+    from fracid.report.tables import write_csv_table
 
     data = job.data
     result.save(out / "result.json")
-    header = "control_mm,measured,std,computed,block"
     block_of = np.empty(data.y.size, dtype=object)
     for name, a, b in data.blocks:
         block_of[a:b] = name
-    rows = [f"{c:.9g},{y:.9g},{s:.9g},{f:.9g},{blk}" for c, y, s, f, blk in
-            zip(data.control, data.y, data.std, result.y_fit, block_of)]
-    (out / "fit.csv").write_text("\n".join([header, *rows]) + "\n")
+    write_csv_table(out / "fit.csv", ("control_mm", "measured", "std", "computed", "block"),
+                    zip(data.control.tolist(), data.y.tolist(), data.std.tolist(), result.y_fit.tolist(), block_of))
     write_report(out / "report.html", result, control=data.control,
                  title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes)
     _write_figures(out / "figures", result, data.control)
@@ -283,24 +296,26 @@ def main(argv=None) -> int:
     """Run the command; returns its exit status (see :mod:`fracid.exits`), never raises."""
     from fracid import exits
 
-    args = _parser().parse_args(argv)
-    if args.workers is not None and args.workers < 1:
-        print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
-        return exits.INPUT
-    args.store_path = args.out_dir = None
-    previous = _terminate_as_interrupt()
-    try:
-        return _dispatch(args)
-    except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
-        if isinstance(err, SystemExit):
+    args = None
+    with exits.stop_signals():
+        try:
+            args = _parser().parse_args(argv)
+            if args.workers is not None and args.workers < 1:
+                print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
+                return exits.INPUT
+            args.store_path = args.out_dir = None
+            return _dispatch(args)
+        except SystemExit:
             raise
-        status, text = exits.describe(err, store_path=args.store_path, out=args.out_dir)
-        if args.debug:
-            traceback.print_exc()
-        print(f"fracid: {text}", file=sys.stderr)
-        return status
-    finally:
-        _restore(previous)
+        except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
+            if isinstance(err, KeyboardInterrupt):
+                exits.ignore_stop_signals()  # a second Ctrl-C must not break the message
+            status, text = exits.describe(err, store_path=getattr(args, "store_path", None),
+                                          out=getattr(args, "out_dir", None))
+            if getattr(args, "debug", False):
+                traceback.print_exc()
+            print(f"fracid: {text}", file=sys.stderr)
+            return status
 
 
 def _dispatch(args) -> int:
@@ -317,24 +332,6 @@ def _dispatch(args) -> int:
     if args.out is None:  # not next to the bundled config inside the installation
         args.out = Path.cwd() / "fracid-demo"
     return run_identify(args, demo_config_path())
-
-
-def _terminate_as_interrupt():
-    """SIGTERM ends the run like Ctrl-C (finished runs stored, a message, exit 143)."""
-    from fracid.exits import Terminated
-
-    def handler(signum, frame):
-        raise Terminated()
-
-    try:
-        return signal.signal(signal.SIGTERM, handler)
-    except ValueError:  # not the main thread (e.g. called from a test runner's thread)
-        return None
-
-
-def _restore(previous):
-    if previous is not None:
-        signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

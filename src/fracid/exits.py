@@ -11,20 +11,75 @@ status  meaning
 4       files and storage: a path that cannot be read or written, a full disk, a corrupt run
         store, an output directory in use by another fracid process
 5       out of memory
-130     interrupted (Ctrl-C); 143: terminated (SIGTERM). Finished runs are stored: run again to resume
+130     interrupted (Ctrl-C); 143: terminated (SIGTERM); 129: hang-up (SIGHUP, the terminal closed).
+        Finished runs are stored: run again to resume
 ======  =====================================================================================
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
+import os
+import shutil
+import signal
 import sqlite3
+import sys
 
-OK, INTERNAL, INPUT, FAILED, FILES, MEMORY, INTERRUPTED, TERMINATED = 0, 1, 2, 3, 4, 5, 130, 143
+OK, INTERNAL, INPUT, FAILED, FILES, MEMORY, INTERRUPTED, TERMINATED, HUNG_UP = 0, 1, 2, 3, 4, 5, 130, 143, 129
 
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised in the main thread so that the run ends as cleanly as after Ctrl-C."""
+
+
+class HungUp(Terminated):
+    """SIGHUP (the terminal or the SSH session closed), ended as SIGTERM is."""
+
+
+_RAISED_BY = {"SIGINT": KeyboardInterrupt, "SIGTERM": Terminated, "SIGHUP": HungUp}
+
+
+@contextlib.contextmanager
+def stop_signals():
+    """Within: the first of SIGINT, SIGTERM or SIGHUP raises KeyboardInterrupt, Terminated or HungUp in
+    the main thread; every later one is ignored, so that a second Ctrl-C (or GNU ``timeout``, which
+    signals twice) cannot break the cleanup or the message. The previous handlers are restored after.
+    Outside the main thread (a test runner's thread) nothing is installed."""
+    received = []
+
+    def handler(signum, frame):
+        if not received:
+            received.append(signum)
+            raise _RAISED_BY[signal.Signals(signum).name]()
+
+    previous = {}
+    try:
+        for name in _RAISED_BY:
+            if hasattr(signal, name):
+                previous[name] = signal.signal(getattr(signal, name), handler)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield received
+    finally:
+        for name, old in previous.items():
+            signal.signal(getattr(signal, name), old)
+
+
+def ignore_stop_signals() -> None:
+    """Ignore SIGINT, SIGTERM and SIGHUP from now on (while a last message is written)."""
+    with contextlib.suppress(ValueError):  # not the main thread
+        for name in _RAISED_BY:
+            if hasattr(signal, name):
+                signal.signal(getattr(signal, name), signal.SIG_IGN)
+
+
+def _loaded(module: str, name: str) -> tuple:
+    """The class ``name`` of ``module`` if that module is imported, else (): an exception of a module
+    never imported cannot have been raised, and describing a failure must import nothing heavy."""
+    found = getattr(sys.modules.get(module), name, None)
+    return () if found is None else (found,)
 
 
 class UsageError(ValueError):
@@ -37,13 +92,15 @@ class OutputInUse(OSError):
 
 def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str]:
     """(exit status, message) for an exception that ended a command."""
-    from fracid.config import ConfigError
-    from fracid.data import DataError
-    from fracid.inverse.knn import AllRunsFailed
-    from fracid.inverse.sensitivity import ForwardRunError
-    from fracid.fem.path_following import ConvergenceError
-
+    config_error = _loaded("fracid.config.schema", "ConfigError")
+    data_error = _loaded("fracid.data.curves", "DataError")
+    mesh_error = _loaded("fracid.specimens.mesh", "MeshError")
+    all_failed = _loaded("fracid.inverse.knn", "AllRunsFailed")
+    run_error = _loaded("fracid.inverse.sensitivity", "ForwardRunError")
+    no_convergence = _loaded("fracid.fem.path_following", "ConvergenceError")
     resume = f"Finished runs are stored in {store_path}; run the same command again to resume." if store_path else ""
+    if isinstance(err, HungUp):
+        return HUNG_UP, f"hang-up (SIGHUP: the terminal closed). {resume}".strip()
     if isinstance(err, Terminated):
         return TERMINATED, f"terminated (SIGTERM). {resume}".strip()
     if isinstance(err, KeyboardInterrupt):
@@ -51,26 +108,64 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     if isinstance(err, MemoryError):
         return MEMORY, ("out of memory. Use a coarser mesh (h_fine, n_elements), a smaller population "
                         "([identify.knn] n), fewer data points (n_points) or fewer workers (--workers).")
-    if isinstance(err, (ConfigError, DataError, UsageError)):
+    if isinstance(err, (*config_error, *data_error, *mesh_error, UsageError)):
         return INPUT, str(err)
-    if isinstance(err, ConvergenceError):
+    if isinstance(err, no_convergence):
         return FAILED, _convergence_text(err)
-    if isinstance(err, AllRunsFailed):
+    if isinstance(err, all_failed):
         return FAILED, (f"{err} Check the parameter values and bounds against the data's units, or the control "
                         f"(an indirect control such as cmod or weak_zone_elongation passes snap-back). "
                         f"Failed runs are stored; --retry-failed runs them again.")
-    if isinstance(err, ForwardRunError):
+    if isinstance(err, run_error):
         return FAILED, str(err)
     if isinstance(err, OutputInUse):
         return FILES, str(err)
     if isinstance(err, sqlite3.Error):
-        where = store_path or "the run store"
-        return FILES, (f"the run store {where} cannot be used ({err}). If it is corrupt or truncated, move it away "
-                       f"(e.g. rename it to runs.sqlite.bad) and run again: the runs will be recomputed.")
+        return FILES, _store_text(err, store_path or "the run store")
     if isinstance(err, OSError):
         return FILES, _os_text(err, out)
     return INTERNAL, (f"internal error ({type(err).__name__}: {err}). Run again with --debug to see the traceback, "
                       "and please report it.")
+
+
+#: SQLite's primary result codes (https://sqlite.org/rescode.html) -> what happened and what to do
+_STORE_ADVICE = {
+    13: "the disk that holds it{disk} is full. Free some space and run the same command again: the runs "
+        "stored before are intact and will be reused",  # SQLITE_FULL
+    10: "a disk input/output error (a removed drive, a network file system that went away?). Check the disk "
+        "and run again: the runs stored before the error are kept",  # SQLITE_IOERR
+    8: "it is read-only (file or directory permissions, or a read-only file system). Give an output "
+       "directory you can write (--out DIR) or fix the permissions",  # SQLITE_READONLY
+    3: "access was denied. Give an output directory you can write (--out DIR)",  # SQLITE_PERM
+    14: "it cannot be opened: is it a directory, or is its directory gone or not writable? Give another "
+        "output directory (--out DIR)",  # SQLITE_CANTOPEN
+    5: "another program holds a lock on it. Close that program (a database browser?) and run again",  # BUSY
+    6: "another connection holds a lock on it. Close that program and run again",  # SQLITE_LOCKED
+}
+_DAMAGED = ("it is damaged (truncated, or not written by fracid). Move it away (e.g. rename it to "
+            "runs.sqlite.bad) and run again: its runs will be recomputed")
+
+
+def _store_text(err, where) -> str:
+    """The message of a run-store failure, by SQLite's result code: only a damaged file is to be moved away."""
+    if type(err).__name__ == "NotARunStore":
+        return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
+                "output directory (--out DIR).")
+    code = getattr(err, "sqlite_errorcode", None)
+    code = code if code is not None else getattr(err.__cause__, "sqlite_errorcode", None)
+    advice = _STORE_ADVICE.get(code & 0xFF if isinstance(code, int) else None, _DAMAGED)
+    return f"the run store {where} cannot be used ({err}): {advice.format(disk=_disk(where))}."
+
+
+def _disk(path) -> str:
+    """`` (the file system mounted at /data, 0 bytes free)``, or '' if that cannot be told."""
+    try:
+        mount = os.path.abspath(path)
+        while not os.path.ismount(mount):
+            mount = os.path.dirname(mount)
+        return f" (the file system mounted at {mount}, {shutil.disk_usage(mount).free:,} bytes free)"
+    except (OSError, ValueError, TypeError):
+        return ""
 
 
 def _convergence_text(err) -> str:
@@ -89,7 +184,8 @@ def _os_text(err: OSError, out) -> str:
         return f"{err}"
     name = err.filename or out or ""
     if err.errno == errno.ENOSPC:
-        return f"the disk is full (writing {name}). Free some space and run again: finished runs are kept."
+        return (f"the disk is full (writing {name}{_disk(name)}). Free some space and run again: finished runs "
+                "are kept.")
     if err.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
         return f"permission denied: {name}. Choose a directory you can write (--out DIR) or fix the permissions."
     if err.errno in (errno.ENOTDIR, errno.EEXIST) or isinstance(err, (NotADirectoryError, FileExistsError)):

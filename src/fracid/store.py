@@ -31,7 +31,7 @@ from typing import Self
 
 import numpy as np
 
-__all__ = ["RunStore", "decode_record", "encode_record", "key_for"]
+__all__ = ["NotARunStore", "RunStore", "UndecodableRecord", "decode_record", "encode_record", "key_for"]
 
 _ARRAY_TAG = "__ndarray__"
 _SIGNIFICANT_DIGITS = 12
@@ -48,6 +48,14 @@ CREATE TABLE IF NOT EXISTS runs (
     record BLOB
 )
 """
+
+
+class NotARunStore(sqlite3.DatabaseError):
+    """An SQLite database of another program: fracid does not add its table to it."""
+
+
+class UndecodableRecord(sqlite3.DatabaseError):
+    """A stored record that is not fracid's JSON (a damaged store, or one another program wrote)."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -300,11 +308,12 @@ class RunStore:
     def get(self, key: str) -> dict | None:
         """The record of ``key``, or None if it is not stored."""
         row = self._reader().execute("SELECT record FROM runs WHERE key = ?", (key,)).fetchone()
-        return None if row is None else decode_record(row[0])
+        return None if row is None else _decoded(key, row[0])
 
     def get_many(self, keys: Iterable[str]) -> dict:
         """``{key: record}`` for those of ``keys`` that are stored."""
-        return {key: decode_record(blob) for key, blob in self._select("key, record", keys)}
+        rows = list(self._select("key, record", keys))  # all read before decoding: a bad record ends the query
+        return {key: _decoded(key, blob) for key, blob in rows}
 
     def info(self, key: str) -> dict | None:
         """``{"study", "created", "status", "seconds"}`` of the run ``key``, or None."""
@@ -405,14 +414,35 @@ def _connect(path: str, readonly: bool, timeout: float, check_same_thread: bool 
                            check_same_thread=check_same_thread)
     try:
         if not readonly:
+            _refuse_foreign(conn, path)
             conn.execute("PRAGMA journal_mode=WAL")
             conn.execute(_SCHEMA)
         conn.execute("PRAGMA synchronous=NORMAL")
         conn.execute("SELECT 1 FROM runs LIMIT 1").fetchone()
+    except NotARunStore:
+        conn.close()
+        raise
     except sqlite3.DatabaseError as exc:
         conn.close()
-        raise sqlite3.DatabaseError(f"RunStore: cannot open {path!r} as a run store: {exc}") from exc
+        error = type(exc)(f"RunStore: cannot open {path!r} as a run store: {exc}")
+        error.sqlite_errorcode = getattr(exc, "sqlite_errorcode", None)  # what went wrong, for the message
+        raise error from exc
     return conn
+
+
+def _refuse_foreign(conn: sqlite3.Connection, path: str) -> None:
+    """NotARunStore if the database holds tables but no ``runs`` table: another program's file."""
+    tables = [row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
+    if tables and "runs" not in tables:
+        raise NotARunStore(f"{path} is an SQLite database of another program (tables: {', '.join(tables[:5])}), "
+                           "not a fracid run store")
+
+
+def _decoded(key: str, blob) -> dict:
+    try:
+        return decode_record(blob)
+    except (ValueError, TypeError, KeyError) as exc:  # JSONDecodeError, UnicodeDecodeError, a bad array tag
+        raise UndecodableRecord(f"the stored record of run {key[:12]}... cannot be decoded ({exc})") from None
 
 
 def _uri_path(path: str) -> str:

@@ -4,6 +4,8 @@ the value given and what is allowed."""
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from pathlib import Path
 
@@ -91,10 +93,21 @@ class _Checker:
             self.fail(key, value, f"must not repeat a name; repeated: {', '.join(map(repr, duplicates))}")
         return tuple(value)
 
-    def file(self, key, value, base: Path) -> Path:
-        self.string(key, value, "must be a file path (string)")
+    def location(self, key, value, base: Path, allowed="must be a path (string)") -> Path:
+        """``value`` as an absolute path (``~`` expanded, relative to ``base``, links resolved); a NUL byte
+        or a symbolic-link loop named."""
+        self.string(key, value, allowed)
+        if "\0" in value:
+            self.fail(key, value, "a path cannot contain a NUL byte (\\0)")
         given = Path(value).expanduser()
-        resolved = (given if given.is_absolute() else base / given).resolve()
+        try:
+            return (given if given.is_absolute() else base / given).resolve()
+        except (OSError, RuntimeError) as err:  # RuntimeError: a symbolic-link loop (Python < 3.13)
+            self.fail(key, value, f"cannot be resolved ({err}): a symbolic link that points to itself?")
+
+    def file(self, key, value, base: Path) -> Path:
+        resolved = self.location(key, value, base, "must be a file path (string)")
+        given = Path(value).expanduser()
         where = f"{resolved}" if given.is_absolute() else f"resolved relative to the config file: {resolved}"
         if not resolved.exists():
             self.fail(key, value, f"file not found ({where})")
@@ -103,10 +116,21 @@ class _Checker:
         return resolved
 
 
-def _read_toml(path: Path) -> dict:
+#: the largest configuration file read [bytes]: a configuration is a few KiB; more is not one
+MAX_CONFIG_BYTES = 1 << 20
+
+#: the name of a configuration read from standard input (``fracid identify -``)
+STDIN = "-"
+
+
+def _read_toml(path: Path, stdin=None) -> dict:
+    """The TOML table of ``path`` (``stdin``: the bytes read from standard input instead); a path that is
+    not a regular file (a FIFO, a device, a directory), a file too large to be a configuration, text that
+    is not UTF-8 or not TOML, each raise a ConfigError naming the file."""
     try:
-        with open(path, "rb") as handle:
-            raw = handle.read()
+        raw = stdin if stdin is not None else _config_bytes(path)
+        if len(raw) > MAX_CONFIG_BYTES:
+            raise ConfigError(f"{path}: more than {MAX_CONFIG_BYTES:,} bytes: too large for a configuration")
         # a byte-order mark (Windows Notepad) is not TOML but says nothing wrong about the file
         return tomllib.loads(raw.removeprefix(b"\xef\xbb\xbf").decode("utf-8"))
     except FileNotFoundError:
@@ -117,3 +141,22 @@ def _read_toml(path: Path) -> dict:
         raise ConfigError(f"{path}: not a UTF-8 text file ({err})") from None
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"{path}: not valid TOML: {err}") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: not a usable configuration: its tables or arrays are nested too deeply "
+                          "(a fracid configuration nests at most three levels)") from None
+
+
+def _config_bytes(path: Path) -> bytes:
+    """The bytes of a regular file of at most MAX_CONFIG_BYTES; checked before reading, so that a FIFO
+    (which would block) or a device such as /dev/zero (which never ends) is refused at once."""
+    with open(path, "rb", opener=lambda name, flags: os.open(name, flags | getattr(os, "O_NONBLOCK", 0))) as handle:
+        info = os.fstat(handle.fileno())
+        if stat.S_ISDIR(info.st_mode):
+            raise IsADirectoryError(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise ConfigError(f"{path}: not a regular file (a pipe, a device or a socket): give the configuration "
+                              f"as a file, or as '{STDIN}' to read it from standard input")
+        if info.st_size > MAX_CONFIG_BYTES:
+            raise ConfigError(f"{path}: {info.st_size:,} bytes: too large for a configuration file (at most "
+                              f"{MAX_CONFIG_BYTES:,}); is it the configuration?")
+        return handle.read(MAX_CONFIG_BYTES + 1)

@@ -6,11 +6,12 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from fracid.config.checker import _Checker, _read_toml
+from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, _Checker, _read_toml
 from fracid.config.experiments import _data_limit_text, _experiments
 from fracid.config.identify import _identify
 from fracid.config.posterior import _posterior
@@ -58,9 +59,9 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     """
     if purpose not in _PURPOSES:
         raise ValueError(f"purpose = {purpose!r}; choose 'identify' or 'simulate'")
-    path = Path(path).expanduser().resolve()
+    path, stdin = _config_path(path)
     ck = _Checker(path)
-    raw = ck.table("", _read_toml(path), _TOP_KEYS)
+    raw = ck.table("", _read_toml(path, stdin), _TOP_KEYS)
     base = path.parent
     model = _model(ck, raw.get("model"))
     specimen = _specimen(ck, raw.get("specimen"), base)
@@ -81,6 +82,20 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
                   identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,
                   warnings=tuple(ck.warnings))
+
+
+def _config_path(path) -> tuple[Path, bytes | None]:
+    """The configuration's absolute path, and its bytes when it is read from standard input (``"-"``: then
+    the relative paths inside it are resolved against the working directory)."""
+    if os.fspath(path) == STDIN:
+        return Path.cwd() / "<stdin>", sys.stdin.buffer.read(MAX_CONFIG_BYTES + 1)
+    text = os.fspath(path)
+    if "\0" in str(text):
+        raise ConfigError(f"{text!r}: a path cannot contain a NUL byte (\\0): check how it was typed or generated")
+    try:
+        return Path(path).expanduser().resolve(), None
+    except (OSError, RuntimeError) as err:  # a symbolic-link loop
+        raise ConfigError(f"{text}: cannot be resolved ({err}): a symbolic link that points to itself?") from None
 
 
 def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:

@@ -209,9 +209,7 @@ def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
 
 def _output(ck: _Checker, raw, base: Path) -> OutputConfig:
     raw = ck.table("output", {} if raw is None else raw, _OUTPUT_KEYS)
-    directory = ck.string("output.directory", raw.get("directory", "results"), "must be a directory path (string)")
-    path = Path(directory).expanduser()
-    path = (path if path.is_absolute() else base / path).resolve()
+    path = ck.location("output.directory", raw.get("directory", "results"), base, "must be a directory path (string)")
     steps = raw.get("vtk_steps", [])
     allowed = "must be a list of step numbers (integers >= 0)"
     if not isinstance(steps, list):
