@@ -148,10 +148,12 @@ def simulate_config(params="", specimen="", simulate="") -> str:
 # ------------------------------------------------------------------------------------ running
 
 
-def run_fracid(args, cwd, timeout=240) -> subprocess.CompletedProcess:
+def run_fracid(args, cwd, timeout=240, *, stdin=None, env=None) -> subprocess.CompletedProcess:
+    """``python -m fracid ARGS`` in ``cwd`` (``stdin``: text on its standard input; ``env``: variables
+    added to :data:`ENV`)."""
     start = time.perf_counter()
     proc = subprocess.run([*FRACID, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout,
-                          env=ENV)
+                          env={**ENV, **(env or {})}, input=stdin, stdin=None if stdin is not None else subprocess.DEVNULL)
     proc.seconds = time.perf_counter() - start
     if os.environ.get("FRACID_TEST_TIMES"):
         print(f"TIME {proc.seconds:6.2f} s  {' '.join(map(str, args))}  ({cwd})", file=sys.__stderr__, flush=True)
@@ -195,6 +197,8 @@ class Case:
     needs_user: bool = False  # file permissions do not bind root
     slow: bool = False  # computes for a few seconds: started first
     verify: Callable | None = None
+    stdin: str | None = None  # the command's standard input
+    env: dict | None = None  # environment variables for the command
 
 
 def _standard_csv(d, curve):
@@ -249,9 +253,15 @@ def _out_is_file(d):
     (d / "taken").write_text("a file where the output directory should be\n")
 
 
+def fracid_wrote(directory: Path, *names) -> None:
+    """Record ``names`` in ``directory``'s manifest as written by fracid (as an earlier run would have)."""
+    (directory / ".fracid-written").write_text(json.dumps(list(names)))
+
+
 def _corrupt_store(d):
     (d / "out").mkdir()
     (d / "out" / "runs.sqlite").write_bytes(b"\x00\x17garbage, not an SQLite database\xff" * 200)
+    fracid_wrote(d / "out", "runs.sqlite")
 
 
 def _read_only_out(d):

@@ -175,10 +175,11 @@ def batch(request, curve, tmp_path_factory):
         spec, d = CASES[name], directories[name]
         try:
             args = spec.prepare(d, curve)
+            options = dict(stdin=spec.stdin, env=spec.env)
             if spec.lock is None:
-                return run_fracid(args, d), d
+                return run_fracid(args, d, **options), d
             with directory_lock(d / spec.lock):
-                return run_fracid(args, d), d
+                return run_fracid(args, d, **options), d
         except Exception as err:  # noqa: BLE001 -- raised by the case's test
             return err, d
 

@@ -142,7 +142,7 @@ _STORE_ADVICE = {
     5: "another program holds a lock on it. Close that program (a database browser?) and run again",  # BUSY
     6: "another connection holds a lock on it. Close that program and run again",  # SQLITE_LOCKED
 }
-_DAMAGED = ("it is damaged (truncated, or not written by fracid). Move it away (e.g. rename it to "
+_DAMAGED = ("it is damaged (truncated, or not written by fracid); move it away (e.g. rename it to "
             "runs.sqlite.bad) and run again: its runs will be recomputed")
 
 

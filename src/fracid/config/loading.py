@@ -22,6 +22,7 @@ from fracid.config.schema import (
     MAX_BAR_ELEMENTS,
     MAX_DATA_VALUES,
     Config,
+    ConfigError,
     ModelConfig,
     SpecimenConfig,
 )
