@@ -21,6 +21,7 @@ import shutil
 import signal
 import sqlite3
 import subprocess
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -32,7 +33,7 @@ import hostile_data
 import hostile_files
 import hostile_mesh
 from fracid.lock import directory_lock
-from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, TRUTH, _cells, _config_bytes,
+from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, TRUTH, _cells, _clean, _config_bytes,
                      _corrupt_store, _estimate_near_truth, _out_dir, _out_is_file, _read_only_out, _scaled, _units_row,
                      _unloading, bar_config, case, check, csv_case, run_fracid, sim_case, synthetic_curve, write_csv,
                      write_rows)
@@ -148,7 +149,8 @@ for _module in (hostile_files, hostile_data, hostile_mesh, hostile_checks):
     CASES.update(_module.CASES)
 
 #: the cases whose output directory another test uses
-_SOURCE_OF = {"test_truncated_run_store": "semicolon-decimal-comma-identifies"}
+_SOURCE_OF = {"test_truncated_run_store": "semicolon-decimal-comma-identifies",
+              "test_undecodable_records_in_the_run_store": "semicolon-decimal-comma-identifies"}
 
 
 def _selected_cases(session) -> list[str]:
@@ -230,15 +232,20 @@ def _as_in_a_terminal():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-@pytest.mark.parametrize("sig, status, words, workers, group, when", [
-    pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", id="sigint"),
+@pytest.mark.parametrize("sig, status, words, workers, group, when, times", [
+    pytest.param(signal.SIGINT, 130, INTERRUPTED, "1", False, "stored", 1, id="sigint"),
     pytest.param(signal.SIGTERM, 143, ["terminated (SIGTERM)", "run the same command again"], "1", False, "stored",
-                 id="sigterm"),
+                 1, id="sigterm"),
+    pytest.param(signal.SIGTERM, 143, ["terminated (SIGTERM)", "run the same command again"], "1", False, "stored",
+                 2, id="sigterm-twice-as-gnu-timeout"),
+    pytest.param(signal.SIGHUP, 129, ["hang-up", "run the same command again"], "1", False, "stored", 1,
+                 id="sighup-terminal-closed"),
 ])
-def test_signal_during_identify(sig, status, words, workers, group, when, curve, tmp_path):
-    """Ctrl-C or SIGTERM during the KNN stage (a population of 1000 runs, longer than the wait), once a few runs
-    are stored, or (``when = "starting"``) just after the run store is opened, while the workers start.
-    ``group``: the signal goes to the whole process group, workers included, as Ctrl-C in a terminal does."""
+def test_signal_during_identify(sig, status, words, workers, group, when, times, curve, tmp_path):
+    """Ctrl-C, SIGTERM or SIGHUP during the KNN stage (a population of 1000 runs, longer than the wait), once a
+    few runs are stored, or (``when = "starting"``) just after the run store is opened, while the workers start.
+    ``group``: the signal goes to the whole process group, workers included, as Ctrl-C in a terminal does;
+    ``times``: sent that often, 20 ms apart (GNU timeout signals twice)."""
     write_csv(tmp_path / "bar.csv", *curve)
     # 1000 runs: the forward runs got 3x faster, and 200 of them could end before the signal on a busy machine
     (tmp_path / "cfg.toml").write_text(bar_config(n="1000"))
@@ -254,10 +261,12 @@ def test_signal_during_identify(sig, status, words, workers, group, when, curve,
         time.sleep(0.3)
         assert proc.poll() is None, f"ended before the signal: {proc.returncode}\n{proc.communicate()}"
         sent = time.monotonic()
-        if group:
-            os.killpg(proc.pid, sig)
-        else:
-            proc.send_signal(sig)
+        for _ in range(times):
+            if group:
+                os.killpg(proc.pid, sig)
+            else:
+                proc.send_signal(sig)
+            time.sleep(0.02)
         out, err = proc.communicate(timeout=15)
         elapsed = time.monotonic() - sent
     finally:
@@ -269,3 +278,79 @@ def test_signal_during_identify(sig, status, words, workers, group, when, curve,
             proc.communicate()
     check(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), tmp_path, status, words)
     assert elapsed < 15
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["sigint", "sigterm"])
+@pytest.mark.parametrize("delay", [0.1, 0.4])
+def test_double_signal_during_start_up(sig, status, delay, curve, tmp_path):
+    """The signal twice, 10 ms apart, while the command imports and loads (the first raises, the second is
+    ignored): the exit status of the signal, a message, no traceback, within 5 s."""
+    write_csv(tmp_path / "bar.csv", *curve)
+    (tmp_path / "cfg.toml").write_text(bar_config(n="1000"))
+    proc = subprocess.Popen([*FRACID, "identify", "cfg.toml", "--out", "out", "--workers", "1", "--quiet"],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
+                            preexec_fn=_as_in_a_terminal)
+    try:
+        time.sleep(delay)
+        proc.send_signal(sig)
+        time.sleep(0.01)
+        with contextlib.suppress(ProcessLookupError):
+            proc.send_signal(sig)
+        out, err = proc.communicate(timeout=5)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    check(subprocess.CompletedProcess(proc.args, proc.returncode, out, err), tmp_path, status,
+          [("interrupted", "terminated", "nothing was computed")])
+
+
+def _private_mounts() -> bool:
+    """Whether this machine lets a process mount a tmpfs in a mount namespace of its own (unshare -Urm)."""
+    if shutil.which("unshare") is None:
+        return False
+    probe = subprocess.run(["unshare", "-Urm", "sh", "-c", "mount -t tmpfs -o size=64k tmpfs /mnt"],
+                           capture_output=True, timeout=20)
+    return probe.returncode == 0
+
+
+FULL_DISK = """\
+set -u
+mount -t tmpfs -o size=160k tmpfs disk
+"$@" --quiet; echo "first exit $?" >&2
+"$PYTHON" -c "import sqlite3; print('stored before', sqlite3.connect('file:disk/out/runs.sqlite?mode=ro', uri=True).execute('SELECT COUNT(*) FROM runs').fetchone()[0])"
+mount -o remount,size=16m disk
+"$@"; echo "second exit $?" >&2
+"""
+
+
+@pytest.mark.skipif(not _private_mounts(), reason="no private tmpfs mounts (unshare -Urm) on this machine")
+def test_full_disk_while_storing(curve, tmp_path):
+    """The output directory on a 160 KiB file system (a tmpfs in a private mount namespace), the KNN population
+    of 64 runs larger than it: the command ends with exit 4, naming the full disk; the runs stored before are
+    intact and, once the file system is grown (space freed), the same command reuses them all."""
+    write_csv(tmp_path / "bar.csv", *curve)
+    (tmp_path / "cfg.toml").write_text(bar_config(n="64"))
+    (tmp_path / "disk").mkdir()
+    (tmp_path / "full.sh").write_text(FULL_DISK)
+    proc = subprocess.run(["unshare", "-Urm", "bash", "full.sh", *FRACID, "identify", "cfg.toml", "--out", "disk/out",
+                           "--workers", "1"], cwd=tmp_path, capture_output=True, text=True, timeout=240,
+                          env={**ENV, "PYTHON": sys.executable})
+    err = _clean(proc.stderr, tmp_path)
+    assert "first exit 4" in err and "second exit 0" in err, err
+    first = err[:err.index("first exit")]
+    assert "Traceback" not in err and "disk" in first and "is full" in first and "move it away" not in first, err
+    stored = int(proc.stdout.split("stored before ")[1].split()[0])
+    computed = int(proc.stdout.split("64 KNN (0 failed, ")[1].split()[0])
+    assert 0 < stored < 64 and computed == 64 - stored, proc.stdout
+
+
+def test_undecodable_records_in_the_run_store(batch, tmp_path):
+    """A real store (of the semicolon case) whose records another program overwrote with bytes that are not
+    JSON: exit 4, the store named as damaged, no traceback (not an internal error)."""
+    _, source = batch["semicolon-decimal-comma-identifies"]
+    work = tmp_path / "w"
+    shutil.copytree(source, work)
+    with contextlib.closing(sqlite3.connect(work / "out" / "runs.sqlite")) as conn, conn:
+        conn.execute("UPDATE runs SET record = x'00ff7b'")
+    check(run_fracid(IDENTIFY, work), work, 4, ["runs.sqlite", "cannot be decoded", "move it away"])

@@ -308,8 +308,8 @@ def main(argv=None) -> int:
         except SystemExit:
             raise
         except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
-            if isinstance(err, KeyboardInterrupt):
-                exits.ignore_stop_signals()  # a second Ctrl-C must not break the message
+            if not isinstance(err, KeyboardInterrupt) and exits.stopped_by() is not None:
+                err = exits.stopped_by()  # the signal, seen through the code it struck
             status, text = exits.describe(err, store_path=getattr(args, "store_path", None),
                                           out=getattr(args, "out_dir", None))
             if getattr(args, "debug", False):

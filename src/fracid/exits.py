@@ -38,19 +38,23 @@ class HungUp(Terminated):
 
 
 _RAISED_BY = {"SIGINT": KeyboardInterrupt, "SIGTERM": Terminated, "SIGHUP": HungUp}
+#: the stop signals received by this process (the first one raised; the others were ignored)
+_received: list[int] = []
 
 
 @contextlib.contextmanager
 def stop_signals():
     """Within: the first of SIGINT, SIGTERM or SIGHUP raises KeyboardInterrupt, Terminated or HungUp in
     the main thread; every later one is ignored, so that a second Ctrl-C (or GNU ``timeout``, which
-    signals twice) cannot break the cleanup or the message. The previous handlers are restored after.
-    Outside the main thread (a test runner's thread) nothing is installed."""
-    received = []
-
+    signals twice) cannot break the cleanup or the message. The previous handlers are restored after,
+    unless a signal came (the process is ending: later ones stay ignored). Outside the main thread (a
+    test runner's thread) nothing is installed."""
     def handler(signum, frame):
-        if not received:
-            received.append(signum)
+        _received.append(signum)
+        if len(_received) == 1:
+            # ignored by the operating system from now on: also while the interpreter shuts down, when
+            # Python puts back the default action of the signals it handled
+            ignore_stop_signals()
             raise _RAISED_BY[signal.Signals(signum).name]()
 
     previous = {}
@@ -61,10 +65,11 @@ def stop_signals():
     except ValueError:  # not the main thread
         pass
     try:
-        yield received
+        yield
     finally:
-        for name, old in previous.items():
-            signal.signal(getattr(signal, name), old)
+        if not _received:  # after a stop signal the process is ending: a late second one stays ignored
+            for name, old in previous.items():
+                signal.signal(getattr(signal, name), old)
 
 
 def ignore_stop_signals() -> None:
@@ -73,6 +78,12 @@ def ignore_stop_signals() -> None:
         for name in _RAISED_BY:
             if hasattr(signal, name):
                 signal.signal(getattr(signal, name), signal.SIG_IGN)
+
+
+def stopped_by() -> BaseException | None:
+    """The exception of the first stop signal received, or None: a signal that struck inside an import or
+    a library may reach the command as another exception (``ImportError: initialization failed``)."""
+    return _RAISED_BY[signal.Signals(_received[0]).name]() if _received else None
 
 
 def _loaded(module: str, name: str) -> tuple:
