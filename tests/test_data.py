@@ -6,6 +6,7 @@ import pytest
 from fracid.data import (
     Curve,
     DataError,
+    DataTypeError,
     ExperimentalData,
     curve_from_arrays,
     from_envelope,
@@ -191,6 +192,194 @@ def test_negative_or_zero_forces_are_refused_naming_file_and_column(tmp_path):
     assert "from -1100 to 0 N" in message and "negate the column" in message
     with pytest.raises(DataError, match=r"curve.csv, column 'F_zero'.*all forces are zero"):
         require_positive_force([zero])
+
+
+# ----------------------------------------------------------- direction of the control (before the order)
+
+
+def signed_rows(control_sign, force_sign, n=12):
+    return [[control_sign * 0.01 * k, force_sign * 100.0 * k * (n - k)] for k in range(n)]
+
+
+def test_a_negative_control_is_named_before_the_order_of_the_rows(tmp_path):
+    path = write_csv(tmp_path, signed_rows(-1, -1))
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "curve.csv" in message and "the control column 'cmod' is negative" in message
+    assert "from 0 mm at row 2 to -0.11 mm at row 13" in message and "multiply it by -1" in message
+    assert "control_unit_scale=-1" in message and "the force column 'F' is negative too" in message
+    assert "backtrack_tolerance" not in message
+    (curve,) = read(path, control_unit_scale=-1.0, force_unit_scale=-1.0)  # the documented fix
+    np.testing.assert_allclose(curve.control, 0.01 * np.arange(12))
+    assert np.all(curve.force >= 0.0) and any("multiplied by -1" in note for note in curve.notes)
+
+
+def test_a_negative_control_with_positive_forces_names_the_control_alone(tmp_path):
+    with pytest.raises(DataError, match="'cmod' is negative") as info:
+        read(write_csv(tmp_path, signed_rows(-1, 1)))
+    assert "negative too" not in str(info.value)
+    with pytest.raises(DataError, match="'control' is negative"):
+        curve_from_arrays(-0.01 * np.arange(12), np.arange(12.0))
+
+
+def test_rows_in_reverse_order_are_named(tmp_path):
+    path = write_csv(tmp_path, good_rows()[::-1])
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "decreases throughout, from 0.11 mm at row 2 to 0 mm at row 13" in message
+    assert "reverse order" in message and "backtrack_tolerance" not in message
+
+
+def test_swapped_columns_are_named(tmp_path):
+    rows = signed_rows(1, 1)  # cmod increasing, F rising to a peak and falling back to 0
+    path = write_csv(tmp_path, [[force, cmod] for cmod, force in rows])
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "the columns look swapped" in message and "control_column = 'F'" in message
+    assert "'cmod' rises to 3600 at row 8" in message
+
+
+def test_an_unloading_loop_is_not_taken_for_swapped_columns(tmp_path):
+    rows = good_rows()
+    rows[7][0] = 0.03  # a backtrack in an increasing control, the force increasing: not swapped
+    with pytest.raises(DataError, match="goes backwards") as info:
+        read(write_csv(tmp_path, rows))
+    assert "swapped" not in str(info.value)
+
+
+# ------------------------------------------------------------------- files as spreadsheets write them
+
+
+@pytest.mark.parametrize("cell, delimiter, decimal, words", [
+    ('"1,234.5"', ",", ".", ["'1,234.5' is not a number", "thousands separator", "(',';"]),
+    ("1,234.5", ",", ".", ["row 6 has 3 cells", "'1,234.5'", "thousands separator ','"]),
+    ("1 234,5", ";", ",", ["'1 234,5' is not a number", "thousands separator", "(spaces;"]),
+    ("1\u00a0234,5", ";", ",", ["thousands separator", "non-breaking spaces"]),
+    ("1.234,5", ";", ",", ["'1.234,5' is not a number", "thousands separator", "('.';"]),
+    ("1.234,5", ";", ".", ["thousands separator", "set decimal = ','"]),
+])
+def test_thousands_separators_name_row_cell_and_fix(tmp_path, cell, delimiter, decimal, words):
+    rows = [delimiter.join((f"{0.01 * k}".replace(".", decimal), "5")) for k in range(12)]
+    rows[4] = delimiter.join(("0" + decimal + "04", cell))  # file row 6
+    path = write_text(tmp_path, delimiter.join(("cmod", "F")) + "\n" + "\n".join(rows) + "\n")
+    with pytest.raises(DataError) as info:
+        read(path, delimiter=delimiter, decimal=decimal)
+    message = str(info.value)
+    assert "curve.csv" in message and "row 6" in message
+    for word in words:
+        assert word in message, message
+
+
+GOOD = "cmod,F\n" + "".join(f"{0.01 * k},{100.0 * k}\n" for k in range(12))
+
+
+@pytest.mark.parametrize("above, skipped", [
+    ("sep=,\n", "line 1 above the header (line 2)"),
+    ('"sep=,"\n', "line 1 above"),
+    ("# exported by Instron Bluehill 3\n", "line 1 above the header (line 2)"),
+    ("Test 1, 2026-01-01\nSpecimen,B4\n\n", "lines 1, 2 above the header (line 4)"),
+    ("# ", None),  # numpy.savetxt's header "# cmod,F"
+])
+def test_lines_above_the_header_are_skipped_and_noted(tmp_path, above, skipped):
+    (curve,) = read(write_text(tmp_path, above + GOOD))
+    np.testing.assert_allclose(curve.force, 100.0 * np.arange(12))
+    assert any(skipped in note for note in curve.notes) if skipped else not curve.notes, curve.notes
+
+
+def test_a_sep_line_must_agree_with_the_delimiter(tmp_path):
+    path = write_text(tmp_path, "sep=;\n" + GOOD.replace(",", ";"))
+    with pytest.raises(DataError, match=r"line 1 \('sep=;'\) declares the cell separator ';'.*set delimiter = ';'"):
+        read(path)
+    assert read(path, delimiter=";")[0].n_points == 12
+    tab = write_text(tmp_path, "sep=\t\n" + GOOD.replace(",", "\t"), name="tab.csv")
+    assert read(tab, delimiter=" ")[0].n_points == 12  # whitespace includes tabs
+
+
+def test_a_header_not_on_line_1_names_the_line_that_looks_like_it(tmp_path):
+    path = write_text(tmp_path, "Test 1, 2026-01-01\nTime,Load\n" + GOOD.split("\n", 1)[1])
+    with pytest.raises(DataError) as info:
+        read(path)
+    message = str(info.value)
+    assert "the header (line 1) has no column 'cmod'" in message and "line 2" in message
+    assert "looks like it ('Time', 'Load')" in message
+
+
+def test_empty_cells_after_the_last_column_are_ignored(tmp_path):
+    text = "".join(line + ",,\n" for line in GOOD.splitlines())
+    assert read(write_text(tmp_path, text))[0].n_points == 12
+
+
+def test_an_unclosed_quote_names_its_line(tmp_path):
+    lines = GOOD.splitlines()
+    lines[3] = '"' + lines[3]
+    with pytest.raises(DataError, match="line 4 runs over several lines: a quote"):
+        read(write_text(tmp_path, "\n".join(lines) + "\n"))
+
+
+def test_a_utf16_file_is_named_as_such(tmp_path):
+    path = tmp_path / "curve.csv"
+    path.write_bytes(GOOD.encode("utf-16"))
+    with pytest.raises(DataError, match="UTF-16.*CSV UTF-8"):
+        read(path)
+
+
+# ------------------------------------------------------------------------------ arguments (API)
+
+
+@pytest.mark.parametrize("options, words", [
+    ({"force_columns": None}, "force_columns must be a column name (str) or a list of names, got None"),
+    ({"force_columns": ["F", 3]}, "force_columns[1] must be a column name (str), got 3 (int)"),
+    ({"control_column": None}, "control_column must be a column name (str), got None"),
+    ({"control_unit_scale": "1e-3"}, "control_unit_scale must be a number, got '1e-3' (str)"),
+    ({"force_unit_scale": True}, "force_unit_scale must be a number, got True (bool)"),
+    ({"backtrack_tolerance": "0.01"}, "backtrack_tolerance must be a number, got '0.01' (str)"),
+    ({"min_points": 2.5}, "min_points must be an integer, got 2.5 (float)"),
+    ({"delimiter": None}, "delimiter and decimal must be str"),
+])
+def test_read_curve_csv_checks_its_arguments(tmp_path, options, words):
+    path = write_csv(tmp_path, good_rows())
+    with pytest.raises(DataTypeError) as info:
+        read(path, **options)
+    assert isinstance(info.value, TypeError) and isinstance(info.value, DataError)
+    assert words in str(info.value)
+
+
+def test_read_curve_csv_checks_its_path_and_values():
+    with pytest.raises(DataTypeError, match=r"path must be a file path \(str or os.PathLike\), got None"):
+        read_curve_csv(None, control_column="cmod", force_columns="F")
+    with pytest.raises(DataError, match="control_unit_scale must be a finite non-zero number"):
+        read_curve_csv("x.csv", control_column="cmod", force_columns="F", control_unit_scale=0.0)
+    with pytest.raises(DataError, match="force_columns is empty"):
+        read_curve_csv("x.csv", control_column="cmod", force_columns=[])
+
+
+@pytest.mark.parametrize("control, force, error, words", [
+    (np.zeros((3, 2)), np.zeros(3), DataError, "one-dimensional, got shape (3, 2)"),
+    (["0", "1", "2"], [0.0, 1.0, 2.0], DataTypeError, "must be an array of numbers (int or float)"),
+    ("012", [0.0, 1.0, 2.0], DataTypeError, "must be an array of numbers"),
+    ([0.0, 1.0, [2.0]], [0.0, 1.0, 2.0], DataTypeError, "must be an array of numbers"),
+    ([True, False, True], [0.0, 1.0, 2.0], DataTypeError, "dtype bool"),
+    ([0.0, 1.0, 2.0], [0.0, 1.0], DataError, "control has 3 values but force has 2"),
+])
+def test_curve_from_arrays_checks_its_arguments(control, force, error, words):
+    with pytest.raises(error) as info:
+        curve_from_arrays(control, force)
+    assert words in str(info.value)
+
+
+def test_builders_check_their_arguments():
+    curve = linear_curve(1.0, 0.0, np.linspace(0.0, 1.0, 5))
+    with pytest.raises(DataTypeError, match="a list of Curve objects, got None"):
+        from_repeats(None, 5)
+    with pytest.raises(DataTypeError, match="std must be an array of numbers"):
+        with_std(curve, "0.1", 5)
+    with pytest.raises(DataTypeError, match="control_range"):
+        with_std(curve, 0.1, 5, ("0.1", "0.5"))
+    with pytest.raises(DataTypeError, match="std_floor must be a number"):
+        from_repeats([curve, curve], 5, std_floor="0.01")
 
 
 # ------------------------------------------------------------------------------- reading rules

@@ -1,5 +1,6 @@
 """The inverse method as an argument: a custom method (scipy's least squares) plugged into identify, its
-result, warnings, JSON and HTML report; the default method passed explicitly; the study's settings."""
+result, warnings, JSON and HTML report; the default method passed explicitly; the study's settings; the misfit
+in units of the data's std; the warnings in the study's verdict.txt."""
 
 import json
 import re
@@ -10,7 +11,7 @@ import pytest
 import fracid
 from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.method import InverseMethod, MethodResult, result_fields
+from fracid.inverse.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
 from fracid.inverse.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
 from fracid.inverse.study import StudySettings
 from fracid.inverse.twin import synthetic_data
@@ -127,3 +128,46 @@ def test_study_settings_group_the_options_and_replace_by_name():
         StudySettings().replace(population=16)
     with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
         StudySettings(prior="flat")
+
+
+def _fit(y_fit, std=0.001, x=2.0):
+    """A one-parameter result on 10 values from 1 to 2 with the fit ``y_fit(y)`` and the data's std ``std``."""
+    y = np.linspace(1.0, 2.0, 10)
+    return MethodResult(names=["c"], x=np.array([x]), C=np.eye(1), y_exp=y, y_fit=y_fit(y), std_exp=np.full(10, std),
+                        converged=True, status="converged", units={"c": "mm^2"}, bounds=([0.5], [4.0]),
+                        at_bound=["c"] if x in (0.5, 4.0) else [])
+
+
+def test_a_misfit_of_tens_of_std_is_flagged_in_units_of_the_std():
+    """4 % above the data: a fine fit in % of the peak, but 60 std off: the warning says so and what it means."""
+    result = _fit(lambda y: 1.04 * y)
+    assert result.rms_percent < POOR_FIT_PERCENT and result.misfit_std > POOR_FIT_STD
+    texts = result.warnings()
+    assert not any("fit is poor" in text for text in texts)
+    (misfit,) = [text for text in texts if "misfit" in text]
+    expected = f"the misfit is {result.misfit_std:.3g} times the data's std"
+    for words in (expected, "units", "geometry", "std is too small"):
+        assert words in misfit, (words, misfit)
+
+
+def test_a_fit_within_the_scatter_is_not_flagged():
+    result = _fit(lambda y: y + 0.001)
+    assert result.misfit_std == pytest.approx(1.0) and result.warnings() == []
+
+
+def test_verdict_txt_carries_the_warnings_of_the_identification(tmp_path):
+    """The study's summary (verdict.txt) gives the warnings stderr and report.html give: misfit, bound."""
+    from fracid.inverse.study import StudyResult
+
+    class Verdict:
+        measure = "Gaussian (linearised) std"
+
+        def text(self, units):
+            return "c: identified"
+
+    ident = _fit(lambda y: 1.04 * y, x=4.0)
+    study = StudyResult(ident, None, [], np.zeros(1), None, None, [], Verdict())
+    assert study.summary().splitlines()[:2] == ["Verdict:", "c: identified"]
+    lines = [f"Warning: {text}" for text in ident.warnings()]
+    assert len(lines) == 2 and all(line in study.summary().splitlines() for line in lines)
+    assert any("estimate at a bound" in line for line in lines) and any("misfit" in line for line in lines)

@@ -10,31 +10,9 @@ from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh
 
 meshio = pytest.importorskip("meshio")
 
-L, H, T, E = 30.0, 6.0, 5.0, 30000.0
+from hostile_mesh import H, L, grid, two_halves, write_msh  # noqa: E402 -- the mesh writers of the hostile cases
 
-
-def grid(nx, ny, triangles):
-    """Corners of an L x H strip, cells (linear), and the left/right edges and the origin as Gmsh groups."""
-    x, y = np.meshgrid(np.linspace(0.0, L, nx + 1), np.linspace(0.0, H, ny + 1), indexing="ij")
-    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-    node = lambda i, j: i * (ny + 1) + j  # noqa: E731
-    quads = np.array([[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)]
-                      for i in range(nx) for j in range(ny)])
-    cells = np.vstack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]) if triangles else quads
-    left = np.array([[node(0, j), node(0, j + 1)] for j in range(ny)])
-    right = np.array([[node(nx, j), node(nx, j + 1)] for j in range(ny)])
-    return points, cells, left, right, np.array([[node(0, 0)]])
-
-
-def write_msh(path, points, cells, left, right, corner, kind, clockwise=False):
-    cells = cells[:, ::-1] if clockwise else cells
-    blocks = [(kind, cells), ("line", np.vstack([left, right])), ("vertex", corner)]
-    physical = [np.full(len(cells), 1), np.r_[np.full(len(left), 2), np.full(len(right), 3)], np.array([4])]
-    mesh = meshio.Mesh(points, blocks, cell_data={"gmsh:physical": physical, "gmsh:geometrical": physical},
-                       field_data={"domain": np.array([1, 2]), "left": np.array([2, 1]), "right": np.array([3, 1]),
-                                   "origin": np.array([4, 0])})
-    meshio.write(path, mesh, file_format="gmsh22", binary=False)
-    return path
+T, E = 5.0, 30000.0
 
 
 def strip(path):
@@ -115,8 +93,112 @@ def test_missing_and_unreadable_files(tmp_path):
         read_mesh(tmp_path / "none.msh")
     bad = tmp_path / "bad.msh"
     bad.write_text("$MeshFormat\nnonsense\n")
-    with pytest.raises(MeshError, match="not a mesh meshio can read"):
+    with pytest.raises(MeshError, match="not a mesh file fracid can read.*format 2.2 or 4.1"):
         read_mesh(bad)
+
+
+def test_duplicate_nodes_are_named_with_one_of_them(tmp_path):
+    """Two halves meshed apart whose nodes on x = L/2 were never merged: refused when read, not at step 0."""
+    path = write_msh(tmp_path / "dup.msh", *two_halves(0.0), "triangle")
+    with pytest.raises(MeshError, match=r"dup.msh: 6 nodes lie on another node .* e.g. two at \[15.0, .*Coherence"):
+        read_mesh(path)
+
+
+def test_a_piece_without_support_is_named_and_a_supported_one_is_not(tmp_path):
+    path = write_msh(tmp_path / "two.msh", *two_halves(0.5), "triangle")
+    with pytest.raises(MeshError, match=r"2 pieces that share no node, and 1 of them holds no support node "
+                                        r"\(supports: 'left', 'origin'\).*piece 2 \(12 elements, x in \[15.5, 30.5\], "
+                                        r"y in \[0, 6\]\).*Boolean fragments") as err:
+        strip(path).describe()
+    assert str(path) in str(err.value)
+    from dataclasses import replace
+
+    held = replace(strip(path), supports=(("left", "x"), ("origin", "y"), ("right", "y")))
+    assert held.describe().nodes.shape[0] == read_mesh(path).nodes.shape[0]  # each piece held: a valid mesh
+
+
+def test_a_support_sharing_nodes_with_a_rigid_load_is_refused(tmp_path):
+    points, cells, left, right, _ = grid(6, 2, True)
+    path = write_msh(tmp_path / "tie.msh", points, cells, left, right, right[:1, :1], "triangle")
+    specimen = MeshSpecimen(str(path), thickness=T, supports=(("left", "x"), ("origin", "y")),
+                            loads=(("right", "y"),), controls=(("deflection", (("right", "y", 1.0),)),))
+    with pytest.raises(MeshError, match="tie.msh: the support group 'origin' and the rigid load group 'right' share "
+                                        "1 node along y.*rigid = false"):
+        specimen.describe()
+    from dataclasses import replace
+
+    assert replace(specimen, loads=(("right", "y", False),)).describe() is not None  # spread: no tie, no conflict
+    assert replace(specimen, loads=(("right", "x"),)).describe() is not None  # another component
+
+
+@pytest.mark.parametrize("content, words", [
+    ("$NOD\n1\n1 0 0 0\n$ENDNOD\n$ELM\n0\n$ENDELM\n", "a Gmsh 1.0 file"),
+    ("x,y\n0,0\n", "not a mesh file fracid can read"),
+    (b"\x89PNG\r\n\x1a\n\xff\xfe" * 8, "not a mesh file fracid can read"),
+])
+def test_files_meshio_cannot_read_say_which_formats_to_export(tmp_path, capsys, content, words):
+    """meshio's own exits and exceptions (SystemExit, ReadError, UnicodeDecodeError) become MeshError."""
+    path = tmp_path / "old.msh"
+    path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
+    with pytest.raises(MeshError, match="format 2.2 or 4.1") as err:
+        read_mesh(path)
+    assert words in str(err.value) and str(path) in str(err.value)
+    assert capsys.readouterr().err == ""  # meshio's own "Error: ..." is not printed
+
+
+def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
+    """The count from the corners and elements is exact for one piece without holes; beyond
+    MAX_UNKNOWNS the mesh is refused before it is built."""
+    from fracid.config import schema
+    from fracid.specimens.mesh import mesh_unknowns
+
+    for triangles in (True, False):
+        points, cells = grid(5, 3, triangles)[:2]
+        mesh = plane_mesh(points, [("triangle" if triangles else "quad", cells)], {})
+        assert mesh_unknowns(mesh.n_vertices, len(mesh.cells)) == 2 * len(mesh.nodes) + mesh.n_vertices
+    monkeypatch.setattr(schema, "MAX_UNKNOWNS", 100)
+    path = write_msh(tmp_path / "big.msh", *grid(6, 2, True), "triangle")
+    with pytest.raises(MeshError, match=r"big.msh: 24 elements and 21 corner nodes make about 151 unknowns .*"
+                                        r"at most 100 unknowns are allowed: use a coarser mesh"):
+        read_mesh(path)
+
+
+def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-damage"):
+    """The ConfigError of :func:`check_mesh_units` on the strip drawn ``size`` times its size in mm (None if none)."""
+    from types import SimpleNamespace
+
+    from fracid.config import ConfigError
+    from fracid.config.checker import _Checker
+    from fracid.config.mesh_section import check_mesh_units
+    from fracid.config.schema import ModelConfig, SpecimenConfig
+
+    path = write_msh(tmp_path / "units.msh", *grid(6, 2, True, L * size, H * size), "triangle")
+    options = dict(path=str(path), thickness=T, scale=scale, supports=(("left", "x"), ("origin", "y")),
+                   loads=(("right", "x", True, 1.0),), controls=(("elongation", (("right", "x", 1.0),)),))
+    identify = bounds and SimpleNamespace(parameters=("beta", "c"), lower=(100.0, bounds[0]), upper=(900.0, bounds[1]))
+    try:
+        check_mesh_units(_Checker(tmp_path / "cfg.toml"), ModelConfig(model, (("c", c),)),
+                         SpecimenConfig("mesh", "elongation", tuple(options.items())), identify)
+    except ConfigError as err:
+        return str(err)
+    return None
+
+
+def test_a_mesh_in_metres_or_micrometres_is_a_unit_error(tmp_path):
+    """l = sqrt(2 c) larger than the whole mesh (drawn in metres) or 100 times smaller than its smallest
+    element (micrometres, or a scale too large): errors naming the extent, l and specimen.scale."""
+    metres = units_error(tmp_path, 1e-3)
+    assert "units.msh" in metres and "the mesh spans 0.03 x 0.006 units of its own" in metres
+    assert "l = sqrt(2 c) = 2.83 mm (with c = 4 mm^2)" in metres and "scale = 1000" in metres
+    assert "lower bound c = 0.5 mm^2" in units_error(tmp_path, 1e-3, bounds=(0.5, 50.0))  # the smallest l
+    assert units_error(tmp_path, 1e-3, scale=1000.0) is None
+    micrometres = units_error(tmp_path, 1e3)
+    assert "smallest element side, 3000 mm, is more than 100 times" in micrometres and "scale = 0.001" in micrometres
+    assert "upper bound c = 50 mm^2" in units_error(tmp_path, 1e3, bounds=(1.0, 50.0))  # the largest l
+    assert units_error(tmp_path, 1e3, bounds=(1.0, 2e5)) is None  # the largest l = 632 mm: plausible
+    assert "leave scale out" in units_error(tmp_path, 1.0, scale=1000.0)  # a mesh in mm with scale = 1000
+    assert units_error(tmp_path, 1e-3, model="local-damage") is None  # no internal length
+    assert units_error(tmp_path, 1.0) is None
 
 
 def test_bad_specimen_fields():

@@ -1,12 +1,14 @@
 """Adaptive importance sampling of the posterior (fracid.inverse.posterior) against posteriors known by quadrature:
-a curved (banana) valley, a bounded one, failed runs, reproducible draws."""
+a curved (banana) valley, a bounded one, failed runs, reproducible draws; the floor of the effective sample size."""
+
+import json
 
 import numpy as np
 import pytest
 
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.forward_operator import RunRecord
-from fracid.inverse.posterior import PosteriorSettings, posterior, weighted_quantile
+from fracid.inverse.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior, weighted_quantile
 
 BANANA_Y = np.array([0.0, 0.5, 0.3])
 BANANA_C = np.diag([0.5, 0.1, 0.6]) ** 2
@@ -85,7 +87,41 @@ def test_the_same_seed_draws_the_same_points():
     first = posterior(banana, BANANA_Y, BANANA_C, space, x0, C0, settings=settings)
     again = posterior(banana, BANANA_Y, BANANA_C, space, x0, C0, settings=settings)
     np.testing.assert_array_equal(first.x, again.x)
-    assert not first.converged and "below the target" in first.status and first.rounds == 3
+    assert not first.converged and first.rounds == 3
+
+
+def banana_posterior(samples_per_round, max_rounds, target_ess):
+    space = ParameterSpace(("a", "b"), (-2.0, -3.0), (2.0, 2.0))
+    x0 = np.array([0.05, 0.4])
+    settings = PosteriorSettings(samples_per_round=samples_per_round, max_rounds=max_rounds, target_ess=target_ess)
+    return posterior(banana, BANANA_Y, BANANA_C, space, x0, gaussian_seed(banana, x0, BANANA_C), settings=settings)
+
+
+def test_between_the_floor_and_the_target_the_intervals_are_rough():
+    result = banana_posterior(100, 4, 1000)  # ESS about 100: above the floor of 50, below the target
+    assert ess_floor(1000) <= result.ess < 1000 and not result.sampling_failed and not result.converged
+    assert "below the target" in result.status and "rough" in result.status
+    assert np.all(np.isfinite(result.credible_intervals(0.9)))
+
+
+def test_below_the_ess_floor_the_sampling_failed_and_gives_no_intervals():
+    """8 draws for a target of 500: ESS about 1, far below the floor of 50. The status says failed with the
+    advice, the intervals are NaN (null in the JSON), the summary shows none."""
+    result = banana_posterior(8, 1, 500)
+    assert result.ess < MIN_ESS and result.sampling_failed and not result.converged
+    assert result.status.startswith("failed: effective sample size")
+    for words in ("< 50", "samples_per_round", "max_rounds", "inflation", "identification"):
+        assert words in result.status, (words, result.status)
+    assert np.all(np.isnan(result.credible_intervals(0.9)))
+    assert np.all(np.isfinite(result.quantiles([0.05, 0.95])))  # the raw quantiles stay available
+    info = json.loads(json.dumps(result.to_dict(), allow_nan=False))
+    assert info["sampling_failed"] and info["interval_90"] == [[None, None], [None, None]]
+    assert "no credible intervals" in result.summary() and "90 % interval" not in result.summary()
+
+
+@pytest.mark.parametrize("target, floor", [(500.0, 50.0), (4000.0, 200.0), (30.0, 30.0)])
+def test_the_floor_is_50_or_5_percent_of_the_target_never_above_it(target, floor):
+    assert ess_floor(target) == floor
 
 
 def test_log_scale_prior_is_log_uniform():

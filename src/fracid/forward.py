@@ -5,6 +5,41 @@ from __future__ import annotations
 from fracid.fem.path_following import PathResult
 
 
+def _specimen_names() -> str:
+    from fracid.specimens import SPECIMENS
+
+    return ", ".join(f"{kind!r} -> {cls.__module__}.{cls.__name__}()" for kind, cls in SPECIMENS.items())
+
+
+def check_specimen(specimen, model=None) -> None:
+    """Raise a TypeError unless ``specimen`` is a specimen object: not a string (the message lists the
+    specimen types of a configuration and their classes), a class, None or a number; for the built-in
+    models (``model`` of :mod:`fracid.models`), one with ``describe`` or a description (``node_sets``).
+    Another model may take other specimen objects."""
+    from fracid.models import _PathFollowing
+
+    if isinstance(specimen, str):
+        raise TypeError(f"specimen = {specimen!r} is a name; give a specimen object, e.g. fracid.BarWithWeakZone() "
+                        f"(the [specimen] types of a configuration and their classes: {_specimen_names()})")
+    if isinstance(specimen, type):
+        raise TypeError(f"specimen is the class {specimen.__name__}; give an instance, e.g. {specimen.__name__}()")
+    described = hasattr(specimen, "describe") or hasattr(specimen, "node_sets")
+    if specimen is None or isinstance(specimen, (int, float)) or (isinstance(model, _PathFollowing) and not described):
+        raise TypeError(f"specimen is a {type(specimen).__name__}; give a specimen object, e.g. "
+                        f"fracid.BarWithWeakZone() (the specimen classes: {_specimen_names()})")
+
+
+def check_parameters(model, params) -> None:
+    """Raise a TypeError unless ``params`` is an instance of ``model.parameters`` (for a dict, the message
+    says how to build one)."""
+    cls = getattr(model, "parameters", None)
+    if not isinstance(cls, type) or isinstance(params, cls):  # a model without a parameter class checks itself
+        return
+    hint = f"{cls.__name__}(**params)" if isinstance(params, dict) else f"{cls.__name__}(c=2.0)"
+    raise TypeError(f"params is a {type(params).__name__}; the model {model.key!r} takes a {cls.__name__} "
+                    f"(e.g. {hint}; its parameters: {', '.join(cls.names())})")
+
+
 def simulate(specimen, params, *, model=None, regularization: str | None = None, **options) -> PathResult:
     """Run a forward model on ``specimen`` with ``params``.
 
@@ -25,6 +60,12 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
         ``damage_threshold`` (damage above which a point counts in the damaged-zone width [-]),
         ``observables`` (names to record; all if None), ``steps`` (:class:`StepOptions`; the
         specimen's default if None) and the options of :func:`~fracid.fem.path_following.follow_path`.
+
+    Raises
+    ------
+    TypeError
+        Before the run: ``specimen`` is not a specimen object (e.g. its name), ``params`` not the
+        model's parameter class.
     """
     from fracid.models import DamageModel
 
@@ -32,4 +73,6 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
         model = DamageModel(regularization or "gradient")
     elif regularization is not None:
         raise ValueError("give either model= or regularization=, not both")
+    check_specimen(specimen, model)
+    check_parameters(model, params)
     return model.simulate(specimen, params, **options)

@@ -21,6 +21,7 @@ local or integral damage; cohesive interface; crack band) with a material law
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import ClassVar, Protocol
 
@@ -35,8 +36,9 @@ from fracid.fem.problem import FORMULATIONS
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
-__all__ = ["MODEL_TYPES", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel", "DamageModel", "ForwardModel",
-           "PathResult", "StepOptions", "known_units", "model_from_type", "parameter_units", "runs_on"]
+__all__ = ["IMPLAUSIBLE_FACTOR", "MODEL_TYPES", "USUAL_RANGES", "CohesiveCrackModel", "ConvergenceError",
+           "CrackBandModel", "DamageModel", "ForwardModel", "PathResult", "StepOptions", "implausible", "known_units",
+           "model_from_type", "parameter_units", "runs_on", "usual_range_text"]
 
 
 class ForwardModel(Protocol):
@@ -277,6 +279,54 @@ def parameter_units(model_or_params) -> dict:
     """Units of a model's parameters (from its parameter class or a parameter object)."""
     cls = getattr(model_or_params, "parameters", None) or type(model_or_params)
     return dict(cls.units())
+
+
+#: The usual values of the parameters of the registered models for quasi-brittle materials (concrete, mortar,
+#: rock), wide on purpose: name -> (lower, upper) in the unit of the parameter class (MPa, mm^2, N/mm, -).
+#: Concrete: kappa_i ~ 1e-4 (ft / E), c of a few mm^2, beta of a few hundred, ft of 2 to 5 MPa, Gf ~ 0.1 N/mm.
+USUAL_RANGES = {
+    "E": (5.0e3, 1.0e5), "nu": (0.0, 0.45), "kappa_i": (2.0e-5, 1.0e-3), "alpha": (0.0, 1.0), "beta": (10.0, 1.0e4),
+    "c": (0.01, 1000.0), "eta": (1.0, 30.0), "ft": (0.5, 20.0), "Gf": (0.005, 1.0), "c1": (0.0, 10.0),
+    "c2": (1.0, 20.0),
+}
+
+#: A value further outside its usual range than this factor (above upper * factor, below lower / factor) is
+#: implausible: almost surely another unit or scale (kappa_i in per mille, E in GPa, c in cm^2)
+IMPLAUSIBLE_FACTOR = 10.0
+
+
+def usual_range_text(name: str, units: dict | None = None) -> str:
+    """The usual range of parameter ``name`` in words, e.g. ``"2e-05 <= kappa_i <= 0.001 [-]"`` ("" if unknown)."""
+    if name not in USUAL_RANGES:
+        return ""
+    lower, upper = USUAL_RANGES[name]
+    unit = (units or known_units()).get(name, "-")
+    return f"{lower:g} <= {name} <= {upper:g} [{unit}]"
+
+
+def implausible(name: str, value: float, units: dict | None = None) -> str | None:
+    """Why ``value`` of parameter ``name`` is implausible for a quasi-brittle material, or None.
+
+    Implausible: more than :data:`IMPLAUSIBLE_FACTOR` times above the upper end of its
+    :data:`USUAL_RANGES` entry, or positive and below its lower end divided by the factor. Parameters
+    without a usual range are never implausible.
+
+    Examples
+    --------
+    >>> implausible("kappa_i", 0.2)
+    'kappa_i = 0.2 is 200 times the upper end of its usual range 2e-05 <= kappa_i <= 0.001 [-]'
+    >>> implausible("kappa_i", 1e-4) is None
+    True
+    """
+    if name not in USUAL_RANGES or not math.isfinite(value):
+        return None
+    lower, upper = USUAL_RANGES[name]
+    usual = usual_range_text(name, units)
+    if value > upper * IMPLAUSIBLE_FACTOR:
+        return f"{name} = {value:g} is {value / upper:.3g} times the upper end of its usual range {usual}"
+    if 0 < value < lower / IMPLAUSIBLE_FACTOR:  # 0 itself is a bound, not a scale (e.g. beta >= 0)
+        return f"{name} = {value:g} is 1/{lower / value:.3g} of the lower end of its usual range {usual}"
+    return None
 
 
 # ``[model] type`` of a configuration -> the forward model (one line per model)

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 from pathlib import Path
 
@@ -32,39 +31,31 @@ def _data_limit_text(n_y: int, what: str) -> str:
             "describe a curve: lower n_points")
 
 
-def _csv_header(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str) -> list[str]:
-    """The header cells of a data file, split by ``delimiter``; a header that is one cell holding
-    another separator, or a first data row with decimal commas read with ``decimal = "."``, is named
-    as such (instead of a missing column or a cell that is not a number)."""
-    from fracid.data.curves import decimal_comma_hint, delimiter_hint, iter_rows
+def _csv_table(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str, columns):
+    """The header and rows of a data file as the reader finds them (:func:`fracid.data.curves.read_table`,
+    ``columns`` the configured column names); a header that is one cell holding another separator, or a
+    first data row with decimal commas read with ``decimal = "."``, is named as such (instead of a missing
+    column or a cell that is not a number)."""
+    from fracid.data.curves import DataError, decimal_comma_hint, delimiter_hint, read_table
 
-    header = first = None
     try:
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            for _, cells in iter_rows(handle, delimiter):
-                if not any(cell.strip() for cell in cells):
-                    continue
-                if header is None:
-                    header = [cell.strip() for cell in cells]
-                else:
-                    first = cells
-                    break
-    except (UnicodeDecodeError, csv.Error) as err:
-        ck.fail(key, value, f"not a readable UTF-8 CSV file ({err})")
-    if header is None:
-        ck.fail(key, value, f"the file is empty (no header row): {path}")
+        table = read_table(str(path), delimiter, decimal, columns)
+    except DataError as err:
+        ck.fail(key, value, str(err))
+    header = table.header
     guess = delimiter_hint(header, delimiter)
     if guess is not None:
         given = _toml_text(delimiter) + (" (the default)" if delimiter == "," else "")
         ck.fail(key, value, f"the header is one cell {header[0]!r} when split by delimiter = {given}: the file seems "
                             f"to be separated by {guess!r}; set delimiter = {_toml_text(guess)} (and decimal = \",\" "
                             "for decimal commas)")
+    first = table.rows[0][1] if table.rows else None
     hint = first is not None and decimal_comma_hint(first, delimiter, decimal, len(header))
     if hint:
         row = ", ".join(repr(cell.strip()) for cell in first)
         ck.fail(key, value, f"the first data row ({row}) cannot be read with delimiter = {_toml_text(delimiter)} and "
                             f"decimal = {_toml_text(decimal)}: {hint}")
-    return header
+    return table
 
 
 def _toml_text(text: str) -> str:
@@ -115,18 +106,6 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
                               f"must be a number >= 0 [{control_unit}] (the largest backtrack of the control column "
                               "treated as noise)", lambda v: v >= 0)
 
-    header = _csv_header(ck, f"{prefix}.file", raw["file"], file, delimiter, decimal)
-    available = "available columns: " + ", ".join(repr(c) for c in header)
-
-    def column(name, value):
-        key = f"{prefix}.{name}"
-        ck.string(key, value, "must be a column name (string)")
-        if value not in header:
-            ck.fail(key, value, f"the file {file} has no such column; {available}")
-        return value
-
-    column("control_column", control_column)
-    options = {}
     if kind in ("repeats", "single"):
         key = f"{prefix}.force_columns"
         names = ck.strings(key, required("force_columns"))
@@ -134,13 +113,19 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
             ck.fail(key, raw["force_columns"], "kind 'repeats' needs at least 2 columns (one per repeated test)")
         if kind == "single" and len(names) != 1:
             ck.fail(key, raw["force_columns"], "kind 'single' takes exactly 1 column")
-        for name in names:
-            if name not in header:
-                ck.fail(key, raw["force_columns"], f"the file {file} has no column {name!r}; {available}")
-        options["force_columns"] = names
+        columns = {key: (raw["force_columns"], names)}
+        options = {"force_columns": names}
     else:
-        for name in _KIND_KEYS["envelope"]:
-            options[name] = column(name, required(name))
+        options = {name: ck.string(f"{prefix}.{name}", required(name), "must be a column name (string)")
+                   for name in _KIND_KEYS["envelope"]}
+        columns = {f"{prefix}.{name}": (options[name], [options[name]]) for name in _KIND_KEYS["envelope"]}
+    columns = {f"{prefix}.control_column": (control_column, [control_column]), **columns}
+    table = _csv_table(ck, f"{prefix}.file", raw["file"], file, delimiter, decimal,
+                       [name for _, names in columns.values() for name in names])
+    for key, (value, names) in columns.items():
+        for name in names:
+            if name not in table.header:
+                ck.fail(key, value, f"{name!r} is not a column of {file}: {table.missing_column(name)}")
     if kind == "single":
         given = [name for name in ("std", "relative_std") if name in raw]
         if len(given) != 1:

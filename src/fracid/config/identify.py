@@ -22,6 +22,20 @@ from fracid.config.schema import (
 from fracid.config.sections import _range_text, _valid_parameter
 
 
+def _check_plausible(ck: _Checker, key: str, pair, name: str, bounds, units: dict) -> None:
+    """Refuse a bound of ``name`` far outside its usual range (:func:`fracid.models.implausible`): the
+    message names the parameter, the bound and the usual range, before any data are read (a kappa_i
+    1000 times too large would otherwise make the data look 1000 times too short)."""
+    from fracid.models import IMPLAUSIBLE_FACTOR, implausible
+
+    for which, value in zip(("lower", "upper"), bounds):
+        reason = implausible(name, value, units)
+        if reason is not None:
+            ck.fail(key, pair, f"the {which} bound is implausible for a quasi-brittle material: {reason} (more than "
+                               f"{IMPLAUSIBLE_FACTOR:g} times outside it); check its unit and scale (e.g. kappa_i "
+                               f"~ 1e-4 for concrete, about ft / E; E in MPa, c in mm^2)")
+
+
 def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:
     if raw is None:
         if needed:
@@ -61,6 +75,7 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         for which, v in (("lower", lo), ("upper", hi)):
             if not _valid_parameter(cls, name, v):
                 ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(cls, name)} [{unit}]")
+        _check_plausible(ck, key, pair, name, (lo, hi), cls.units())
         lower.append(lo)
         upper.append(hi)
     log = ()

@@ -22,7 +22,10 @@ physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+
+import numpy as np
 
 from fracid.config.checker import ConfigError, _Checker
 from fracid.config.schema import SpecimenConfig
@@ -31,6 +34,10 @@ MESH_TYPE = "mesh"
 _KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
          "crack", "regions")
 _COMPONENT = "must be 'x' or 'y'"
+#: an element side this many times the largest internal length l is taken for a unit mistake
+_COARSEST = 100.0
+#: a mesh whose extent is below this many units is probably drawn in metres
+_METRES = 5.0
 
 
 def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
@@ -161,4 +168,68 @@ def _check_mesh(ck: _Checker, options: dict) -> None:
     except ImportError as err:
         raise ConfigError(f"{ck.path}: specimen.file: {err}") from None
     except ValueError as err:
-        raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {err}") from None
+        text = str(err).removeprefix(f"{options['path']}: ")  # the file is named once
+        raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {text}") from None
+
+
+def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) -> None:
+    """Refuse a mesh whose size is implausible against the internal length l = sqrt(2 c) of a gradient or
+    integral damage model, a sign of a unit mistake (a mesh drawn in metres without ``scale = 1000``, or in
+    micrometres): l larger than the whole mesh for the smallest c considered, or the smallest element side
+    more than :data:`_COARSEST` times l for the largest c considered (c given or default, and the bounds of
+    ``[identify.bounds] c`` when c is identified).
+
+    Parameters
+    ----------
+    ck : _Checker
+        The configuration's checker (its path starts the message).
+    model : ModelConfig
+        The validated ``[model]``.
+    specimen : SpecimenConfig
+        The validated ``[specimen]``; nothing is checked unless its type is "mesh".
+    identify : IdentifyConfig or None
+        The validated ``[identify]``, if any.
+
+    Raises
+    ------
+    ConfigError
+        Naming the file, the mesh's extent in its units and in mm, ``specimen.scale``, c and l.
+    """
+    if specimen.type != MESH_TYPE or model.regularization not in ("gradient", "integral"):
+        return
+    from fracid.config.loading import _smallest_side
+    from fracid.specimens.mesh import MeshSpecimen
+
+    built = MeshSpecimen(**dict(specimen.options))
+    description = built.describe()
+    extent = np.ptp(description.nodes, axis=0) / built.scale  # mesh units
+    size = (f"specimen.file = {built.path!r}: the mesh spans {extent[0]:.6g} x {extent[1]:.6g} units of its own, "
+            f"{extent[0] * built.scale:.6g} x {extent[1] * built.scale:.6g} mm with specimen.scale = {built.scale:g} "
+            "(mm per unit)")
+    (small, small_where), (large, large_where) = _c_range(model, identify)
+    length = math.sqrt(2.0 * small)
+    if length > extent.max() * built.scale:
+        hint = ("is the mesh drawn in metres? then set scale = 1000 under [specimen] (mm per mesh unit)"
+                if extent.max() < _METRES else "check specimen.scale (mm per mesh unit) and that c is in mm^2")
+        raise ConfigError(f"{ck.path}: {size}, smaller than the internal length l = sqrt(2 c) = {length:.3g} mm "
+                          f"(with {small_where}): {hint}")
+    length, side = math.sqrt(2.0 * large), _smallest_side(description)
+    if side > _COARSEST * length:
+        hint = ("is the mesh drawn in mm? then leave scale out (1, the default)" if built.scale > 1 else
+                "scale = 0.001 for a mesh drawn in micrometres")
+        raise ConfigError(f"{ck.path}: {size}; its smallest element side, {side:.6g} mm, is more than "
+                          f"{_COARSEST:g} times the internal length l = sqrt(2 c) = {length:.3g} mm (with "
+                          f"{large_where}): check specimen.scale ({hint}) and that c is in mm^2")
+
+
+def _c_range(model, identify) -> tuple:
+    """((smallest c, where), (largest c, where)) [mm^2] of the model's c and the bounds of an identified c."""
+    from fracid.config.loading import _model_parameters
+
+    c = _model_parameters(model).c
+    values = [(c, f"c = {c:g} mm^2" + ("" if "c" in dict(model.parameters) else " (default)"))]
+    if identify is not None and "c" in identify.parameters:
+        i = identify.parameters.index("c")
+        values += [(identify.lower[i], f"the lower bound c = {identify.lower[i]:g} mm^2 of identify.bounds.c"),
+                   (identify.upper[i], f"the upper bound c = {identify.upper[i]:g} mm^2 of identify.bounds.c")]
+    return min(values), max(values)

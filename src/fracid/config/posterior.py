@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from fracid.config.checker import _Checker
 from fracid.config.schema import _POSTERIOR_KEYS, PosteriorConfig
+from fracid.inverse.posterior import MIN_ESS, ess_floor
 
 
 def _posterior(ck: _Checker, raw) -> PosteriorConfig:
@@ -33,10 +34,26 @@ def _posterior(ck: _Checker, raw) -> PosteriorConfig:
                             lambda v: v > 0),
         seed=ck.integer("posterior.seed", given("seed"), "must be an integer >= 0", lambda v: v >= 0),
     )
+    _warn_floor(ck, config)
+    return config
+
+
+def _warn_floor(ck: _Checker, config: PosteriorConfig) -> None:
+    """Warn of settings that cannot give an effective sample size at the floor or the target."""
     total = config.samples_per_round * config.max_rounds
-    if config.target_ess > total:
+    floor = ess_floor(config.target_ess)
+    if total < floor:
+        ck.warn(f"posterior.samples_per_round {config.samples_per_round} x posterior.max_rounds {config.max_rounds} = "
+                f"{total} draws at most, below the floor of {floor:g} effective samples (and posterior.target_ess = "
+                f"{config.target_ess:g}): the effective sample size never exceeds the number of draws, so the "
+                "posterior fails whatever the data (exit status 3) and gives no credible intervals; raise "
+                "samples_per_round or max_rounds")
+    elif config.target_ess > total:
         ck.warn(f"posterior.target_ess = {config.target_ess:g} is above the {total} draws at most "
                 f"(samples_per_round {config.samples_per_round} x max_rounds {config.max_rounds}): the effective "
                 "sample size never exceeds the number of draws, so the sampler runs every round and reports "
                 "the target as not reached; raise max_rounds or samples_per_round, or lower target_ess")
-    return config
+    if config.target_ess < MIN_ESS:
+        ck.warn(f"posterior.target_ess = {config.target_ess:g} is below {MIN_ESS:g}, the effective sample size below "
+                "which credible intervals are those of a few draws: the sampler stops there and its intervals are "
+                f"rough; raise target_ess to {MIN_ESS:g} or more")

@@ -8,7 +8,14 @@ Units: control quantities in mm, forces in N.
 ((40,), (40, 40))
 """
 
-from fracid.data.curves import Curve, DataError, curve_from_arrays, read_curve_csv, require_positive_force
+from fracid.data.curves import (
+    Curve,
+    DataError,
+    DataTypeError,
+    curve_from_arrays,
+    read_curve_csv,
+    require_positive_force,
+)
 from fracid.data.experimental import (
     ExperimentalData,
     from_envelope,
@@ -24,6 +31,7 @@ from fracid.data.experimental import (
 __all__ = [
     "Curve",
     "DataError",
+    "DataTypeError",
     "ExperimentalData",
     "curve_from_arrays",
     "from_envelope",

@@ -48,6 +48,15 @@ class Observation:
     name: str = "global"
     damage_threshold: float = 0.0
 
+    def __post_init__(self):
+        from fracid.forward import check_specimen
+
+        check_specimen(self.specimen)
+        object.__setattr__(self, "control_points", _control_points(self.control_points))
+        if not isinstance(self.quantity, str) or not self.quantity:
+            raise TypeError(f"quantity = {self.quantity!r}; give 'force' or the name of an observable of the "
+                            "forward run (e.g. 'fpz_width')")
+
     @property
     def run_key(self) -> tuple:
         """(specimen, control, threshold): observations with compatible keys share one forward run.
@@ -59,6 +68,25 @@ class Observation:
         except TypeError:
             specimen = id(self.specimen)
         return (specimen, self.control, None if self.quantity == "force" else self.damage_threshold)
+
+
+def _control_points(values) -> np.ndarray:
+    """``values`` as a 1-D float array of finite, strictly increasing control values, or a ValueError."""
+    try:
+        points = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"control_points is a {type(values).__name__} that is not an array of numbers") from None
+    if points.ndim != 1 or points.size == 0:
+        raise ValueError(f"control_points has shape {points.shape}; give a non-empty 1-D array of control values [mm] "
+                         "(the data's control, e.g. ExperimentalData.control of one block)")
+    if not np.all(np.isfinite(points)):
+        raise ValueError("control_points holds NaN or infinite values; every control value must be a finite number")
+    steps = np.diff(points)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0))
+        raise ValueError(f"control_points must increase strictly, but point {i + 1} ({points[i + 1]:.6g} mm) does not "
+                         f"exceed point {i} ({points[i]:.6g} mm)")
+    return points
 
 
 @dataclass
@@ -133,7 +161,13 @@ class ForwardOperator:
 
     def __post_init__(self):
         object.__setattr__(self, "observations", tuple(self.observations))
+        if isinstance(self.names, str):
+            raise TypeError(f"names = {self.names!r} is a string; give a sequence of parameter names, e.g. "
+                            f"({self.names!r},)")
         object.__setattr__(self, "names", tuple(self.names))
+        strangers = [type(o).__name__ for o in self.observations if not isinstance(o, Observation)]
+        if strangers or not self.observations:
+            raise TypeError(f"observations must be a non-empty sequence of Observation, got {strangers or 'none'}")
         if self.model is None:
             object.__setattr__(self, "model", DamageModel(self.regularization or "gradient"))
         elif self.regularization is not None and self.regularization != getattr(self.model, "regularization", None):

@@ -22,6 +22,9 @@ from fracid.inverse.kalman import GaussianEstimate
 
 #: RMS fit error [% of the measured peak] above which a fit is reported as poor
 POOR_FIT_PERCENT = 10.0
+#: RMS of the residual in units of the data's std above which the misfit is reported as huge (a good fit
+#: is about 1: the residuals are the scatter of the data)
+POOR_FIT_STD = 10.0
 
 
 @runtime_checkable
@@ -135,6 +138,15 @@ class MethodResult(GaussianEstimate):
         return float(100 * rms / scale) if scale > 0 else float("nan")
 
     @property
+    def misfit_std(self) -> float:
+        """RMS of (computed - measured) / std over the points with a std > 0: the misfit in units of the
+        data's standard deviation (about 1 for a fit within the scatter; NaN if not computed)."""
+        std = np.asarray(self.std_exp, float)
+        residual = np.asarray(self.y_fit, float) - np.asarray(self.y_exp, float)
+        scaled = residual[std > 0] / std[std > 0]
+        return float(np.sqrt(np.mean(scaled**2))) if scaled.size else float("nan")
+
+    @property
     def status_label(self) -> str:
         """Label of the stage that gave the estimate (and the status), e.g. ``"Kalman filter"``."""
         labels = list((self.stages or {}).values())
@@ -161,16 +173,16 @@ class MethodResult(GaussianEstimate):
         return ", ".join(f"{c['failed']} of {c['runs']} in the {self.stages[stage]} stage"
                          for stage, c in self.stage_runs().items())
 
-    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT) -> list[str]:
-        """What a user must know before trusting the result: a non-finite or poor fit, estimates at a
-        bound, a method that did not converge or stopped, failed forward runs."""
+    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT, poor_fit_std: float = POOR_FIT_STD) -> list[str]:
+        """What a user must know before trusting the result: a non-finite or poor fit (in % of the peak, or
+        in units of the data's std), estimates at a bound, a method that did not converge or stopped,
+        failed forward runs."""
         out = []
         rms = self.rms_percent
         if not np.all(np.isfinite(np.asarray(self.x, float))) or not math.isfinite(rms):
             out.append("the result is not finite: no forward run succeeded at the estimate")
-        elif rms > poor_fit_percent:
-            out.append(f"the fit is poor: RMS error {rms:.3g} % of the measured peak (above {poor_fit_percent:g} %). "
-                       "Check the data's units (force_unit, control_unit) and sign, the bounds and the model")
+        else:
+            out += self._fit_warnings(rms, poor_fit_percent, poor_fit_std)
         if self.at_bound:
             where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.names, self.x) if n in self.at_bound)
             out.append(f"estimate at a bound of [identify.bounds]: {where}; the data pull it outside the bounds "
@@ -179,6 +191,20 @@ class MethodResult(GaussianEstimate):
             out.append(f"{self.status_label} {self.status}")
         if any(c["failed"] for c in self.stage_runs().values()):
             out.append(f"failed forward runs: {self.failed_runs_text()} (recorded; see report.html)")
+        return out
+
+    def _fit_warnings(self, rms: float, poor_fit_percent: float, poor_fit_std: float) -> list[str]:
+        out = []
+        if rms > poor_fit_percent:
+            out.append(f"the fit is poor: RMS error {rms:.3g} % of the measured peak (above {poor_fit_percent:g} %). "
+                       "Check the data's units (force_unit, control_unit) and sign, the bounds and the model")
+        misfit = self.misfit_std
+        if misfit > poor_fit_std:
+            out.append(f"the misfit is {misfit:.3g} times the data's std (RMS of (computed - measured) / std; above "
+                       f"{poor_fit_std:g}, where about 1 is a fit within the scatter): the model cannot follow the "
+                       "data within their std. Usually the units are wrong (force_unit, control_unit), the specimen's "
+                       "geometry is not that of the test (its size, [specimen]), or the std is too small (std, "
+                       "relative_std of [[experiments]])")
         return out
 
     def summary(self) -> str:
@@ -229,6 +255,74 @@ def at_bounds(names, x, bounds) -> list[str]:
     return [n for n, v, lo, hi, w in zip(names, x, lower, upper, span) if min(v - lo, hi - v) <= 1e-9 * w]
 
 
+def _float_array(name: str, value) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} is a {type(value).__name__} that is not an array of numbers") from None
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} holds {int(np.sum(~np.isfinite(array)))} NaN or infinite values; every entry "
+                         "must be a finite number")
+    return array
+
+
+def _check_space(operator, space) -> None:
+    if not all(hasattr(space, attr) for attr in ("names", "lower", "upper", "log")):
+        raise TypeError(f"space is a {type(space).__name__}; give a fracid.inverse.knn.ParameterSpace(names, lower, "
+                        "upper): the identified parameters and their bounds")
+    names = getattr(operator, "names", None)
+    if names is not None and tuple(space.names) != tuple(names):
+        raise ValueError(f"the space's parameters {list(space.names)} are not the operator's identified parameters "
+                         f"{list(names)}: give the same names in the same order")
+
+
+def check_problem(operator, y_exp, C_exp, space) -> tuple[np.ndarray, np.ndarray]:
+    """Check the arguments of an identification before any forward run.
+
+    Parameters
+    ----------
+    operator : ForwardOperator or callable
+        Its ``n_outputs`` (when it has one) sets the size of y; its ``names`` (when it has them) must
+        be the space's.
+    y_exp, C_exp : array_like
+        Measured values, shape (n,), and their covariance, shape (n, n), symmetric positive definite.
+    space : ParameterSpace
+
+    Returns
+    -------
+    y_exp, C_exp : ndarray
+        As float arrays.
+
+    Raises
+    ------
+    TypeError
+        An operator that is not callable, a space that is not a ParameterSpace, values that are not numbers.
+    ValueError
+        Shapes that do not match the operator's outputs, non-finite values, a covariance that is not
+        symmetric positive definite, parameter names that differ from the operator's.
+    """
+    if not callable(operator):
+        raise TypeError(f"operator is a {type(operator).__name__}; give a ForwardOperator "
+                        "(fracid.inverse.forward_operator) or a callable x -> run record")
+    _check_space(operator, space)
+    y, C = _float_array("y_exp", y_exp), _float_array("C_exp", C_exp)
+    n = int(getattr(operator, "n_outputs", y.size))
+    if y.shape != (n,):
+        raise ValueError(f"y_exp has shape {y.shape}, but the operator computes {n} values: give a vector of {n} "
+                         "measured values, in the order of its observations")
+    if C.shape != (n, n):
+        raise ValueError(f"C_exp has shape {C.shape}, but the covariance of {n} measured values has shape ({n}, {n}) "
+                         "(from standard deviations: np.diag(std**2))")
+    if not np.allclose(C, C.T, rtol=1e-10, atol=0.0):
+        raise ValueError("C_exp is not symmetric; a covariance matrix is")
+    try:
+        np.linalg.cholesky(C)
+    except np.linalg.LinAlgError:
+        raise ValueError("C_exp is not positive definite (a zero or negative variance, or dependent rows); every "
+                         "measured value needs a std > 0") from None
+    return y, C
+
+
 def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> dict:
     """The fields of a :class:`MethodResult` that follow from the problem and the estimate ``x``:
     ``names``, ``y_exp``, ``std_exp``, ``blocks``, ``notes``, ``units``, ``bounds``
@@ -244,5 +338,5 @@ def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> d
             "at_bound": at_bounds(space.names, np.asarray(x, float), (lower, upper))}
 
 
-__all__ = ["POOR_FIT_PERCENT", "InverseMethod", "MethodResult", "at_bounds", "identification_bounds",
-           "result_fields"]
+__all__ = ["POOR_FIT_PERCENT", "POOR_FIT_STD", "InverseMethod", "MethodResult", "at_bounds", "check_problem",
+           "identification_bounds", "result_fields"]

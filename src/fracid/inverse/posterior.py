@@ -32,7 +32,30 @@ from scipy.special import logsumexp
 from fracid.inverse.mixture import GaussianMixture, fit_mixture, weighted_covariance
 from fracid.inverse.sensitivity import ForwardRunError, evaluate_points
 
-__all__ = ["PosteriorResult", "PosteriorSettings", "posterior", "sample_posterior", "weighted_quantile"]
+__all__ = ["MIN_ESS", "MIN_ESS_FRACTION", "PosteriorResult", "PosteriorSettings", "ess_floor", "posterior",
+           "sample_posterior", "weighted_quantile"]
+
+#: Effective sample size below which the sampling has failed: the weights sit on a few draws, and
+#: quantiles of a few points are not credible intervals (at ESS 1 the interval is a point)
+MIN_ESS = 50.0
+#: ... or below this share of ``target_ess``, when that is larger
+MIN_ESS_FRACTION = 0.05
+#: What to change when the sampling failed (the status's and the configuration warning's advice)
+ESS_ADVICE = ("draw more (samples_per_round, max_rounds of [posterior]), widen the first proposal (a larger "
+              "inflation), or check the identification (a poor fit, an estimate at a bound, a std too small)")
+
+
+def ess_floor(target_ess: float) -> float:
+    """The effective sample size below which the sampling has failed: ``max(MIN_ESS, MIN_ESS_FRACTION *
+    target_ess)``, but never above ``target_ess`` itself (a lower target is the user's choice, warned
+    about when the configuration is loaded).
+
+    Examples
+    --------
+    >>> ess_floor(500.0), ess_floor(4000.0), ess_floor(30.0)
+    (50.0, 200.0, 30.0)
+    """
+    return float(min(target_ess, max(MIN_ESS, MIN_ESS_FRACTION * target_ess)))
 
 
 @dataclass(frozen=True)
@@ -107,7 +130,9 @@ class PosteriorResult:
         Per parameter: whether its prior is log-uniform (a log axis in plots).
     units : dict
     status : str
-        ``"converged"`` (ESS reached) or ``"ESS ... below the target ..."``.
+        ``"converged"`` (ESS reached), ``"ESS ... below the target ..."`` (between the floor
+        :func:`ess_floor` and the target: rough intervals) or ``"failed: effective sample size ..."``
+        (below the floor: :attr:`sampling_failed`, no credible intervals).
     history : list of dict
         Per round: draws, failed, ESS after the round, components of the proposal.
     """
@@ -135,6 +160,13 @@ class PosteriorResult:
         return self.status == "converged"
 
     @property
+    def sampling_failed(self) -> bool:
+        """Whether the effective sample size stayed below the floor (:func:`ess_floor`): the draws give no
+        credible intervals (:meth:`credible_intervals` is NaN) and ``fracid posterior`` exits 3.
+        (``failed`` is the count of failed forward runs.)"""
+        return self.status.startswith("failed")
+
+    @property
     def mean(self) -> np.ndarray:
         return self.weights @ self.x
 
@@ -151,7 +183,10 @@ class PosteriorResult:
         return np.column_stack([weighted_quantile(self.x[:, j], self.weights, q) for j in range(self.x.shape[1])])
 
     def credible_intervals(self, level: float = 0.9) -> np.ndarray:
-        """Equal-tailed credible intervals, shape (p, 2)."""
+        """Equal-tailed credible intervals, shape (p, 2); NaN when :attr:`sampling_failed` (the quantiles of
+        a few draws are not an interval: :meth:`quantiles` still gives them)."""
+        if self.sampling_failed:
+            return np.full((len(self.names), 2), np.nan)
         return self.quantiles([(1.0 - level) / 2.0, (1.0 + level) / 2.0]).T
 
     def predictive_band(self, level: float = 0.9) -> np.ndarray:
@@ -171,6 +206,8 @@ class PosteriorResult:
     def summary(self) -> str:
         lines = [f"posterior: {len(self.x)} draws in {self.rounds} rounds, ESS {self.ess:.0f}, "
                  f"{self.failed} failed runs; {self.status}"]
+        if self.sampling_failed:
+            return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
         intervals = self.credible_intervals(0.9)
         for j, name in enumerate(self.names):
             lines.append(f"  {name}: mean {self.mean[j]:.5g}, std {self.std[j]:.3g}, 90 % interval "
@@ -178,10 +215,13 @@ class PosteriorResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        intervals = self.credible_intervals(0.9)
+        """The statistics as plain values; ``interval_90`` holds None (JSON null) when :attr:`sampling_failed`."""
+        intervals = self.credible_intervals(0.9).astype(object)
+        intervals[~np.isfinite(intervals.astype(float))] = None
         return {"names": list(self.names), "mean": self.mean.tolist(), "std": self.std.tolist(),
                 "cov": self.cov.tolist(), "interval_90": intervals.tolist(), "ess": self.ess, "draws": len(self.x),
                 "rounds": self.rounds, "failed": self.failed, "status": self.status,
+                "sampling_failed": self.sampling_failed,
                 "estimate": np.asarray(self.estimate).tolist(), "estimate_cov": np.asarray(self.estimate_cov).tolist(),
                 "units": dict(self.units), "history": self.history}
 
@@ -301,13 +341,25 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh. "
                               "Check the bounds of [identify.bounds] (the prior) and the forward runs of the "
                               "identification; failed runs are stored: --retry-failed runs them again")
-    status = "converged" if ess >= settings.target_ess else (
-        f"ESS {ess:.0f} below the target {settings.target_ess:g} after {len(proposals)} rounds: the intervals are "
-        "rough; raise max_rounds or samples_per_round")
+    status = _status(ess, settings, len(u_all), len(proposals))
     lower, upper = space.lower, space.upper
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
                            np.sqrt(np.diag(C_exp)), ess, len(proposals), failed, np.asarray(x0, float),
                            np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
+
+
+def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
+    """The sampler's verdict on its weights: converged, rough (below the target) or failed (below the floor)."""
+    if ess >= settings.target_ess:
+        return "converged"
+    floor = ess_floor(settings.target_ess)
+    if ess < floor:
+        return (f"failed: effective sample size {ess:.3g} < {floor:g} (the floor: {MIN_ESS:g}, or "
+                f"{MIN_ESS_FRACTION:.0%} of target_ess = {settings.target_ess:g}) after {draws} draws in {rounds} "
+                f"round{'s' if rounds != 1 else ''}: the weights sit on a few draws, so there are no credible "
+                f"intervals; {ESS_ADVICE}")
+    return (f"ESS {ess:.0f} below the target {settings.target_ess:g} after {rounds} rounds: the intervals are "
+            "rough; raise max_rounds or samples_per_round")
 
 
 def sample_posterior(evaluate, data, space, identification, settings, *, executor=None, progress=None, log=None):

@@ -16,7 +16,7 @@ import numpy as np
 from fracid.inverse.gauss_newton import gauss_newton
 from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.knn import ParameterSpace, knn_search
-from fracid.inverse.method import InverseMethod, MethodResult, identification_bounds, result_fields
+from fracid.inverse.method import InverseMethod, MethodResult, check_problem, identification_bounds, result_fields
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.parallel import BatchStats
@@ -161,6 +161,7 @@ class KnnKalman:
             raises: see :func:`refine`.
         """
         start = time.perf_counter()
+        y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
         stats = BatchStats()
         knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
                           stats=stats, retry_failed=retry_failed)
@@ -199,6 +200,7 @@ class KnnGaussNewton:
                  retry_failed=False, blocks=(), notes=()) -> IdentificationResult:
         """Both stages (see :class:`~fracid.inverse.method.InverseMethod`)."""
         start = time.perf_counter()
+        y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
         stats = BatchStats()
         knn = KnnKalman(self.knn).search(operator, y_exp, C_exp, space, executor=executor, store=store,
                                         progress=progress, stats=stats, retry_failed=retry_failed)
@@ -266,11 +268,17 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
     AllRunsFailed
         Default method: when fewer than k population runs succeeded. A failed run of the Kalman stage
         never raises: see :func:`refine`.
-    ValueError
-        When ``method`` is an inverse method and settings of the default method are given too.
+    TypeError, ValueError
+        Before any forward run, for arguments that do not fit together
+        (:func:`~fracid.inverse.method.check_problem`: the shapes of ``y_exp`` and ``C_exp`` against the
+        operator's outputs, the space's names against the operator's), and when ``method`` is an inverse
+        method and settings of the default method are given too.
     """
     start = time.perf_counter()
-    y_exp, C_exp = np.asarray(y_exp, float), np.asarray(C_exp, float)
+    y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
+    if not (method is None or isinstance(method, str) or callable(method)):
+        raise TypeError(f"method is a {type(method).__name__}; give an InverseMethod (e.g. KnnKalman()), a population "
+                        "design ('sobol', 'lhs', 'grid') or None")
     given = {"n": n, "seed": seed, "k": k, "groups": groups, "max_iterations": max_iterations, "tol": tol,
              "restart": restart}
     if method is None or isinstance(method, str):
@@ -364,6 +372,9 @@ def identify_data(operator, data, space: ParameterSpace, **settings) -> MethodRe
     ``data`` is an :class:`~fracid.data.ExperimentalData`; its blocks must line up with the
     operator's observations (same number of values, in order).
     """
+    if not all(hasattr(data, attr) for attr in ("y", "covariance", "blocks", "notes")):
+        raise TypeError(f"data is a {type(data).__name__}; give fracid.data.ExperimentalData (e.g. from "
+                        "fracid.data.with_std), or call identify(operator, y_exp, C_exp, space)")
     if data.y.size != operator.n_outputs:
         raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
     for block, part in zip(data.blocks, operator.slices()):

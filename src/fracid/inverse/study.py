@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.method import identification_bounds
+from fracid.inverse.method import check_problem, identification_bounds
 from fracid.inverse.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
 from fracid.inverse.stability import stability as stability_check
@@ -117,13 +117,19 @@ class StudyResult:
         return "Forward runs: " + ", ".join(parts) if parts else ""
 
     def summary(self) -> str:
-        lines = ["Verdict:", self.verdict.text(self.identification.units)]
+        """The text of verdict.txt: the verdict per parameter, the warnings of the identification (a poor fit,
+        estimates at a bound, no convergence, failed runs: those stderr and report.html give), the posterior,
+        the forward runs, the status, the notes and the predictions."""
+        ident = self.identification
+        lines = ["Verdict:", self.verdict.text(ident.units)]
+        lines += [f"Warning: {text}" for text in ident.warnings()]
         if self.posterior is not None:
             first = self.posterior.summary().splitlines()[0]
-            lines += [f"Verdict measure: {self.verdict.measure} (std-equivalent: half-width / 1.645)", f"P{first[1:]}"]
+            if not self.posterior.sampling_failed:
+                lines.append(f"Verdict measure: {self.verdict.measure} (std-equivalent: half-width / 1.645)")
+            lines.append(f"P{first[1:]}")
         if self.runs:
             lines.append(self.runs_text())
-        ident = self.identification
         if getattr(ident, "status", ""):
             lines.append(f"{ident.status_label}: {ident.status}")
         lines += [f"Note: {note}" for note in self.notes]
@@ -297,6 +303,7 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
     """
     if data.y.size != operator.n_outputs:
         raise ValueError(f"the data hold {data.y.size} values but the observations compute {operator.n_outputs}")
+    check_problem(operator, data.y, data.covariance, space)
     timings, clock = {}, time.perf_counter()
     log = log or (lambda text: None)
 
@@ -382,8 +389,9 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
         stage("posterior")
     if runs["KNN"][1]:
         notes.insert(0, f"{runs['KNN'][1]} of {runs['KNN'][0]} KNN runs failed (they rank last; see population.csv)")
+    usable = None if post is None or post.sampling_failed else post  # below the ESS floor: no intervals
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
-                                 tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=post)
+                                 tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=usable)
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, timings, runs, notes,
                        posterior=post)
 
@@ -391,7 +399,8 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
 def _posterior_stage(operator, data, space, ident, settings, *, store, executor, progress, log, retry_failed, runs,
                      notes):
     """The posterior sampled from the identification's Gaussian (runs stored under the label "posterior"),
-    or None with a note when there is no finite Gaussian to start from or every run failed."""
+    or None with a note when there is no finite Gaussian to start from or every run failed; a note too
+    when its effective sample size is below the floor (the verdict then reads the Gaussian std)."""
     if not (np.all(np.isfinite(ident.x)) and np.all(np.isfinite(ident.C))):
         notes.append("posterior skipped: the identification gave no finite estimate and covariance to start the "
                      "sampler from; the verdict reads the Gaussian std")
@@ -404,7 +413,9 @@ def _posterior_stage(operator, data, space, ident, settings, *, store, executor,
         notes.append(f"posterior skipped: {err}; the verdict reads the Gaussian std")
         return None
     runs["posterior"] = (len(post.x), post.failed)
-    if not post.converged:
+    if post.sampling_failed:
+        notes.append(f"posterior {post.status}; the verdict reads the Gaussian std")
+    elif not post.converged:
         notes.append(f"posterior: {post.status}")
     return post
 

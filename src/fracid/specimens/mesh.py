@@ -10,8 +10,10 @@ times ``scale`` [mm].
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
+import io
 import os
 from dataclasses import dataclass
 
@@ -117,6 +119,8 @@ class MeshSpecimen:
         if missing:
             raise MeshError(f"{self.path}: no physical group {', '.join(map(repr, missing))}; the file names "
                             f"{sorted(mesh.node_sets) or 'no physical groups'}")
+        self._check_rigid_loads(mesh)
+        self._check_pieces(mesh)
         return Description(
             nodes=mesh.nodes * self.scale, cells=mesh.cells, n_vertices=mesh.n_vertices, section=float(self.thickness),
             node_sets=mesh.node_sets,
@@ -128,6 +132,47 @@ class MeshSpecimen:
             symmetry_factor=float(self.symmetry_factor),
             **self._crack(mesh), **self._regions(mesh),
         )
+
+    def _check_rigid_loads(self, mesh) -> None:
+        """Raise MeshError when a rigid load group shares nodes with a support or symmetry group on the same
+        component: the tied group would be held as a whole and the load could not act."""
+        held = [("support", group, _component(component, "supports")) for group, component in self.supports]
+        held += [("symmetry", group, _component(component, "symmetry")) for group, component in self.symmetry]
+        for group, component, *rest in self.loads:
+            if rest and not rest[0]:
+                continue
+            normal = _component(component, "loads")
+            for kind, other, other_normal in held:
+                if other_normal != normal:
+                    continue
+                shared = np.intersect1d(mesh.node_sets[group], mesh.node_sets[other]).size
+                if shared:
+                    raise MeshError(
+                        f"{self.path}: the {kind} group {other!r} and the rigid load group {group!r} share {shared} "
+                        f"node{'s' if shared > 1 else ''} along {'xy'[normal]}: the nodes of a rigid group move as "
+                        f"one, so the {kind} holds the whole group and the load cannot act. Make the groups disjoint "
+                        "(in Gmsh, physical groups of different lines or points) or give the load rigid = false")
+
+    def _check_pieces(self, mesh) -> None:
+        """Raise MeshError when the mesh is made of pieces that share no node and one of them holds no
+        support node: that piece is free to move as a rigid body."""
+        n_pieces = int(mesh.pieces.max()) + 1
+        if n_pieces == 1:
+            return
+        supports = [group for group, _ in self.supports]
+        held = np.unique(np.concatenate([mesh.pieces[mesh.node_sets[g]] for g in supports] or [np.zeros(0, int)]))
+        free = np.setdiff1d(np.arange(n_pieces), held)
+        if not free.size:
+            return
+        cell_piece = mesh.pieces[mesh.cells[:, 0]]
+        described = "; ".join(_piece_text(mesh, cell_piece == k, k) for k in free[:5])
+        names = ", ".join(map(repr, supports)) or "none"
+        raise MeshError(
+            f"{self.path}: the mesh is made of {n_pieces} pieces that share no node, and {free.size} of them "
+            f"hold{'s' if free.size == 1 else ''} no support node (supports: {names}) "
+            f"and would move as a rigid body: {described}. Fuse the surfaces so that they share their nodes (Gmsh: "
+            "Boolean fragments of the surfaces, or Geometry > Coherence, then mesh again), or add a support in "
+            "each piece")
 
     def _regions(self, mesh) -> dict:
         """Per-element stiffness factor and damageability of the regions."""
@@ -202,6 +247,14 @@ def _load(item) -> Load:
     return Load(group, _component(component, "loads"), total, rigid=rigid)
 
 
+def _piece_text(mesh, cells, k) -> str:
+    """One piece of a mesh in words: its number, elements and bounding box (mesh units)."""
+    corners = mesh.nodes[np.unique(mesh.cells[cells])]
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    return (f"piece {k + 1} ({int(cells.sum())} elements, x in [{low[0]:.6g}, {high[0]:.6g}], "
+            f"y in [{low[1]:.6g}, {high[1]:.6g}])")
+
+
 @dataclass(frozen=True, eq=False)
 class PlaneMesh:
     """A plane mesh in fracid's numbering: corners first (``n_vertices``), then mid-edge nodes."""
@@ -211,6 +264,7 @@ class PlaneMesh:
     n_vertices: int
     node_sets: dict
     cell_sets: dict  # group of surfaces -> indices of its cells
+    pieces: np.ndarray  # per node: the connected piece of the mesh it belongs to (0, 1, ...)
 
 
 def read_mesh(path) -> PlaneMesh:
@@ -229,11 +283,37 @@ def _read(path, mtime, size) -> PlaneMesh:
         import meshio
     except ImportError as err:
         raise ImportError(f"reading {path} needs meshio: pip install 'fracid[vtk]' ({err})") from err
-    try:
-        raw = meshio.read(path)
-    except Exception as err:  # meshio raises many types on a malformed file
-        raise MeshError(f"{path}: not a mesh meshio can read ({type(err).__name__}: {err})") from None
+    raw = _meshio_read(meshio, path)
     return plane_mesh(raw.points, [(block.type, block.data) for block in raw.cells], _physical_groups(raw), path)
+
+
+def _meshio_read(meshio, path):
+    """meshio's mesh of ``path``, or MeshError naming the file and the formats to export: meshio may
+    raise any exception, or print an error and call ``sys.exit``, on a file it cannot read."""
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
+            return meshio.read(path)
+    except MemoryError:
+        raise
+    except (SystemExit, Exception) as err:  # noqa: BLE001 -- every failure of the reader is a bad file
+        reason = " ".join(said.getvalue().split()).removeprefix("Error: ") or f"{type(err).__name__}: {err}"
+        raise MeshError(f"{path}: not a mesh file fracid can read ({_GMSH_1 if _is_gmsh_1(path) else reason}). "
+                        f"{_EXPORT}") from None
+
+
+_GMSH_1 = "a Gmsh 1.0 file ($NOD), a format meshio does not read"
+_EXPORT = ("Save it from Gmsh in the format 2.2 or 4.1 (File > Export, format Gmsh MSH, \"Version 4 ASCII\" or "
+           "\"Version 2 ASCII\"; on the command line: gmsh -2 file.geo -format msh22 -o file.msh)")
+
+
+def _is_gmsh_1(path) -> bool:
+    """Whether the file starts as Gmsh's old format 1.0 ($NOD, no $MeshFormat)."""
+    try:
+        with open(path, "rb") as handle:
+            return handle.read(64).lstrip().startswith(b"$NOD")
+    except OSError:
+        return False
 
 
 _DIMENSION = {"vertex": 0, "line": 1, "line3": 1, **{kind: 2 for kind in _SURFACES}}
@@ -278,6 +358,8 @@ def plane_mesh(points, blocks, cell_sets, path="mesh") -> PlaneMesh:
                         "Mesh.RecombineAll = 1 for quadrilaterals only, 0 for triangles)")
     n_corners = families.pop()
     corners = np.concatenate([data[:, :n_corners] for _, data in surfaces])
+    vertex_ids = np.unique(corners)
+    _check_size(path, vertex_ids.size, len(corners))
     used = np.unique(np.concatenate([data.ravel() for _, data in surfaces]))
     unused = np.setdiff1d(np.arange(len(points)), used)
     if unused.size:
@@ -286,17 +368,80 @@ def plane_mesh(points, blocks, cell_sets, path="mesh") -> PlaneMesh:
         raise MeshError(f"{path}: {count} to no triangle or quadrilateral (node {node} at "
                         f"{points[node, :2].tolist()}); save only the meshed surfaces (Gmsh: Mesh.SaveAll = 0 with "
                         "physical surfaces)")
-    vertex_ids = np.unique(corners)
     renumber = np.full(len(points), -1)
     renumber[vertex_ids] = np.arange(vertex_ids.size)
     vertices = points[vertex_ids, :2]
     cells = renumber[corners]
+    _check_coincident(path, vertices, cells)
     cells = _counterclockwise(vertices, cells, path)
     edges, mid = _mid_edges(cells)
     nodes = np.vstack([vertices, 0.5 * (vertices[edges[:, 0]] + vertices[edges[:, 1]])])
     quadratic = np.hstack([cells, vertex_ids.size + mid])
     node_sets = _node_sets(blocks, cell_sets, renumber, edges, vertex_ids.size, path)
-    return PlaneMesh(nodes, quadratic, int(vertex_ids.size), node_sets, _cell_sets(surfaces, cell_sets))
+    return PlaneMesh(nodes, quadratic, int(vertex_ids.size), node_sets, _cell_sets(surfaces, cell_sets),
+                     _pieces(vertex_ids.size, edges))
+
+
+def mesh_unknowns(n_vertices: int, n_cells: int) -> int:
+    """The unknowns of fracid's quadratic mesh built on a linear one.
+
+    Parameters
+    ----------
+    n_vertices, n_cells : int
+        Element corners and elements (triangles or quadrilaterals) of the mesh read.
+
+    Returns
+    -------
+    int
+        2 displacements per corner and per mid-edge node, and the nonlocal strain on the corners; the
+        edges counted by Euler's formula for one piece without holes, E = V + F - 1 (each hole adds one).
+    """
+    n_edges = n_vertices + n_cells - 1
+    return 2 * (n_vertices + n_edges) + n_vertices
+
+
+def _check_size(path, n_vertices: int, n_cells: int) -> None:
+    """Raise MeshError, before the mesh is built, when its unknowns exceed
+    :data:`fracid.config.schema.MAX_UNKNOWNS` (the limit of the built-in specimens' meshes)."""
+    from fracid.config.checker import _bytes
+    from fracid.config.schema import BYTES_PER_UNKNOWN, MAX_UNKNOWNS
+
+    unknowns = mesh_unknowns(n_vertices, n_cells)
+    if unknowns > MAX_UNKNOWNS:
+        raise MeshError(
+            f"{path}: {n_cells:,} elements and {n_vertices:,} corner nodes make about {unknowns:,} unknowns once "
+            f"fracid adds the mid-edge nodes, needing about {_bytes(unknowns * BYTES_PER_UNKNOWN)} of memory in a "
+            f"forward run ({BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most {MAX_UNKNOWNS:,} unknowns "
+            "are allowed: use a coarser mesh (small elements only where the crack runs; a few elements per "
+            "internal length l = sqrt(2 c) are enough)")
+
+
+def _check_coincident(path, vertices, cells) -> None:
+    """Raise MeshError when corners lie on one another (within 1e-6 of the median element side): Gmsh left
+    duplicate nodes unmerged, and the elements on either side are not connected."""
+    from scipy.spatial import cKDTree
+
+    sides = np.linalg.norm(vertices[cells[:, 1]] - vertices[cells[:, 0]], axis=1)
+    tolerance = 1e-6 * float(np.median(sides))
+    pairs = cKDTree(vertices).query_pairs(tolerance, output_type="ndarray")
+    if not len(pairs):
+        return
+    count = np.unique(pairs).size
+    raise MeshError(
+        f"{path}: {count} nodes lie on another node (closer than {tolerance:.3g} mesh units), e.g. two at "
+        f"{vertices[pairs[0, 0]].tolist()}: duplicate nodes that were not merged leave the elements on either side "
+        "unconnected. Merge them in Gmsh: Geometry > Coherence (or a larger Geometry.Tolerance) before meshing, or "
+        "\"Coherence Mesh;\" to merge the duplicate nodes of the mesh, then save it again")
+
+
+def _pieces(n_vertices: int, edges) -> np.ndarray:
+    """The connected piece (0, 1, ...) of every node: corners, then the mid-edge node of each edge."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n_vertices, n_vertices))
+    _, labels = connected_components(graph, directed=False)
+    return np.concatenate([labels, labels[edges[:, 0]]])
 
 
 def _cell_sets(surfaces, groups) -> dict:
