@@ -49,6 +49,13 @@ CASES = {
     "E-bounds-in-GPa": case(2, ["identify.bounds.E", "implausible", "usual range", "MPa"],
                             config={"parameters": '["c", "E"]', "bounds": "c = [0.5, 4.0]\nE = [20.0, 40.0]"},
                             args=IDENTIFY),
+    "kappa_i-upper-bound-9x-too-large-named": case(
+        2, ["identify.bounds.kappa_i (upper bound 0.009)", "0.032 mm", "usual"], args=IDENTIFY,
+        config={"parameters": KAPPA_I, "bounds": BOUNDS + "kappa_i = [1e-4, 0.009]"}),
+    "model-kappa_i-50x-too-large-named": case(2, ["model.parameters.kappa_i", "50 times", "usual range"],
+                                              config={"params": "kappa_i = 0.05"}, args=IDENTIFY),
+    "model-kappa_i-9x-named-beside-control_unit": case(2, ["control_unit", "or model.parameters.kappa_i = 0.009"],
+                                                       config={"params": "kappa_i = 0.009"}, args=IDENTIFY),
     # ---- [posterior] settings warned about when the configuration is loaded
     "posterior-target_ess-below-floor-warned": case(
         4, ["fracid: warning", "posterior.target_ess = 20", "below 50", "taken is a file"], files=_out_is_file,

@@ -39,6 +39,12 @@ def _lines(*above, header=None, cell=None, sep=",", decimal=".", end=""):
     return csv
 
 
+def _utf16(d, curve):
+    """The standard file saved as a spreadsheet's "Unicode Text": UTF-16 with its byte order mark."""
+    write_csv(d / "bar.csv", *curve)
+    (d / "bar.csv").write_bytes((d / "bar.csv").read_text().encode("utf-16"))
+
+
 def _reads(csv, **config) -> Case:
     """A data file that must be read: the command reaches the output path, a file ("taken is a file")."""
     return case(4, ["taken is a file"], csv=csv, config=config or None, files=_out_is_file,
@@ -49,10 +55,15 @@ SEMICOLON = {"experiment": 'delimiter = ";"\ndecimal = ","'}
 
 CASES = {
     # ---- signs: checked before the order of the rows (not "raise backtrack_tolerance")
-    "data-negative-tension-test": case(2, ["'u_mm' is negative", "negate", "'F_N' is negative too"],
+    "data-negative-tension-test": case(2, ["'u_mm' is negative", 'negate = ["control"]', "'F_N' is negative too"],
                                        csv=_negated(-1, -1), args=IDENTIFY),
     "data-negative-control-only": case(2, ["'u_mm' is negative", "multiply it by -1"], csv=_negated(-1, 1),
                                        args=IDENTIFY),
+    "data-negative-tension-test-negated-by-the-config": case(
+        4, ["taken is a file"], csv=_negated(-1, -1), config={"experiment": 'negate = ["control", "force"]'},
+        files=_out_is_file, args=("identify", "cfg.toml", *REACHES_OUTPUT)),
+    "data-negate-unknown-column": case(2, ["experiments[0].negate", '"control" and/or "force"'],
+                                       config={"experiment": 'negate = ["cmod"]'}),
     # ---- order and columns
     "data-rows-in-reverse-order": csv_case(2, ["reverse order", "'u_mm'", "sort them"], rows=_reversed, args=IDENTIFY),
     "data-swapped-columns": csv_case(2, ["look swapped", "control_column = 'F_N'", "'u_mm'"], rows=_swapped,
@@ -77,4 +88,7 @@ CASES = {
     "data-header-not-on-line-1": case(2, ["experiments[0].control_column", "line 1", "line 2", "looks like it",
                                           "'Extension'"], csv=_lines("Test 1, 2026-01-01", header="Extension,Load")),
     "reads-trailing-empty-cells": _reads(_lines(end=",,")),
+    "data-unclosed-quote": csv_case(2, ["line 32", "quote", "not closed"],
+                                    lambda i, row: [row[0], '"' + row[1]] if i == 30 else row, args=IDENTIFY),
+    "data-utf16-unicode-text": case(2, ["experiments[0].file", "UTF-16", "CSV UTF-8"], csv=_utf16),
 }

@@ -157,7 +157,7 @@ CASES = {
         files=_config_as_result_json),
     "simulate-again-replaces-its-own-files": case(None, config=simulate_config(), csv=None, files=_simulated_before,
                                                   args=(*SIM, "--out", "out"), verify=_rerun),
-    "another-programs-runs-sqlite-in-out": case(2, ["runs.sqlite", "not written by fracid"],
+    "another-programs-runs-sqlite-in-out": case(4, ["runs.sqlite", "another program", "runs_of_my_lab", "--out"],
                                                 files=_foreign_database(False), args=IDENTIFY),
     "another-programs-database-listed-as-fracids": case(4, ["another program", "runs_of_my_lab", "--out"],
                                                         files=_foreign_database(True), args=IDENTIFY),

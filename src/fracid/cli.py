@@ -262,6 +262,10 @@ def run_posterior_command(args) -> int:
     _say(args, post.summary())
     _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
                f"the run store, {post.failed} failed)\nwrote in {out}: " + ", ".join(written))
+    if post.sampling_failed:
+        print(f"fracid: posterior {post.status}. The draws are in {out / 'posterior.csv'}, without credible "
+              "intervals.", file=sys.stderr)
+        return FAILED
     if not post.converged:
         _warn(f"posterior: {post.status}")
     return 0

@@ -1,6 +1,7 @@
 """What a command writes into its output directory, and the guard that keeps it from destroying anything
 else: an output is never one of the run's inputs (the configuration, a data file, a mesh), and fracid
-replaces only files it wrote itself, which it lists in the directory's manifest ``.fracid-written``.
+replaces only files it wrote itself, which it lists in the directory's manifest ``.fracid-written`` (the
+run store, which it only adds to, may come from elsewhere).
 
 The guard runs before any computation: a refused output costs nothing and changes nothing.
 """
@@ -36,6 +37,11 @@ OUTPUTS = {
 }
 
 
+#: outputs that fracid adds to rather than replaces: a run store copied from another output directory is
+#: reused (:class:`fracid.store.RunStore` refuses an SQLite database of another program)
+APPENDED = frozenset({"runs.sqlite"})
+
+
 class OutputRefused(UsageError):
     """An output that would replace an input of the run, or a file fracid did not write (exit 2)."""
 
@@ -69,7 +75,7 @@ def claim_outputs(out: Path, command: str, inputs: Iterable[tuple[str, Path]]) -
                     f"{target} would be written by `fracid {command}`, and it is {role} ({source}) of this run: "
                     "fracid never overwrites its inputs. Give another output directory (--out DIR or "
                     "[output] directory), or move the input elsewhere.")
-        if (target.exists() or target.is_symlink()) and name not in written:
+        if (target.exists() or target.is_symlink()) and name not in written | APPENDED:
             raise OutputRefused(
                 f"{target} exists and was not written by fracid (it is not listed in {out / MANIFEST}); "
                 f"`fracid {command}` would replace it. Give another output directory (--out DIR or [output] "

@@ -4,6 +4,8 @@ keyword arguments of the identification, the study and a forward run."""
 
 from __future__ import annotations
 
+import contextlib
+
 import inspect
 
 import numpy as np
@@ -50,7 +52,8 @@ def _experiment_data(cfg: Config, exp: ExperimentConfig):
     else:
         columns = list(exp.force_columns)
     curves = read_curve_csv(exp.file, control_column=exp.control_column, force_columns=columns,
-                            control_unit_scale=exp.control_scale, force_unit_scale=exp.force_scale,
+                            control_unit_scale=exp.control_scale * exp.sign("control"),
+                            force_unit_scale=exp.force_scale * exp.sign("force"),
                             delimiter=exp.delimiter, decimal=exp.decimal,
                             backtrack_tolerance=exp.backtrack_tolerance_mm)
     if exp.quantity == "force":
@@ -88,21 +91,22 @@ CONTROL_SCALE_LIMIT = 30.0
 
 
 def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> None:
+    """Refuse data whose control reaches far beyond, or stops far short of, the control at which the
+    specimen has long failed: blamed on ``control_unit`` unless a bound or a parameter value explains it."""
     specimen, model = build_specimen(cfg, exp), build_model(cfg)
     if not hasattr(model, "default_target"):
         return
     params = build_parameters(cfg)
-    candidates = [params]
+    candidates = {"[model.parameters]": params}
     if cfg.identify is not None:
         for name, upper in zip(cfg.identify.parameters, cfg.identify.upper):
-            try:
-                candidates.append(params.replace(**{name: upper}))
-            except ValueError:
-                continue
+            with contextlib.suppress(ValueError):
+                candidates[f"identify.bounds.{name} (upper bound {upper:g})"] = params.replace(**{name: upper})
     try:
-        target = max(float(model.default_target(specimen, p)) for p in candidates)
+        targets = {label: float(model.default_target(specimen, p)) for label, p in candidates.items()}
     except (AttributeError, ValueError, TypeError):
         return
+    target = max(targets.values())
     where = f"{cfg.path}: experiments[{exp.index}].control_unit = {exp.control_unit!r}: the control values of {exp.file}"
     if target > 0 and reach > CONTROL_SCALE_LIMIT * target:
         raise ConfigError(
@@ -110,10 +114,42 @@ def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> No
             f"specimen has long failed with these parameters; check control_unit (values in um declared as mm "
             f"are 1000 times too large) and control_range")
     if target > 0 and reach < target / CONTROL_SCALE_LIMIT**2:
+        _blame_short_reach(cfg, exp, reach, targets, params)
         raise ConfigError(
             f"{where} reach only {reach:.3g} mm, 1/{target / reach:.0f} of the {target:.3g} mm at which this "
             f"specimen has long failed with these parameters, deep in its elastic range; check control_unit "
-            f"(values in m declared as mm are 1000 times too small)")
+            f"(values in m declared as mm are 1000 times too small){_unusual_values(cfg, params)}")
+
+
+def _unusual_values(cfg: Config, params) -> str:
+    """``"; or model.parameters.kappa_i = 0.009 (usual: ...)"`` for the given values outside their usual range."""
+    from fracid.models import USUAL_RANGES, usual_range_text
+
+    unusual = [f"model.parameters.{name} = {value:g} (usual: {usual_range_text(name)})"
+               for name, value in dict(cfg.model.parameters).items()
+               if name in USUAL_RANGES and not USUAL_RANGES[name][0] <= value <= USUAL_RANGES[name][1]]
+    return "; or " + ", ".join(unusual) if unusual else ""
+
+
+def _blame_short_reach(cfg: Config, exp: ExperimentConfig, reach: float, targets: dict, params) -> None:
+    """When data stop deep in the elastic range of some parameters: a ConfigError naming the parameter value
+    or the upper bound that puts failure so far out, if the data are plausible for the others."""
+    from fracid.models import implausible, usual_range_text
+
+    for name in dict(cfg.model.parameters):
+        why = implausible(name, float(getattr(params, name, float("nan"))))
+        if why is not None:
+            raise ConfigError(f"{cfg.path}: model.parameters.{name}: {why}; the data of experiments[{exp.index}] "
+                              f"({exp.file}) end at {reach:.3g} mm, deep in the elastic range such a value gives. "
+                              "Check the value's unit and scale")
+    if reach * CONTROL_SCALE_LIMIT**2 < targets["[model.parameters]"]:
+        return  # the given parameters too: the data's unit is the likelier cause
+    label, target = max(targets.items(), key=lambda item: item[1])
+    name = label.split()[0].rsplit(".", 1)[-1]
+    raise ConfigError(f"{cfg.path}: {label}: with it this specimen fails only at a control of {target:.3g} mm, "
+                      f"{target / reach:.0f} times the {reach:.3g} mm that the data of experiments[{exp.index}] "
+                      f"reach; the bound is implausible (usual: {usual_range_text(name) or 'see the README'}). "
+                      "Lower it, or check its unit")
 
 
 def build_experiment_data(cfg: Config, experiment: ExperimentConfig):

@@ -172,11 +172,12 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
         threshold = ck.number(f"{prefix}.damage_threshold", raw["damage_threshold"],
                               "must be a number with 0 <= t < 1 (damage counted in the width)", lambda v: 0 <= v < 1)
     role = ck.choice(f"{prefix}.role", raw.get("role", "calibration"), _ROLES)
+    negate = _negated(ck, f"{prefix}.negate", raw.get("negate", []))
     return ExperimentConfig(index=i, file=file, control_column=control_column, control_unit=control_unit,
                             force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
                             quantity=quantity, name=name, specimen=overrides, weight=weight,
                             damage_threshold=threshold, role=role, delimiter=delimiter, decimal=decimal,
-                            backtrack_tolerance=backtrack, **options)
+                            backtrack_tolerance=backtrack, negate=negate, **options)
 
 
 _REQUIRED_TEXT = {
@@ -190,6 +191,14 @@ _REQUIRED_TEXT = {
     "lower_column": "the name of the lower-envelope column (kind 'envelope')",
     "upper_column": "the name of the upper-envelope column (kind 'envelope')",
 }
+
+
+def _negated(ck: _Checker, key: str, value) -> tuple:
+    """``negate``: a list of "control" and/or "force" (the columns to multiply by -1)."""
+    allowed = 'must be a list of "control" and/or "force": the columns recorded with a negative sign'
+    if not isinstance(value, list) or any(v not in ("control", "force") for v in value):
+        ck.fail(key, value, allowed)
+    return tuple(dict.fromkeys(value))
 
 
 def _experiments(ck: _Checker, raw, base: Path, specimen: SpecimenConfig, needed: bool) -> tuple:

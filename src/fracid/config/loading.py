@@ -14,6 +14,7 @@ import numpy as np
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, _Checker, _read_toml
 from fracid.config.experiments import _data_limit_text, _experiments
 from fracid.config.identify import _identify
+from fracid.config.mesh_section import check_mesh_units
 from fracid.config.posterior import _posterior
 from fracid.config.registry import _model_of, _specimen_class
 from fracid.config.schema import (
@@ -79,6 +80,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     simulate = _simulate(ck, raw.get("simulate"))
     study = _study(ck, raw.get("study"))
     posterior = _posterior(ck, raw.get("posterior"))
+    check_mesh_units(ck, model, specimen, identify)
     _mesh_warnings(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
                   identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,

@@ -58,6 +58,7 @@ present they are always validated. Every other key is optional unless marked *re
     lower_column = "load_min_N"
     upper_column = "load_max_N"
     n_points = 40                       # required: integer >= 3, equally spaced control values
+    # negate = ["control", "force"]    # columns a machine records with a negative sign, multiplied by -1
     control_range = [0.001, 0.2]        # optional [start, stop], 0 < start < stop, in control_unit;
                                         #   default: the range common to the columns
     quantity = "force"                  # "force" (default) or a local observable of the specimen:
@@ -163,7 +164,7 @@ _MODEL_KEYS = ("type", "parameters")
 _EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                     "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
                     "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
-                    "backtrack_tolerance")
+                    "backtrack_tolerance", "negate")
 _KIND_KEYS = {
     "repeats": ("force_columns",),
     "envelope": ("mean_column", "lower_column", "upper_column"),
@@ -265,6 +266,11 @@ class ExperimentConfig:
     delimiter: str = ","  # the cell separator itself ("tab" is stored as "\t"; " " is any whitespace)
     decimal: str = "."
     backtrack_tolerance: float | None = None  # in control_unit, as given; None: 1 % of the control range
+    negate: tuple = ()  # of "control", "force": columns the machine records with a negative sign
+
+    def sign(self, column: str) -> float:
+        """-1 if the ``column`` ("control" or "force") is to be negated, else 1."""
+        return -1.0 if column in self.negate else 1.0
 
     @property
     def control_scale(self) -> float:

@@ -55,7 +55,8 @@ DEFAULT_BACKTRACK_FRACTION = 0.01
 _SWAPPED_FALL = 0.2
 
 #: how a column is negated (no key of [[experiments]] does it)
-_NEGATE = "multiply it by -1 in the file (from Python: read_curve_csv(..., {scale}=-1))"
+_NEGATE = ('set negate = ["{column}"] in its [[experiments]] block, or multiply it by -1 in the file (from Python: '
+           'read_curve_csv(..., {scale}=-1))')
 
 #: the advice for a number written with thousands separators
 _REMOVE_THOUSANDS = "remove the thousands separators ({}; in a spreadsheet: a number format without them)"
@@ -317,20 +318,21 @@ def _check_direction(control: np.ndarray, forces: np.ndarray, rows: np.ndarray, 
 
 
 def _check_control_sign(control: np.ndarray, forces: np.ndarray, rows: np.ndarray, labels: _Labels) -> None:
-    """Refuse a control that is mostly negative (its largest excursion below 0 [mm]): a test recorded
-    with a negative sign, named with the negative force columns too."""
+    """Refuse a control that is mostly negative, decreasing from about 0 (its largest excursion below 0 [mm],
+    reached after the first row): a test recorded with a negative sign, named with the negative force
+    columns too. An increasing control with a negative offset is left to the other checks."""
     low = int(np.argmin(control))
-    if not control[low] < 0.0 < -control[low] - max(float(control.max()), 0.0):
+    if not (control[low] < 0.0 < -control[low] - max(float(control.max()), 0.0) and control[-1] < control[0]):
         return
     negative = [name for name, force in zip(labels.forces, forces.T) if -force.min() > force.max()]
     also = (f"; the force column{'s' if len(negative) > 1 else ''} {', '.join(negative)} "
             f"{'are' if len(negative) > 1 else 'is'} negative too: negate {'them' if len(negative) > 1 else 'it'} "
-            f"as well ({_NEGATE.format(scale='force_unit_scale')})" if negative else "")
+            f"as well ({_NEGATE.format(column='force', scale='force_unit_scale')})" if negative else "")
     raise DataError(
         f"{labels.where}: the control column {labels.control} is negative: it runs from {control[0] + 0.0:.6g} mm "
         f"at {labels.unit} {rows[0]} to {control[low]:.6g} mm at {labels.unit} {rows[low]}, while a test's control "
         "(CMOD, deflection, elongation) grows from 0 to positive values: the machine records it with a negative "
-        f"sign; negate the column: {_NEGATE.format(scale='control_unit_scale')}" + also
+        f"sign; negate the column: {_NEGATE.format(column='control', scale='control_unit_scale')}" + also
     )
 
 
@@ -951,5 +953,5 @@ def require_positive_force(curves: Sequence[Curve]) -> None:
             raise DataError(
                 f"{curve.source}: the forces are all negative (from {lowest:g} to {highest:g} N): "
                 "a tension or bending test gives positive forces; if the sign convention of the machine is "
-                f"negative, negate the column: {_NEGATE.format(scale='force_unit_scale')}"
+                f"negative, negate the column: {_NEGATE.format(column='force', scale='force_unit_scale')}"
             )
