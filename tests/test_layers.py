@@ -9,7 +9,7 @@ import fracid
 FLOORS = {
     "fem": 0,
     "specimens": 1,
-    "models": 2, "forward": 2, "data": 2, "store": 2, "parallel": 2, "progress": 2,
+    "models": 2, "forward": 2, "data": 2, "store": 2, "tables": 2, "parallel": 2, "progress": 2,
     "inverse": 3,
     "report": 4,
     "config": 5,

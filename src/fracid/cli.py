@@ -202,7 +202,7 @@ def _identification(args, job, store, executor):
 def _write_identification(args, job, out, result) -> None:
     """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
     from fracid.report.html import write_report
-    from fracid.report.tables import write_csv_table
+    from fracid.tables import write_csv_table
 
     data = job.data
     result.save(out / "result.json")

@@ -31,6 +31,7 @@ from fracid.inverse.runs import StoredOperator
 from fracid.inverse.strategy import KalmanSettings, KnnKalman, KnnSettings
 from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
 from fracid.inverse.verdict import DataDescription, parameter_verdicts
+from fracid.tables import without_nan, write_csv_table
 
 
 @dataclass
@@ -170,7 +171,7 @@ class StudyResult:
         if self.posterior is not None:
             out["posterior"] = {**self.posterior.to_dict(), "interval_90_label": "equal-tailed 90 % credible "
                                 "interval (weighted 5 % and 95 % quantiles of the importance-weighted draws)"}
-        return json.loads(json.dumps(out, allow_nan=True).replace("NaN", "null").replace("Infinity", "null"))
+        return without_nan(out)
 
     def save(self, directory) -> Path:
         """Write study.json, verdict.txt and the CSV tables into ``directory``."""
@@ -178,18 +179,21 @@ class StudyResult:
         directory.mkdir(parents=True, exist_ok=True)
         (directory / "study.json").write_text(json.dumps(self.to_dict(), indent=1))
         (directory / "verdict.txt").write_text(self.summary() + "\n")
-        header = ",".join(self.names)
         ident = self.identification
         population = getattr(ident, "knn", None) or {}
         if population.get("points") is not None:
-            table = np.column_stack([np.asarray(population["points"], float), np.asarray(population["f"], float)])
-            np.savetxt(directory / "population.csv", table, delimiter=",", header=header + ",f", comments="")
+            points, f = np.asarray(population["points"], float), np.asarray(population["f"], float)
+            status = population.get("status") or ["ok" if np.isfinite(v) else "failed" for v in f]
+            errors = population.get("errors") or [""] * len(f)
+            # a failed run has no objective: an empty cell and its status, not "inf"
+            write_csv_table(directory / "population.csv", [*self.names, "f", "status", "error"],
+                            ([*x, v, s, e or ""] for x, v, s, e in zip(points.tolist(), f.tolist(), status, errors)))
         if self.sensitivity is not None:
             table = np.column_stack([self.sensitivity.normalised, self.sensitivity.variance_share])
             cols = [f"S_{n}" for n in self.names] + [f"variance_removed_{n}" for n in self.names]
-            np.savetxt(directory / "sensitivity.csv", table, delimiter=",", header=",".join(cols), comments="")
+            write_csv_table(directory / "sensitivity.csv", cols, table.tolist())
         if self.stability is not None:
-            np.savetxt(directory / "stability.csv", self.stability.estimates, delimiter=",", header=header, comments="")
+            write_csv_table(directory / "stability.csv", self.names, np.asarray(self.stability.estimates).tolist())
         if self.posterior is not None:
             self.posterior.save_csv(directory / "posterior.csv")
         return directory

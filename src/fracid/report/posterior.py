@@ -20,6 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from fracid.inverse.verdict import Z_90
+from fracid.tables import without_nan
 from fracid.report.figures import (
     _COMPUTED,
     _MEASURED,
@@ -257,18 +258,6 @@ def posterior_dict(result) -> dict:
     return out
 
 
-def _nulls(value):
-    """``value`` (dicts, lists, numbers) with every non-finite number as None: JSON has no NaN (an interval
-    that a failed sampling does not give is null)."""
-    if isinstance(value, dict):
-        return {k: _nulls(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_nulls(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: str = "fracid posterior") -> list[str]:
     """Write the posterior in the directory ``out``.
 
@@ -295,7 +284,7 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     """
     out = Path(out)
     written = [result.save_csv(out / "posterior.csv").name]
-    (out / "posterior.json").write_text(json.dumps(_nulls(posterior_dict(result)), indent=1, default=float) + "\n")
+    (out / "posterior.json").write_text(json.dumps(without_nan(posterior_dict(result)), indent=1, default=float) + "\n")
     written.append("posterior.json")
     skipped = []
     try:
