@@ -3,6 +3,8 @@ run by tests/test_hostile_inputs.py."""
 
 from __future__ import annotations
 
+import csv
+
 from hostile import IDENTIFY, OUT, REACHES_OUTPUT, _clean, _out_is_file, case, check, write_csv
 
 #: [identify] of the bar's gradient-damage model with kappa_i identified too
@@ -32,6 +34,10 @@ def _verdict_has_warnings(proc, d):
     verdict = _clean((d / "out" / "verdict.txt").read_text(), d)
     assert "Warning: the misfit is" in verdict and "times the data's std" in verdict, verdict
     assert "Warning: estimate at a bound" in verdict, verdict
+    with open(d / "out" / "population.csv", newline="") as handle:  # each KNN run's objective and status
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["c", "beta", "f", "status", "error"] and len(rows) == 1 + 8, rows
+    assert all(r[3] == "ok" and float(r[2]) >= 0 for r in rows[1:]), rows
 
 
 def _study_posterior_failed(proc, d):

@@ -354,3 +354,28 @@ def test_undecodable_records_in_the_run_store(batch, tmp_path):
     with contextlib.closing(sqlite3.connect(work / "out" / "runs.sqlite")) as conn, conn:
         conn.execute("UPDATE runs SET record = x'00ff7b'")
     check(run_fracid(IDENTIFY, work), work, 4, ["runs.sqlite", "cannot be decoded", "move it away"])
+
+
+READ_ONLY = """\
+set -u
+mount -t tmpfs -o size=16m tmpfs disk
+"$@" 2>/dev/null; echo "first exit $?" >&2
+mount -o remount,ro disk
+"$@"; echo "second exit $?" >&2
+"""
+
+
+@pytest.mark.skipif(not _private_mounts(), reason="no private tmpfs mounts (unshare -Urm) on this machine")
+def test_read_only_file_system(curve, tmp_path):
+    """An output directory whose file system became read-only (a full identification done there before): exit 4
+    naming the read-only file system, not a permission to fix, not a store to move away."""
+    write_csv(tmp_path / "bar.csv", *curve)
+    (tmp_path / "cfg.toml").write_text(bar_config())
+    (tmp_path / "disk").mkdir()
+    (tmp_path / "ro.sh").write_text(READ_ONLY)
+    proc = subprocess.run(["unshare", "-Urm", "bash", "ro.sh", *FRACID, *IDENTIFY[:2], "--out", "disk/out",
+                           "--workers", "1", "--quiet"], cwd=tmp_path, capture_output=True, text=True, timeout=240,
+                          env=ENV)
+    err = _clean(proc.stderr, tmp_path)
+    assert "first exit 0" in err and "second exit 4" in err, err
+    assert "read-only" in err and "Traceback" not in err and "move it away" not in err, err

@@ -197,7 +197,10 @@ def _os_text(err: OSError, out) -> str:
     if err.errno == errno.ENOSPC:
         return (f"the disk is full (writing {name}{_disk(name)}). Free some space and run again: finished runs "
                 "are kept.")
-    if err.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+    if err.errno == errno.EROFS:
+        return (f"the file system holding {name} is read-only{_disk(name)}. Choose an output directory on a "
+                "writable disk (--out DIR); the runs stored there can be copied along with runs.sqlite.")
+    if err.errno in (errno.EACCES, errno.EPERM):
         return f"permission denied: {name}. Choose a directory you can write (--out DIR) or fix the permissions."
     if err.errno in (errno.ENOTDIR, errno.EEXIST) or isinstance(err, (NotADirectoryError, FileExistsError)):
         return f"{name} is a file, not a directory: give another output directory (--out DIR)."

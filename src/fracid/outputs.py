@@ -80,7 +80,8 @@ def claim_outputs(out: Path, command: str, inputs: Iterable[tuple[str, Path]]) -
                 f"{target} exists and was not written by fracid (it is not listed in {out / MANIFEST}); "
                 f"`fracid {command}` would replace it. Give another output directory (--out DIR or [output] "
                 "directory), or move the file away if it may be replaced.")
-    _write_manifest(out, written | set(OUTPUTS[command]))
+    if not set(OUTPUTS[command]) <= written:
+        _write_manifest(out, written | set(OUTPUTS[command]))
 
 
 def read_manifest(out: Path) -> set[str]:
