@@ -32,11 +32,13 @@ def _data_limit_text(n_y: int, what: str) -> str:
 
 
 def _csv_table(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str, columns):
-    """The header and rows of a data file as the reader finds them (:func:`fracid.data.curves.read_table`,
+    """The header and rows of a data file as the reader finds them (:func:`fracid.data.table.read_table`,
     ``columns`` the configured column names); a header that is one cell holding another separator, or a
     first data row with decimal commas read with ``decimal = "."``, is named as such (instead of a missing
     column or a cell that is not a number)."""
-    from fracid.data.curves import DataError, decimal_comma_hint, delimiter_hint, read_table
+    from fracid.data.cells import decimal_comma_hint
+    from fracid.data.errors import DataError
+    from fracid.data.table import delimiter_hint, read_table
 
     try:
         table = read_table(str(path), delimiter, decimal, columns)

@@ -62,6 +62,7 @@ __all__ = [
     "require_positive_force",
 ]
 
+
 @dataclass(frozen=True, eq=False)
 class Curve:
     """One measured (or simulated) curve: force against a strictly increasing control quantity.
@@ -129,7 +130,7 @@ class Curve:
 
 
 def curve_from_arrays(control, force, *, source: str = "arrays", backtrack_tolerance: float | None = None) -> Curve:
-    """Build a :class:`Curve` from arrays, applying the backtracking rule of this module.
+    """Build a :class:`Curve` from arrays, applying the checks of :mod:`fracid.data.checks`.
 
     Parameters
     ----------
@@ -189,7 +190,7 @@ def read_curve_csv(
     ----------
     path : str or path-like
         CSV file; the header is the first line naming the requested columns (lines above it skipped,
-        see the module docstring), else the first line neither blank nor a comment.
+        see :mod:`fracid.data.table`), else the first line neither blank nor a comment.
     control_column : str
         Header name of the control quantity (CMOD, deflection, elongation, ...).
     force_columns : str or sequence of str
@@ -208,7 +209,7 @@ def read_curve_csv(
         Fewest data rows accepted (before and after the backtracking rule), >= 2.
     backtrack_tolerance : float, optional
         Largest backtrack of the control [mm, after scaling] treated as noise; default 1 % of the
-        control range of the file. See the module docstring for the rule.
+        control range of the file. See :mod:`fracid.data.checks` for the rule.
 
     Returns
     -------
@@ -245,7 +246,7 @@ def read_curve_csv(
         raise DataError(f"{path}: {len(table.rows)} data rows, fewer than the {min_points} a curve needs")
     values, lines = parse_table(table, wanted, indices, decimal, delimiter)
     labels = Labels(f"{path} (control {control_column!r})", repr(control_column),
-                     tuple(map(repr, wanted[1:])), "row")
+                    tuple(map(repr, wanted[1:])), "row")
     keep, notes = checked_curve(values[:, 0] * c_scale, values[:, 1:] * f_scale, lines, backtrack_tolerance, labels)
     if keep.sum() < min_points:
         raise DataError(

@@ -27,16 +27,9 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg
 
-from fracid.data.curves import (
-    Curve,
-    DataError,
-    DataTypeError,
-    _numeric_array,
-    _real,
-    _shown,
-    integer_at_least,
-    read_curve_csv,
-)
+from fracid.data.arguments import integer_at_least, numeric_array, real_number, shown
+from fracid.data.curves import Curve, read_curve_csv
+from fracid.data.errors import DataError, DataTypeError
 
 #: default standard-deviation floor, fraction of the peak |y| of a block
 DEFAULT_STD_FLOOR = 0.01
@@ -177,7 +170,7 @@ def sample_points(start: float, stop: float, n: int) -> np.ndarray:
         If n < 2 or not start < stop.
     """
     n = integer_at_least(n, 2, "the number of points")
-    a, b = _real(start, "the start of the control range"), _real(stop, "the end of the control range")
+    a, b = real_number(start, "the start of the control range"), real_number(stop, "the end of the control range")
     if not (math.isfinite(a) and math.isfinite(b) and a < b):
         raise DataError(f"the control range needs finite start < stop, got [{start!r}, {stop!r}] mm")
     return np.linspace(a, b, n)
@@ -195,10 +188,10 @@ def _resolve_points(curves: Sequence[Curve], n_points: int, control_range) -> tu
         how = "the common control range of the curves"
     else:
         try:
-            a, b = (_real(v, "control_range") for v in control_range)
+            a, b = (real_number(v, "control_range") for v in control_range)
         except (TypeError, ValueError):
             raise DataTypeError(f"control_range must be a pair of numbers (start, stop) [mm], got "
-                                f"{_shown(control_range)}") from None
+                                f"{shown(control_range)}") from None
         points = sample_points(a, b, n_points)
         slack = _RANGE_SLACK * (b - a)
         for curve in curves:
@@ -227,7 +220,7 @@ def _curve_notes(curves: Sequence[Curve]) -> list[str]:
 
 
 def _check_floor(std_floor) -> float:
-    value = _real(std_floor, "std_floor")
+    value = real_number(std_floor, "std_floor")
     if not (math.isfinite(value) and value >= 0.0):
         raise DataError(f"std_floor must be a finite fraction >= 0, got {std_floor!r}")
     return value
@@ -268,7 +261,7 @@ def _as_curves(curves) -> list[Curve]:
     if isinstance(curves, Curve):
         curves = [curves]
     if isinstance(curves, (str, bytes)) or not isinstance(curves, Iterable):
-        raise DataTypeError(f"expected a list of Curve objects, got {_shown(curves)}")
+        raise DataTypeError(f"expected a list of Curve objects, got {shown(curves)}")
     curves = list(curves)
     for curve in curves:
         if not isinstance(curve, Curve):
@@ -446,7 +439,7 @@ def with_std(
     curve = _as_curves([curve])[0]
     points, sampling = _resolve_points([curve], n_points, control_range)
     y = _interpolate(curve, points)
-    given = _numeric_array(std, "std")
+    given = numeric_array(std, "std")
     if given.ndim == 0:
         given = np.full(y.shape, float(given))
     if given.shape != y.shape:
@@ -503,7 +496,7 @@ def local_block(values_series, std, name: str = "local", *, points=None) -> Expe
         y = np.array(series.force)
         notes.append(f"{len(y)} local values at their own control points ({series.source})")
     else:
-        sample = _numeric_array(points, "points")
+        sample = numeric_array(points, "points")
         if sample.ndim != 1 or sample.size == 0 or not np.all(np.isfinite(sample)):
             raise DataError("points must be a non-empty one-dimensional array of finite values [mm]")
         c0, c1 = series.control_range
@@ -515,7 +508,7 @@ def local_block(values_series, std, name: str = "local", *, points=None) -> Expe
             )
         y = _interpolate(series, np.clip(sample, c0, c1))
         notes.append(f"{len(y)} local values interpolated linearly at the given points ({series.source})")
-    given = _numeric_array(std, "std")
+    given = numeric_array(std, "std")
     s = np.full(y.shape, float(given)) if given.ndim == 0 else given
     if s.shape != y.shape or not np.all(np.isfinite(s)):
         raise DataError(f"std must be a finite number or have shape ({len(y)},), got {np.shape(std)}")
