@@ -1,5 +1,6 @@
 """Hostile-input cases (Gmsh meshes: disconnected, duplicate nodes, overlapping groups, unreadable formats, size
-and unit plausibility); run by tests/test_hostile_inputs.py. Also the mesh writers of tests/test_mesh_specimen.py.
+and unit plausibility); run by tests/test_hostile_inputs.py. Also the mesh writers and the strip's config of
+tests/test_mesh_specimen.py.
 
 Every case is ``fracid simulate`` of a strip meshed with triangles (groups ``left``, ``right`` and a point
 ``origin``), changed so that the mesh or its groups are what a user may really hand in; each ends while the
@@ -52,11 +53,7 @@ def two_halves(gap=0.0):
 CONFIG = """\
 [model]
 type = "gradient-damage"
-[model.parameters]
-E = 30000.0
-kappa_i = 1e-4
-beta = 300.0
-c = 4.0
+parameters = {{E = 30000.0, kappa_i = 1e-4, beta = 300.0, c = 4.0}}
 
 [specimen]
 type = "mesh"
@@ -75,9 +72,14 @@ target = 0.01
 SUPPORTS = '[{group = "left", component = "x"}, {group = "origin", component = "y"}]'
 
 
+def strip_config(*, scale="", supports=SUPPORTS, load="x") -> str:
+    """The simulation config of the strip in ``strip.msh``, pulled along ``load`` ("x" or "y")."""
+    return CONFIG.format(scale=scale, supports=supports, load=load)
+
+
 def mesh_case(words, mesh, *, scale="", supports=SUPPORTS, load="x", status=2):
     """``fracid simulate`` of the strip config whose ``strip.msh`` is written by ``mesh(path)``."""
-    config = CONFIG.format(scale=scale, supports=supports, load=load)
+    config = strip_config(scale=scale, supports=supports, load=load)
     return case(status, words, config=config, csv=None, args=("simulate", "cfg.toml", "--quiet"),
                 files=lambda d: mesh(d / "strip.msh"))
 

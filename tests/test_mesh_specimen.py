@@ -10,7 +10,7 @@ from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh
 
 meshio = pytest.importorskip("meshio")
 
-from hostile_mesh import H, L, grid, two_halves, write_msh  # noqa: E402 -- the mesh writers of the hostile cases
+from hostile_mesh import H, L, grid, strip_config, two_halves, write_msh  # noqa: E402 -- shared with the hostile cases
 
 T, E = 5.0, 30000.0
 
@@ -148,9 +148,10 @@ def test_files_meshio_cannot_read_say_which_formats_to_export(tmp_path, capsys, 
 
 def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     """The count from the corners and elements is exact for one piece without holes; beyond
-    MAX_UNKNOWNS the mesh is refused before it is built."""
+    MAX_UNKNOWNS the configuration refuses the mesh before it is built."""
     from fracid.config import schema
-    from fracid.specimens.mesh import mesh_unknowns
+    from fracid.config.mesh_section import _check_mesh_size
+    from fracid.specimens.mesh import mesh_size, mesh_unknowns
 
     for triangles in (True, False):
         points, cells = grid(5, 3, triangles)[:2]
@@ -158,9 +159,11 @@ def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
         assert mesh_unknowns(mesh.n_vertices, len(mesh.cells)) == 2 * len(mesh.nodes) + mesh.n_vertices
     monkeypatch.setattr(schema, "MAX_UNKNOWNS", 100)
     path = write_msh(tmp_path / "big.msh", *grid(6, 2, True), "triangle")
+    assert mesh_size(path) == (21, 24)
     with pytest.raises(MeshError, match=r"big.msh: 24 elements and 21 corner nodes make about 151 unknowns .*"
                                         r"at most 100 unknowns are allowed: use a coarser mesh"):
-        read_mesh(path)
+        _check_mesh_size(str(path))
+    assert read_mesh(path).n_vertices == 21  # the limit is the configuration's, not the reader's
 
 
 def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-damage"):
@@ -254,31 +257,7 @@ def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp
     np.testing.assert_allclose(cracks[1].force, cracks[0].force, rtol=0, atol=1e-6 * cracks[0].peak_force)
 
 
-CONFIG = """
-[model]
-type = "gradient-damage"
-[model.parameters]
-E = 30000.0
-kappa_i = 1e-4
-beta = 300.0
-c = 4.0
-
-[specimen]
-type = "mesh"
-file = "strip.msh"
-thickness = 5.0
-supports = [{group = "left", component = "x"}, {group = "origin", component = "y"}]
-loads = [{group = "right", component = "x"}]
-[specimen.controls]
-elongation = [{group = "right", component = "x"}]
-
-[simulate]
-target = 0.01
-stop_force_fraction = 0.5
-
-[output]
-vtk_steps = [3]
-"""
+CONFIG = strip_config() + "stop_force_fraction = 0.5\n\n[output]\nvtk_steps = [3]\n"
 
 
 def test_a_mesh_specimen_runs_from_the_command_line(tmp_path):
@@ -293,7 +272,7 @@ def test_a_mesh_specimen_runs_from_the_command_line(tmp_path):
 @pytest.mark.parametrize("replace, words", [
     ('file = "strip.msh"', ["specimen.file", "file not found"]),
     ('{group = "left", component = "x"}', ["specimen.supports[0].component", "must be one of 'x', 'y'"]),
-    ('loads = [{group = "right", component = "x"}]', ["specimen.file", "no physical group 'top'"]),
+    ('loads = [{group = "right",', ["specimen.file", "no physical group 'top'"]),
     ('elongation = [{group = "right", component = "x"}]', ["specimen.controls.elongation[0].weight", "non-zero"]),
     ('thickness = 5.0', ["specimen.thickness", "must be a number > 0"]),
 ])
@@ -303,7 +282,7 @@ def test_bad_mesh_configs_name_the_key(tmp_path, replace, words):
     write_msh(tmp_path / "strip.msh", *grid(2, 1, True), "triangle")
     broken = {'file = "strip.msh"': 'file = "none.msh"',
               '{group = "left", component = "x"}': '{group = "left", component = "z"}',
-              'loads = [{group = "right", component = "x"}]': 'loads = [{group = "top", component = "x"}]',
+              'loads = [{group = "right",': 'loads = [{group = "top",',
               'elongation = [{group = "right", component = "x"}]': 'elongation = [{group = "right", component = "x", weight = 0}]',
               'thickness = 5.0': 'thickness = -5.0'}[replace]
     (tmp_path / "bad.toml").write_text(CONFIG.replace(replace, broken))

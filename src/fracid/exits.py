@@ -105,7 +105,7 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     """(exit status, message) for an exception that ended a command."""
     config_error = _loaded("fracid.config.schema", "ConfigError")
     data_error = _loaded("fracid.data.errors", "DataError")
-    mesh_error = _loaded("fracid.specimens.mesh", "MeshError")
+    mesh_error = _loaded("fracid.specimens.mesh_reading", "MeshError")
     all_failed = _loaded("fracid.inverse.knn", "AllRunsFailed")
     run_error = _loaded("fracid.inverse.sensitivity", "ForwardRunError")
     no_convergence = _loaded("fracid.fem.path_following", "ConvergenceError")

@@ -27,7 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.config.checker import ConfigError, _Checker
+from fracid.config import schema
+from fracid.config.checker import ConfigError, _bytes, _Checker
 from fracid.config.schema import SpecimenConfig
 
 MESH_TYPE = "mesh"
@@ -160,16 +161,34 @@ def _regions(ck, value) -> tuple:
 
 
 def _check_mesh(ck: _Checker, options: dict) -> None:
-    """Read the mesh and describe the specimen once: a bad mesh or a group it lacks is a config error."""
+    """Count the mesh's unknowns, then read the mesh and describe the specimen once: a bad mesh, one too
+    large or a group it lacks is a config error."""
     from fracid.specimens.mesh import MeshSpecimen
 
     try:
+        _check_mesh_size(options["path"])
         MeshSpecimen(**options).describe()
     except ImportError as err:
         raise ConfigError(f"{ck.path}: specimen.file: {err}") from None
     except ValueError as err:
         text = str(err).removeprefix(f"{options['path']}: ")  # the file is named once
         raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {text}") from None
+
+
+def _check_mesh_size(path: str) -> None:
+    """Raise MeshError, before the mesh is built, when its unknowns exceed :data:`MAX_UNKNOWNS` (the limit
+    of the built-in specimens' meshes)."""
+    from fracid.specimens.mesh import MeshError, mesh_size, mesh_unknowns
+
+    n_vertices, n_cells = mesh_size(path)
+    unknowns = mesh_unknowns(n_vertices, n_cells)
+    if unknowns > schema.MAX_UNKNOWNS:
+        raise MeshError(
+            f"{path}: {n_cells:,} elements and {n_vertices:,} corner nodes make about {unknowns:,} unknowns once "
+            f"fracid adds the mid-edge nodes, needing about {_bytes(unknowns * schema.BYTES_PER_UNKNOWN)} of memory "
+            f"in a forward run ({schema.BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most "
+            f"{schema.MAX_UNKNOWNS:,} unknowns are allowed: use a coarser mesh (small elements only where the crack "
+            "runs; a few elements per internal length l = sqrt(2 c) are enough)")
 
 
 def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) -> None:
