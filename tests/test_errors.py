@@ -100,3 +100,80 @@ def test_snap_back_under_end_displacement_fails_with_partial_result():
     assert result.status.startswith("force below")
     end = result.observables["end_displacement"]
     assert np.any(np.diff(end) < 0)  # the end displacement goes back: snap-back traced
+
+
+BRITTLE = fracid.DamageParameters(E=37000.0, kappa_i=1e-4, beta=10000.0, c=1.0)  # snaps back in a small beam
+
+
+def _snap_back_failure(specimen, params, control):
+    """The ConvergenceError of ``specimen`` under ``control`` and the command's (status, message) for it."""
+    from fracid import exits
+
+    with pytest.raises(fracid.ConvergenceError) as info:
+        fracid.simulate(specimen, params, control=control, stop_force_fraction=0.2)
+    return info.value, exits.describe(info.value)
+
+
+def test_snap_back_under_deflection_is_named_and_cmod_advised():
+    """A brittle beam under deflection control fails past the peak with the force falling steeply: the
+    error says the curve snaps back and names cmod, which then traces the curve to 20 % of the peak."""
+    from fracid import exits
+
+    from fracid.specimens import NotchedBeam
+
+    beam = NotchedBeam(h_fine=4.0, h_coarse=10.0)
+    err, (status, text) = _snap_back_failure(beam, BRITTLE, "deflection")
+    assert err.snap_back and err.control == "deflection" and set(err.functionals) == {"cmod", "deflection"}
+    assert err.partial.force[-1] < err.partial.peak_force  # past the peak
+    assert status == exits.FAILED and "did not converge" in text
+    assert "snaps back under control 'deflection'" in text and 'control = "cmod"' in text
+    assert "weak_zone_elongation" not in text  # only the beam's control is named
+    assert fracid.simulate(beam, BRITTLE, control="cmod", stop_force_fraction=0.2).status.startswith("force below")
+
+
+def test_snap_back_of_a_bar_names_the_weak_zone_elongation():
+    bar = fracid.BarWithWeakZone(length=400.0, n_elements=40)
+    err, (_, text) = _snap_back_failure(bar, fracid.DamageParameters(beta=1000.0), "end_displacement")
+    assert err.snap_back and "snaps back under control 'end_displacement'" in text
+    assert 'control = "weak_zone_elongation"' in text and "cmod" not in text
+
+
+def test_a_failure_without_snap_back_is_not_called_one():
+    """c = 1e12 fails at the first step: no peak, no snap-back diagnosis, the general advice."""
+    err, (_, text) = _snap_back_failure(fracid.BarWithWeakZone(n_elements=40), fracid.DamageParameters(c=1e12),
+                                        "end_displacement")
+    assert not err.snap_back and "snaps back" not in text and "did not converge" in text
+
+
+@pytest.mark.parametrize("force, expected", [
+    ([0.0, 1.0, 2.0, 1.9, 1.0], True),  # past the peak, falling at 9 x the initial stiffness
+    ([0.0, 1.0, 2.0, 1.9, 1.85], False),  # softening at half the initial stiffness
+    ([0.0, 1.0, 2.0, 2.1, 2.2], False),  # still rising
+    ([0.0, 1.0], False),  # too short to tell
+])
+def test_snaps_back_reads_the_slope_past_the_peak(force, expected):
+    from fracid.fem.path_following import snaps_back
+
+    control = [0.0, 1.0, 2.0, 2.1, 2.2][:len(force)]
+    assert snaps_back(force, control) is expected
+
+
+def test_convergence_error_keeps_its_diagnosis_when_pickled():
+    import pickle
+
+    from fracid.fem.path_following import ConvergenceError
+
+    err = pickle.loads(pickle.dumps(ConvergenceError("failed", None, True, "deflection", ("cmod", "deflection"))))
+    assert (str(err), err.snap_back, err.control, err.functionals) == ("failed", True, "deflection",
+                                                                        ("cmod", "deflection"))
+
+
+def test_snap_back_control_of_each_specimen():
+    from fracid.specimens import snap_back_control
+
+    assert snap_back_control("deflection", ("cmod", "deflection")) == "cmod"
+    hinged_dogbone = ("elongation", "platen_displacement", "platen_tilt")
+    assert snap_back_control("platen_displacement", hinged_dogbone) == "elongation"
+    assert snap_back_control("elongation", ("band_opening", "elongation")) == "band_opening"  # the tension strip
+    assert snap_back_control("cmod", ("cmod", "deflection")) is None  # already the one that follows
+    assert snap_back_control("u_top", ("u_top", "opening")) is None  # a mesh of one's own: unknown

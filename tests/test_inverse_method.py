@@ -114,7 +114,8 @@ def test_failed_runs_and_status_of_a_stage_named_by_the_method():
                           y_fit=np.array([1.0, 2.0]), std_exp=np.array([0.1, 0.1]), status="stopped: no step",
                           runs={"grid": 9, "grid_failed": 2, "wall_seconds": 1.0}, stages={"grid": "grid search"})
     assert result.warnings() == ["grid search stopped: no step",
-                                 "failed forward runs: 2 of 9 in the grid search stage (recorded; see report.html)"]
+                                 "failed forward runs: 2 of 9 in the grid search stage (each with its reason, in "
+                                 "the result)"]
     assert result.stage_runs() == {"grid": {"runs": 9, "failed": 2}} and result.forward_runs == 9
 
 

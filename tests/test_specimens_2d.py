@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import fracid
+from fracid import exits
 from fracid.specimens.dogbone import DogBone
 
 # c = 25 mm^2 (internal length 7 mm) is resolved by the dog-bone's 2 mm process-zone elements
@@ -56,6 +57,8 @@ def test_snap_back_traced_by_gauge_elongation_not_by_platen_displacement():
     with pytest.raises(fracid.ConvergenceError) as info:
         fracid.simulate(specimen, params, control="platen_displacement", target=2 * platen.max(), stop_force_fraction=0.2)
     assert info.value.partial.force[-1] > 0.5 * result.peak_force  # it stops near the peak
+    assert info.value.snap_back and info.value.control == "platen_displacement"  # diagnosed as such
+    assert 'control = "elongation"' in exits.describe(info.value)[1]
 
 
 def test_size_effect_nominal_strength_decreases():

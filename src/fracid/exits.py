@@ -184,10 +184,25 @@ def _convergence_text(err) -> str:
     reached = ""
     if partial is not None and getattr(partial, "n_steps", 0):
         reached = f" after {partial.n_steps} steps, at control {float(partial.control[-1]):.6g} mm"
-    return (f"the forward analysis did not converge{reached}: {err}. Try an indirect control that passes "
-            "snap-back (bar: control = \"weak_zone_elongation\"; beam: \"cmod\"; dogbone: \"elongation\"), "
-            "a smaller [simulate] target, or parameter values within the usual ranges (kappa_i ~ 1e-4, c of "
-            "a few mm^2).")
+    text = f"the forward analysis did not converge{reached}: {err}. "
+    if getattr(err, "snap_back", False):
+        return text + _snap_back_advice(err.control, getattr(err, "functionals", ()))
+    return text + ("Try an indirect control that passes snap-back (bar: control = \"weak_zone_elongation\"; beam: "
+                   "\"cmod\"; dogbone: \"elongation\"), a smaller [simulate] target, or parameter values within "
+                   "the usual ranges (kappa_i ~ 1e-4, c of a few mm^2).")
+
+
+def _snap_back_advice(control, functionals) -> str:
+    """What to do when the curve snaps back under ``control``: the specimen's control that follows it."""
+    from fracid.specimens import snap_back_control
+
+    indirect = snap_back_control(control, functionals)
+    what = (f"The curve snaps back under control {control!r} (the force falls faster than the {control} can "
+            f"follow): ")
+    if indirect is not None:
+        return what + f"use an indirect control that follows snap-back: [specimen] control = \"{indirect}\"."
+    return what + ("use a control that grows through the snap-back (an opening across the crack), or parameters "
+                   "that make the specimen less brittle (a larger c, a smaller beta).")
 
 
 def _os_text(err: OSError, out) -> str:

@@ -49,6 +49,9 @@ CREATE TABLE IF NOT EXISTS runs (
 )
 """
 
+# created on the first put_meta only, so that opening an older store changes nothing in it
+_META_SCHEMA = "CREATE TABLE IF NOT EXISTS meta (label TEXT PRIMARY KEY, created REAL, record BLOB)"
+
 
 class NotARunStore(sqlite3.DatabaseError):
     """An SQLite database of another program: fracid does not add its table to it."""
@@ -252,7 +255,8 @@ class RunStore:
     Notes
     -----
     Table ``runs(key TEXT PRIMARY KEY, study TEXT, created REAL, status TEXT, seconds REAL,
-    record BLOB)``, ``record`` being :func:`encode_record` bytes. Many processes may read, one
+    record BLOB)``, ``record`` being :func:`encode_record` bytes; once :meth:`put_meta` was called,
+    also ``meta(label TEXT PRIMARY KEY, created REAL, record BLOB)``. Many processes may read, one
     writes: in a batch the workers compute and the parent stores. Do not share an open store
     across ``fork``; open one per process. Use it from the thread that opened it.
 
@@ -303,7 +307,23 @@ class RunStore:
             (key, str(study), time.time(), str(status), float(seconds), sqlite3.Binary(blob)),
         )
 
+    def put_meta(self, label: str, record: Mapping) -> None:
+        """Store (or replace) a record about the runs, e.g. the provenance of a command's runs under the
+        label ``"provenance:identify"``, in the table ``meta(label, created, record)`` (made here)."""
+        conn = self._writer()
+        conn.execute(_META_SCHEMA)
+        conn.execute("INSERT OR REPLACE INTO meta (label, created, record) VALUES (?, ?, ?)",
+                     (str(label), time.time(), sqlite3.Binary(encode_record(record))))
+
     # -- reading ------------------------------------------------------------------------------
+
+    def get_meta(self, label: str) -> dict | None:
+        """The record stored by :meth:`put_meta` under ``label``; None if none (or a store without ``meta``)."""
+        try:
+            row = self._reader().execute("SELECT record FROM meta WHERE label = ?", (str(label),)).fetchone()
+        except sqlite3.OperationalError:  # no such table: a store older than put_meta
+            return None
+        return None if row is None else _decoded(str(label), row[0])
 
     def get(self, key: str) -> dict | None:
         """The record of ``key``, or None if it is not stored."""

@@ -68,11 +68,50 @@ class PathResult:
 
 
 class ConvergenceError(RuntimeError):
-    """The analysis could not go on even with the smallest step; ``partial`` holds what converged."""
+    """The analysis could not go on even with the smallest step; ``partial`` holds what converged.
 
-    def __init__(self, message: str, partial: PathResult):
+    Attributes
+    ----------
+    partial : PathResult
+        The steps that converged.
+    snap_back : bool
+        The diagnosis of :func:`snaps_back`: the failure came past the peak while the force was falling
+        faster than the control could follow, so the curve snaps back under ``control`` and only a
+        control that grows through the snap-back (an opening across the crack) can trace it.
+    control : str or None
+        The prescribed functional that failed.
+    functionals : tuple of str
+        Every functional of the problem (the controls it could have been run with).
+    """
+
+    def __init__(self, message: str, partial: PathResult, snap_back: bool = False, control: str | None = None,
+                 functionals: tuple = ()):
         super().__init__(message)
-        self.partial = partial
+        self.partial, self.snap_back, self.control, self.functionals = partial, snap_back, control, tuple(functionals)
+
+    def __reduce__(self):  # pickled with its attributes (runs in worker processes)
+        return type(self), (self.args[0], self.partial, self.snap_back, self.control, self.functionals)
+
+
+def snaps_back(force, control) -> bool:
+    """Whether a path that failed was snapping back under its control.
+
+    True past the peak when, over the last converged step, the force fell faster than the initial
+    stiffness: dF/dtau < -F_1 / tau_1 (step 1 is elastic). Softening under a control that can follow
+    it stays far flatter; as the curve turns back, dF/dtau goes to minus infinity.
+
+    Parameters
+    ----------
+    force : ndarray
+        The force [N] at every converged step, step 0 unloaded.
+    control : ndarray
+        The control [mm] at the same steps.
+    """
+    force, control = np.abs(np.asarray(force, dtype=float)), np.asarray(control, dtype=float)
+    if force.size < 3 or not force[-1] < force.max() or control[1] <= 0.0:
+        return False
+    slope = (force[-1] - force[-2]) / (control[-1] - control[-2])
+    return bool(slope < -force[1] / control[1])
 
 
 @dataclass(frozen=True)
@@ -234,11 +273,7 @@ def follow_path(
             step = increment * steps.shrink
             minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or first_step)
             if step < minimum:
-                message = (
-                    f"increment from {control} = {tau:.6g} mm failed at the minimum step {increment:.3g} mm "
-                    f"after {stats.steps} converged steps (peak force {recorder.peak:.6g} N): {err}"
-                )
-                raise ConvergenceError(message, result("failed: " + str(err))) from None
+                raise _failure(control, tau, increment, stats, recorder, err, result("failed: " + str(err))) from None
             continue
         tau += increment
         if derivatives is not None:
@@ -247,7 +282,8 @@ def follow_path(
             except SingularMatrixError as err:
                 message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
                            f"derivatives are not defined there (a bifurcation of the path): {err}")
-                raise ConvergenceError(message, result("failed: singular tangent for the derivatives")) from None
+                raise ConvergenceError(message, result("failed: singular tangent for the derivatives"),
+                                       control=control, functionals=tuple(problem.functionals)) from None
         z, kappa = z_new, arrays.kappa
         stats.steps += 1
         force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
@@ -273,6 +309,16 @@ def follow_path(
         maximum = steps.maximum if steps.maximum is not None else steps.max_factor * base
         step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
     return result(status)
+
+
+def _failure(control, tau, increment, stats, recorder, err, partial) -> ConvergenceError:
+    """The ConvergenceError of an increment that failed at the minimum step, with its snap-back diagnosis."""
+    snap_back = snaps_back(partial.force, partial.control)
+    message = (f"increment from {control} = {tau:.6g} mm failed at the minimum step {increment:.3g} mm "
+               f"after {stats.steps} converged steps (peak force {recorder.peak:.6g} N): {err}")
+    if snap_back:
+        message += "; snap-back: past the peak the force fell faster than the elastic stiffness"
+    return ConvergenceError(message, partial, snap_back, control, tuple(recorder.problem.functionals))
 
 
 class _Recorder:

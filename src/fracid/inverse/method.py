@@ -18,6 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from fracid.inverse.diagnostics import diagnostic_warnings, diagnostics_lines, fit_diagnostics
 from fracid.inverse.kalman import GaussianEstimate
 
 #: RMS fit error [% of the measured peak] above which a fit is reported as poor
@@ -109,6 +110,15 @@ class MethodResult(GaussianEstimate):
         in text (e.g. ``{"knn": "KNN", "kalman": "Kalman filter"}``). The last gave the estimate.
     records : dict of str -> object
         What a stage recorded, by stage name (JSON-serialisable values; the report lists them).
+    control : ndarray or None
+        Control value of every entry of y [mm] (the observations' ``control_points``; None if unknown).
+    control_names : list of str
+        The control quantity of each block (e.g. ``"cmod"``, ``"deflection"``; empty if unknown).
+    quantities : list of str
+        The observed quantity of each block (``"force"``, ``"fpz_width"``, ...; empty if unknown).
+    provenance : dict
+        How the result was obtained (:func:`fracid.provenance.collect`: version, command line,
+        configuration, data files and their SHA-256, specimen, mesh, machine, date); empty if not given.
     """
 
     names: list
@@ -128,6 +138,10 @@ class MethodResult(GaussianEstimate):
     method: str = ""
     stages: dict = field(default_factory=dict)
     records: dict = field(default_factory=dict)
+    control: object = None
+    control_names: list = field(default_factory=list)
+    quantities: list = field(default_factory=list)
+    provenance: dict = field(default_factory=dict)
 
     @property
     def rms_percent(self) -> float:
@@ -173,16 +187,26 @@ class MethodResult(GaussianEstimate):
         return ", ".join(f"{c['failed']} of {c['runs']} in the {self.stages[stage]} stage"
                          for stage, c in self.stage_runs().items())
 
-    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT, poor_fit_std: float = POOR_FIT_STD) -> list[str]:
+    def diagnostics(self, control=None) -> dict:
+        """Elastic slopes, peaks and the worst residual of the fit
+        (:func:`~fracid.inverse.diagnostics.fit_diagnostics`), at ``control`` [mm] or the result's own."""
+        control = self.control if control is None else control
+        return fit_diagnostics(None if control is None else np.asarray(control, float), self.y_exp, self.std_exp,
+                               self.y_fit, self.blocks, self.quantities)
+
+    def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT, poor_fit_std: float = POOR_FIT_STD, *,
+                 control=None) -> list[str]:
         """What a user must know before trusting the result: a non-finite or poor fit (in % of the peak, or
-        in units of the data's std), estimates at a bound, a method that did not converge or stopped,
-        failed forward runs."""
+        in units of the data's std), an elastic slope or a peak off the data's
+        (:mod:`fracid.inverse.diagnostics`, at ``control`` [mm] or the result's own), estimates at a bound,
+        a method that did not converge or stopped, failed forward runs."""
         out = []
         rms = self.rms_percent
         if not np.all(np.isfinite(np.asarray(self.x, float))) or not math.isfinite(rms):
             out.append("the result is not finite: no forward run succeeded at the estimate")
         else:
             out += self._fit_warnings(rms, poor_fit_percent, poor_fit_std)
+            out += diagnostic_warnings(self.diagnostics(control))
         if self.at_bound:
             where = ", ".join(f"{n} = {v:.6g}" for n, v in zip(self.names, self.x) if n in self.at_bound)
             out.append(f"estimate at a bound of [identify.bounds]: {where}; the data pull it outside the bounds "
@@ -190,7 +214,7 @@ class MethodResult(GaussianEstimate):
         if self.status and not self.converged:
             out.append(f"{self.status_label} {self.status}")
         if any(c["failed"] for c in self.stage_runs().values()):
-            out.append(f"failed forward runs: {self.failed_runs_text()} (recorded; see report.html)")
+            out.append(f"failed forward runs: {self.failed_runs_text()} (each with its reason, in the result)")
         return out
 
     def _fit_warnings(self, rms: float, poor_fit_percent: float, poor_fit_std: float) -> list[str]:
@@ -208,14 +232,19 @@ class MethodResult(GaussianEstimate):
         return out
 
     def summary(self) -> str:
+        """The estimates (rounded to two significant digits of their std), the correlation, the status
+        and the fit diagnostics, as printed by ``fracid identify``."""
         units = self.units
         lines = []
         for name, v, s in zip(self.names, self.x, self.std):
             flag = "  (at a bound: the std is not a spread)" if name in self.at_bound else ""
-            lines.append(f"{name:>8} = {v:.6g} +- {s:.3g} {units.get(name, '')}{flag}".rstrip())
+            lines.append(f"{name:>8} = {estimate_text(v, s)} {units.get(name, '')}{flag}".rstrip())
         lines.append("correlation:\n" + np.array2string(self.correlation, precision=3))
         if self.status:
             lines.append(f"{self.status_label}: {self.status}")
+        if np.size(self.y_fit) == np.size(self.y_exp) and np.any(np.isfinite(np.asarray(self.y_fit, float))):
+            lines.append("fit diagnostics:")
+            lines += [f"  {line}" for line in diagnostics_lines(self.diagnostics())]
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -233,6 +262,7 @@ class MethodResult(GaussianEstimate):
         d = {k: plain(getattr(self, k)) for k in self.__dataclass_fields__}
         d["std"], d["correlation"] = self.std.tolist(), self.correlation.tolist()
         d["f_fit"] = float(np.sum(((self.y_exp - self.y_fit) / self.std_exp) ** 2))
+        d["diagnostics"] = plain(self.diagnostics())
         return json.loads(json.dumps(d, allow_nan=True).replace("Infinity", "null"))
 
     def save(self, path) -> Path:
@@ -240,6 +270,40 @@ class MethodResult(GaussianEstimate):
         path = Path(path)
         path.write_text(json.dumps(self.to_dict(), indent=1))
         return path
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "MethodResult":
+        """The result of :meth:`to_dict` (or of a ``result.json`` written by an older fracid: fields it
+        lacks take their defaults). Derived entries (std, correlation, f_fit, diagnostics) are recomputed."""
+        known = {name: value for name, value in d.items() if name in cls.__dataclass_fields__}
+        for name in ("x", "C", "y_exp", "y_fit", "std_exp"):
+            known[name] = np.array([np.nan if v is None else v for v in np.ravel(np.asarray(known[name], object))],
+                                   float).reshape(np.shape(known[name]))
+        if known.get("control") is not None:
+            known["control"] = np.asarray(known["control"], float)
+        known["blocks"] = [tuple(b) for b in known.get("blocks") or []]
+        known["bounds"] = tuple(known.get("bounds") or ())
+        return cls(**known)
+
+    @classmethod
+    def load(cls, path) -> "MethodResult":
+        """Read a result written by :meth:`save` (``result.json``)."""
+        return cls.from_dict(json.loads(Path(path).read_text(encoding="utf-8")))
+
+
+def estimate_text(value: float, std: float) -> str:
+    """``"value +- std"`` with the std rounded to two significant digits and the value to the same
+    decimal place (e.g. ``"21.3 +- 4.2"``, ``"4.79e-05 +- 4.2e-06"``); six significant digits when
+    the std is zero or not finite."""
+    if not (math.isfinite(value) and math.isfinite(std) and std > 0):
+        return f"{value:.6g} +- {std:.3g}"
+    std = float(f"{std:.2g}")
+    place = math.floor(math.log10(std)) - 1  # the decimal place of the std's second digit
+    if value == 0 or 1e-3 <= abs(value) < 1e6:
+        decimals = max(0, -place)
+        return f"{round(value, -place):.{decimals}f} +- {std:.{decimals}f}"
+    digits = max(2, math.floor(math.log10(abs(value))) - place + 1)
+    return f"{value:.{digits - 1}e} +- {std:.1e}"
 
 
 def identification_bounds(operator, space) -> tuple[np.ndarray, np.ndarray]:
@@ -335,8 +399,21 @@ def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> d
     return {"names": list(space.names), "y_exp": np.asarray(y_exp, float),
             "std_exp": np.sqrt(np.diag(np.asarray(C_exp, float))), "blocks": list(blocks), "notes": list(notes),
             "units": dict(operator.units), "bounds": (lower.tolist(), upper.tolist()),
-            "at_bound": at_bounds(space.names, np.asarray(x, float), (lower, upper))}
+            "at_bound": at_bounds(space.names, np.asarray(x, float), (lower, upper)),
+            **observed_fields(operator, np.size(y_exp))}
+
+
+def observed_fields(operator, n: int) -> dict:
+    """``control`` [mm], ``control_names`` and ``quantities`` of a result, from the operator's
+    observations (:class:`~fracid.inverse.forward_operator.Observation`); empty when it has none or
+    they do not hold ``n`` values."""
+    observations = list(getattr(operator, "observations", None) or [])
+    if not observations or sum(np.size(o.control_points) for o in observations) != n:
+        return {}
+    return {"control": np.concatenate([np.asarray(o.control_points, float) for o in observations]),
+            "control_names": [str(o.control or getattr(o.specimen, "default_control", "") or "") for o in observations],
+            "quantities": [str(o.quantity) for o in observations]}
 
 
 __all__ = ["POOR_FIT_PERCENT", "POOR_FIT_STD", "InverseMethod", "MethodResult", "at_bounds", "check_problem",
-           "identification_bounds", "result_fields"]
+           "estimate_text", "identification_bounds", "observed_fields", "result_fields"]

@@ -67,10 +67,30 @@ def parameter_label(name: str) -> str:
 def block_quantity(name: str) -> str:
     """Axis label of the measured quantity of a data block: a width [mm] if its name says so,
     else the force [N]."""
-    lowered = str(name).lower()
-    if "width" in lowered or "fpz" in lowered:
-        return f"{name} [mm]"
-    return "force [N]"
+    from fracid.inverse.diagnostics import is_force_block
+
+    return "force [N]" if is_force_block(name) else f"{name} [mm]"
+
+
+#: how a control quantity is written on an axis (others: underscores as spaces)
+_CONTROL_WORDS = {"cmod": "CMOD"}
+
+
+def control_label(name: str | None) -> str:
+    """Axis label of a control quantity, e.g. ``"CMOD [mm]"``, ``"deflection [mm]"``, ``"end displacement
+    [mm]"``; ``"control [mm]"`` when the name is unknown (None or empty)."""
+    if not name:
+        return "control [mm]"
+    return f"{_CONTROL_WORDS.get(str(name).lower(), str(name).replace('_', ' '))} [mm]"
+
+
+def block_control_labels(result, n_blocks: int, label: str | None = None) -> list[str]:
+    """The x-axis label of every block of a result: ``label`` when given, else from the result's
+    ``control_names`` (one per block), else ``"control [mm]"``."""
+    if label:
+        return [label] * n_blocks
+    names = list(getattr(result, "control_names", None) or [])
+    return [control_label(names[i] if i < len(names) else None) for i in range(n_blocks)]
 
 
 def _float_array(values, fill=np.inf) -> np.ndarray:
@@ -163,30 +183,39 @@ def strongest_pair(result) -> tuple[int, int] | None:
 # ------------------------------------------------------------------------------------ figures
 
 
-def fit_figure(result, control=None) -> Figure:
+def fit_figure(result, control=None, control_label=None) -> Figure:
     """Measured points with their +/- 2 std band and the curve computed at the estimate, per block.
+
+    The computed values are known at the data points only: the computed curve is the line through
+    them (its finite values), not a finer curve.
 
     Parameters
     ----------
     result : IdentificationResult
     control : array_like, optional
         Control value [mm] of every entry of y (e.g. ``ExperimentalData.control``, the blocks
-        concatenated). Without it the x axis is the index of the point in its block.
+        concatenated); the result's ``control`` when omitted. Without either the x axis is the index
+        of the point in its block.
+    control_label : str, optional
+        The x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
     """
     y_exp = _float_array(result.y_exp, np.nan)
     std = _float_array(result.std_exp, np.nan)
     y_fit = _float_array(result.y_fit, np.nan) if result.y_fit is not None else np.full_like(y_exp, np.nan)
-    fig, panels = block_panels(result_blocks(result), None if control is None else _float_array(control, np.nan),
-                               y_exp.size)
-    for ax, name, part, x in panels:
+    control = getattr(result, "control", None) if control is None else control
+    blocks = result_blocks(result)
+    fig, panels = block_panels(blocks, None if control is None else _float_array(control, np.nan), y_exp.size)
+    labels = block_control_labels(result, len(blocks), control_label)
+    for (ax, name, part, x), label in zip(panels, labels):
         y, s, fit = y_exp[part], std[part], y_fit[part]
         sort = np.argsort(x, kind="stable")
         ax.fill_between(x[sort], (y - 2 * s)[sort], (y + 2 * s)[sort], color=_MEASURED, alpha=0.2, lw=0,
                         label="measured +/- 2 std")
         ax.plot(x, y, "o", color=_MEASURED, ms=3.5, label="measured")
-        if np.any(np.isfinite(fit)):
-            ax.plot(x[sort], fit[sort], "-", color=_COMPUTED, lw=1.6, label="computed at the estimate")
-        finish_block_panel(ax, name, control is not None)
+        drawn = sort[np.isfinite(fit[sort])]
+        if drawn.size:
+            ax.plot(x[drawn], fit[drawn], "-", color=_COMPUTED, lw=1.6, label="computed at the estimate")
+        finish_block_panel(ax, name, control is not None, label)
     return fig
 
 
@@ -211,9 +240,10 @@ def block_panels(blocks, control, n_values: int):
     return fig, panels
 
 
-def finish_block_panel(ax, name: str, has_control: bool) -> None:
-    """Axis labels (control or point index, the block's quantity), title, grid and legend of a block's panel."""
-    ax.set_xlabel("control [mm]" if has_control else "point index in the block [-]")
+def finish_block_panel(ax, name: str, has_control: bool, control_label: str = "control [mm]") -> None:
+    """Axis labels (``control_label`` or the point index, the block's quantity), title, grid and legend
+    of a block's panel."""
+    ax.set_xlabel(control_label if has_control else "point index in the block [-]")
     ax.set_ylabel(block_quantity(name))
     ax.set_title(name)
     ax.grid(True, alpha=0.3)

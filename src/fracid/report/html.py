@@ -123,6 +123,7 @@ def fit_metrics(result) -> list[dict]:
         ``index_peak_measured``/``index_peak_computed`` (positions in y) and ``f`` (the block's share
         of the objective sum(((y_exp - y_fit) / std_exp)^2)).
     """
+    from fracid.inverse.diagnostics import block_peak
     from fracid.report.figures import _float_array, result_blocks
 
     y_exp = _float_array(result.y_exp, np.nan)
@@ -132,12 +133,12 @@ def fit_metrics(result) -> list[dict]:
     for name, start, stop in result_blocks(result):
         y, fit, s = y_exp[start:stop], y_fit[start:stop], std[start:stop]
         both = np.isfinite(y) & np.isfinite(fit)
-        im = int(np.nanargmax(np.abs(y))) if np.any(np.isfinite(y)) else None
+        im = block_peak(y)
         peak_m = float(y[im]) if im is not None else math.nan
         if both.any():
             residual = fit[both] - y[both]
             rms = float(np.sqrt(np.mean(residual**2)))
-            ic = int(np.nanargmax(np.where(np.isfinite(fit), np.abs(fit), -np.inf)))
+            ic = block_peak(fit)
             peak_c = float(fit[ic])
             f = float(np.sum((residual / s[both]) ** 2))
         else:
@@ -156,7 +157,7 @@ def fit_metrics(result) -> list[dict]:
 # ------------------------------------------------------------------------------------ sections
 
 
-def _parameter_section(result) -> str:
+def _parameter_section(result, control=None) -> str:
     from fracid.report.figures import parameter_units
 
     units = {**parameter_units(), **(getattr(result, "units", None) or {})}
@@ -171,7 +172,7 @@ def _parameter_section(result) -> str:
     table = _table(["parameter", "value", "std", "unit", "std / value [%]"], rows, text_columns=(0, 3))
     text = getattr(result, "status", "") or ("converged" if result.converged else "not converged")
     status = _e(text) if result.converged else f'<span class="warn">{_e(text)}</span>'
-    warnings = result.warnings() if hasattr(result, "warnings") else []
+    warnings = result.warnings(control=control) if hasattr(result, "warnings") else []
     shown = "".join(f'<li><span class="warn">warning</span>: {_e(w)}</li>' for w in warnings)
     rms = getattr(result, "rms_percent", float("nan"))
     return (f"<h2>Identified parameters</h2>\n{table}\n"
@@ -191,7 +192,7 @@ def _correlation_section(result, figures) -> str:
     return f"<h2>Correlation</h2>\n{table}\n{image}"
 
 
-def _fit_section(result, control, figures) -> str:
+def _fit_section(result, control, figures, control_label=None) -> str:
     metrics = fit_metrics(result)
     rows = []
     for m in metrics:
@@ -201,12 +202,41 @@ def _fit_section(result, control, figures) -> str:
                      _num(m["peak_computed"], 5), _num(m["peak_error_percent"], 3), _num(m["f"], 4)])
     table = _table(["block", "unit", "points", "RMS error", "RMS / |measured peak| [%]", "measured peak",
                     "computed peak", "peak error [%]", "objective share f [-]"], rows, text_columns=(0, 1))
-    image = _image(figures.to_png(figures.fit_figure(result, control)), "measured and computed curves",
-                   "Measured points with the +/- 2 std band of the data and the curve computed at the estimate.")
+    image = _image(figures.to_png(figures.fit_figure(result, control, control_label)), "measured and computed curves",
+                   "Measured points with the +/- 2 std band of the data and the curve computed at the estimate "
+                   "(a line through its values at the data points).")
     unit_note = ("RMS error of the computed values over the measured range and peaks in the unit of the block "
                  "(N for forces, mm for widths); peaks are the values of largest magnitude; the objective share is "
                  "sum(((y_exp - y_fit) / std_exp)^2) over the block.")
-    return f"<h2>Fit</h2>\n{image}\n{table}\n<p>{_e(unit_note)}</p>"
+    return f"<h2>Fit</h2>\n{image}\n{table}\n<p>{_e(unit_note)}</p>\n{_diagnostics_fragment(result, control)}"
+
+
+def _diagnostics_fragment(result, control) -> str:
+    """The fit diagnostics (:mod:`fracid.inverse.diagnostics`): elastic slopes and peaks per force block,
+    the worst residual, what they can see."""
+    from fracid.inverse.diagnostics import ELASTIC_FRACTION, fit_diagnostics
+    from fracid.report.figures import _float_array
+
+    control = getattr(result, "control", None) if control is None else control
+    d = fit_diagnostics(None if control is None else _float_array(control, np.nan), _float_array(result.y_exp, np.nan),
+                        _float_array(result.std_exp, np.nan), _float_array(result.y_fit, np.nan),
+                        getattr(result, "blocks", None) or [], getattr(result, "quantities", None) or [])
+    where = "control [mm]" if d["control"] == "mm" else "point index"
+    rows = [[b["block"], b["elastic_points"], _num(b["slope_data"], 4), _num(b["slope_model"], 4),
+             _num(100 * b["slope_ratio"], 3), _num(b["peak_data"], 5), _num(b["control_peak_data"], 4),
+             _num(b["peak_model"], 5), _num(b["control_peak_model"], 4), _num(100 * b["peak_ratio"], 3)]
+            for b in d["blocks"]]
+    table = _table(["force block", "elastic points", "measured slope", "computed slope", "computed / measured [%]",
+                    "measured peak", f"at {where}", "computed peak", f"at {where}", "computed / measured [%]"],
+                   rows, text_columns=(0,)) if rows else ""
+    worst = d["worst"]
+    text = (f"Worst residual: {worst['residual_std']:+.3g} std at point {worst['index']} (block {worst['block']}, "
+            f"{where} {_num(worst['control'], 4)}: computed {_num(worst['computed'], 5)}, measured "
+            f"{_num(worst['measured'], 5)}). " if worst else "")
+    text += (f"Elastic slope: the least-squares line through the measured points of the rising branch up to "
+             f"{100 * ELASTIC_FRACTION:.0f} % of the block's peak, and through the computed values at the same points; "
+             f"slopes in the block's unit per {'mm' if d['control'] == 'mm' else 'point'}. Note: {d['note']}.")
+    return f"<h3>Fit diagnostics</h3>\n{table}\n<p>{_e(text)}</p>"
 
 
 def _kalman_section(result, name, figures) -> str:
@@ -351,7 +381,7 @@ def _notes_section(result, data_notes) -> str:
 
 
 def write_report(path, result, *, control=None, title: str = "fracid identification", data_notes=(),
-                 extra_sections=()) -> Path:
+                 extra_sections=(), control_label=None, provenance=None) -> Path:
     """Write one self-contained HTML report of an identification.
 
     Parameters
@@ -360,13 +390,18 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         The HTML file to write (parent directories are created).
     result : IdentificationResult
     control : array_like, optional
-        Control value [mm] of every measured value (``ExperimentalData.control``); the fit figure
-        uses the point index without it.
+        Control value [mm] of every measured value (``ExperimentalData.control``); the result's
+        ``control`` when omitted; the fit figure uses the point index without either.
     title : str
     data_notes : sequence of str
         Rules applied to the data (e.g. ``ExperimentalData.notes``), listed first in the notes.
     extra_sections : sequence of (str, str)
         (heading, HTML fragment) appended at the end; the heading is escaped, the fragment is not.
+    control_label : str, optional
+        The fit figure's x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
+    provenance : dict, optional
+        How the result was obtained (:func:`fracid.provenance.collect`); the result's ``provenance``
+        when omitted. Shown last, collapsed: "How this was run".
 
     Returns
     -------
@@ -381,16 +416,41 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         f"<h1>{_e(title)}</h1>",
         (f'<p class="meta">Generated {_e(date)} by fracid. Identified parameters: {_e(names)}; '
          f"{np.size(result.y_exp)} measured values.</p>"),
-        _parameter_section(result),
+        _parameter_section(result, control),
         _correlation_section(result, figures),
-        _fit_section(result, control, figures),
+        _fit_section(result, control, figures, control_label),
         *_stage_sections(result, figures),
         _runs_section(result),
         _notes_section(result, data_notes),
     ]
     for heading, fragment in extra_sections:
         body.append(f"<h2>{_e(heading)}</h2>\n{fragment}")
+    body.append(provenance_section(getattr(result, "provenance", None) if provenance is None else provenance))
     return write_document(path, title, body)
+
+
+def provenance_section(provenance) -> str:
+    """A collapsed ``<details>`` "How this was run": version, command, date, machine, data files with
+    their SHA-256, specimen and mesh, parameters, bounds and the configuration (as JSON); empty
+    without a provenance."""
+    import json
+
+    if not provenance:
+        return ""
+    p = dict(provenance)
+    files = _table(["data file", "bytes", "SHA-256"], [[f.get("path", ""), f.get("bytes", ""),
+                                                      f.get("sha256", f.get("error", ""))]
+                                                     for f in p.get("data_files") or []], text_columns=(0, 2))
+    rows = [["fracid", p.get("fracid", "")], ["command", p.get("command", "")], ["date (UTC)", p.get("date", "")]]
+    rows += [[key.replace("_", " "), value] for key, value in (p.get("machine") or {}).items()]
+    parts = [_table(["", ""], rows, text_columns=(0, 1)), files if p.get("data_files") else ""]
+    for key, heading in (("specimen", "Specimen and mesh"), ("parameters", "Model parameters (the fixed ones at "
+                         "their values)"), ("bounds", "Bounds of the identified parameters"), ("config",
+                         "Configuration (as read, defaults filled)")):
+        if p.get(key) is not None:
+            parts.append(f"<h3>{_e(heading)}</h3>\n<pre>{_e(json.dumps(p[key], indent=1))}</pre>")
+    return ('<details class="provenance">\n<summary>How this was run</summary>\n' + "\n".join(x for x in parts if x)
+            + "\n</details>")
 
 
 def generated_now() -> str:

@@ -258,7 +258,8 @@ def posterior_dict(result) -> dict:
     return out
 
 
-def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: str = "fracid posterior") -> list[str]:
+def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: str = "fracid posterior",
+                    provenance=None) -> list[str]:
     """Write the posterior in the directory ``out``.
 
     Files: ``posterior.csv`` (the draws, their weights and log-likelihoods), ``posterior.json``
@@ -276,6 +277,9 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     log_axes : sequence of bool, optional
         Log axes of the corner plot per parameter (``ParameterSpace.log``).
     title : str
+    provenance : dict, optional
+        How the run was made (:func:`fracid.provenance.collect`): in the page, collapsed, and in
+        ``posterior.json`` under ``provenance``.
 
     Returns
     -------
@@ -284,7 +288,8 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     """
     out = Path(out)
     written = [result.save_csv(out / "posterior.csv").name]
-    (out / "posterior.json").write_text(json.dumps(without_nan(posterior_dict(result)), indent=1, default=float) + "\n")
+    saved = {**posterior_dict(result), **({"provenance": provenance} if provenance else {})}
+    (out / "posterior.json").write_text(json.dumps(without_nan(saved), indent=1, default=float) + "\n")
     written.append("posterior.json")
     skipped = []
     try:
@@ -301,7 +306,7 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     for name, png in pngs.items():
         (figures_dir / f"{name}.png").write_bytes(png)
         written.append(f"figures/{name}.png")
-    write_posterior_page(out / "posterior.html", result, pngs, title=title)
+    write_posterior_page(out / "posterior.html", result, pngs, title=title, provenance=provenance)
     return [*written, "posterior.html", *skipped]
 
 
@@ -331,11 +336,11 @@ def statistics_table(result) -> str:
                              ["status", result.status]], text_columns=(0, 1))
 
 
-def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid posterior") -> Path:
+def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid posterior", provenance=None) -> Path:
     """A self-contained HTML page: the Kalman filter's Gaussian estimate beside the posterior per
-    parameter, the sampler's statistics and rounds, and the figures ``pngs`` (``corner`` and
-    ``posterior_predictive`` PNG bytes) embedded."""
-    from fracid.report.html import _e, _image, _num, _table, generated_now, write_document
+    parameter, the sampler's statistics and rounds, the figures ``pngs`` (``corner`` and
+    ``posterior_predictive`` PNG bytes) embedded and, collapsed, how the run was made (``provenance``)."""
+    from fracid.report.html import _e, _image, _num, _table, generated_now, provenance_section, write_document
 
     table, stats = comparison_table(result), statistics_table(result)
     status = _e(result.status) if result.converged else f'<span class="warn">{_e(result.status)}</span>'
@@ -364,5 +369,6 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
                "noise), its median, and the Kalman filter's fit (dashed)."),
         "<h2>Rounds of the sampler</h2>",
         history,
+        provenance_section(provenance),
     ]
     return write_document(path, title, body)

@@ -191,13 +191,18 @@ def study_sections(study, figures: dict, posterior_figures: dict | None = None) 
     return sections
 
 
-def write_study(directory, study, data, *, title="fracid study", truth=None, size_effect=None) -> list:
+def write_study(directory, study, data, *, title="fracid study", truth=None, size_effect=None,
+                provenance=None) -> list:
     """Write the study's JSON/CSV tables, figures (PNG) and HTML report into ``directory``; with a
     posterior, also the files of :func:`~fracid.report.posterior.write_posterior`.
+
+    ``provenance`` (:func:`fracid.provenance.collect`) is shown, collapsed, in the reports; the
+    identification's own when omitted.
 
     Returns the paths written; a note in brackets (a string, not a path) for a posterior file skipped.
     """
     directory = Path(directory)
+    provenance = provenance or getattr(study.identification, "provenance", None)
     study.save(directory)
     figs = study_figures(study, data.control if data is not None else None, truth, size_effect)
     (directory / "figures").mkdir(parents=True, exist_ok=True)
@@ -211,7 +216,7 @@ def write_study(directory, study, data, *, title="fracid study", truth=None, siz
     if getattr(study, "posterior", None) is not None:
         post = study.posterior
         for item in write_posterior(directory, post, data=data, fit=study.identification.y_fit,
-                                    title=f"{title}: posterior"):  # log axes: the posterior's own (its space's)
+                                    title=f"{title}: posterior", provenance=provenance):  # log axes: the posterior's own (its space's)
             if item.startswith("("):
                 notes.append(item)
             else:
@@ -221,5 +226,5 @@ def write_study(directory, study, data, *, title="fracid study", truth=None, siz
     report = write_report(directory / "report.html", study.identification,
                           control=None if data is None else data.control, title=title,
                           data_notes=() if data is None else data.notes,
-                          extra_sections=study_sections(study, figs, pngs))
+                          extra_sections=study_sections(study, figs, pngs), provenance=provenance)
     return written + [report] + notes

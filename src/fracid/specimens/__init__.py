@@ -14,4 +14,29 @@ from fracid.specimens.wedge import WedgeSplitting
 
 SPECIMENS = {"notched-beam": NotchedBeam, "dogbone": DogBone, "bar": BarWithWeakZone, "wedge-splitting": WedgeSplitting}
 
-__all__ = ["BarWithWeakZone", "DogBone", "NotchedBeam", "SPECIMENS", "TensionStrip", "WedgeSplitting"]
+#: the control of each specimen that grows through a snap-back (an opening across the crack)
+SNAP_BACK_CONTROLS = {NotchedBeam: "cmod", BarWithWeakZone: "weak_zone_elongation", DogBone: "elongation",
+                      TensionStrip: "band_opening", WedgeSplitting: "cmod"}
+
+
+def snap_back_control(control: str, functionals) -> str | None:
+    """The control to use instead of ``control`` when the curve snaps back under it, or None.
+
+    Parameters
+    ----------
+    control : str
+        The control the analysis failed under.
+    functionals : iterable of str
+        The functionals of the failed problem: the specimen is the one whose controls are all among
+        them and include ``control`` (None for a specimen of one's own mesh, or when ``control`` is
+        already the one that follows snap-back).
+    """
+    names = set(functionals)
+    for kind, indirect in SNAP_BACK_CONTROLS.items():
+        if control in kind.controls and set(kind.controls) <= names and indirect != control:
+            return indirect
+    return None
+
+
+__all__ = ["BarWithWeakZone", "DogBone", "NotchedBeam", "SNAP_BACK_CONTROLS", "SPECIMENS", "TensionStrip",
+           "WedgeSplitting", "snap_back_control"]

@@ -7,9 +7,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from fracid.specimens.checks import require_positive
+from fracid.specimens.checks import require_positive, resolve_defaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
+
+COARSE_PER_DEPTH = 0.08  # default h_coarse / D: 4 mm at the default D = 50 mm
+FINE_PER_DEPTH = 0.2  # default fine_width / D: 10 mm at D = 50 mm
 
 
 @dataclass(frozen=True)
@@ -33,10 +36,19 @@ class NotchedBeam:
         the deflection mesh-dependent).
     h_fine : float
         Element size in the process zone, a band of ``fine_width`` around the ligament [mm].
-    h_coarse : float
-        Largest element size away from it [mm].
-    fine_width : float
-        Half-width of the refined band around the crack path [mm].
+    h_coarse : float or None
+        Largest element size away from it [mm]; None: ``COARSE_PER_DEPTH`` D = D / 12.5, at least
+        ``h_fine`` (4 mm for the default D = 50 mm).
+    fine_width : float or None
+        Half-width of the refined band around the crack path [mm]; None: ``FINE_PER_DEPTH`` D = D / 5,
+        at least ``notch_width / 2 + 2 h_fine`` and at most ``(span - plate_width) / 4`` (10 mm for
+        the default beam).
+
+    The mesh defaults scale with the depth, so a deeper or longer beam does not get the elements of
+    a 50 mm one: the element size grows from ``h_fine`` away from the band and the notch tip up to
+    ``h_coarse``. They are resolved when the beam is built (the fields then hold the numbers, and a
+    beam built with None has the run key of one built with these numbers);
+    ``dataclasses.replace(beam, depth=...)`` keeps them, ``NotchedBeam(depth=...)`` derives them anew.
 
     Controls: ``cmod`` (default; passes snap-back) and ``deflection`` (plain displacement control
     of the loading plate). Observable of the damage models: ``fpz_width`` [mm].
@@ -50,8 +62,8 @@ class NotchedBeam:
     notch_width: float = 2.0
     plate_width: float = 5.0
     h_fine: float = 1.0
-    h_coarse: float = 4.0
-    fine_width: float = 10.0
+    h_coarse: float | None = None
+    fine_width: float | None = None
 
     default_control = "cmod"
     controls: ClassVar[tuple] = ("cmod", "deflection")
@@ -59,13 +71,24 @@ class NotchedBeam:
 
     def __post_init__(self):
         require_positive(self, ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
-                                "h_fine", "h_coarse", "fine_width"), " [mm]")
+                                "h_fine"), " [mm]")
+        resolve_defaults(self, {"h_coarse": self._default_coarse, "fine_width": self._default_fine_width})
+        require_positive(self, ("h_coarse", "fine_width"), " [mm]")
         if not self.span <= self.length:
             raise ValueError(f"span = {self.span} must not exceed length = {self.length} (S = L: supports at the ends)")
         if not self.notch_depth < self.depth:
             raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
         if not self.notch_width / 2 < self.fine_width < self.span / 2 - self.plate_width / 2:
             raise ValueError(f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
+
+    def _default_coarse(self) -> float:
+        """h_coarse when not given: D / 12.5, at least h_fine [mm]."""
+        return max(self.h_fine, COARSE_PER_DEPTH * self.depth)
+
+    def _default_fine_width(self) -> float:
+        """fine_width when not given: D / 5, within [notch_width / 2 + 2 h_fine, (span - plate_width) / 4] [mm]."""
+        lowest = self.notch_width / 2 + 2.0 * self.h_fine
+        return min(max(FINE_PER_DEPTH * self.depth, lowest), (self.span - self.plate_width) / 4)
 
     @property
     def characteristic_size(self) -> float:

@@ -39,7 +39,7 @@ class DogBone:
     fine_height : float or None
         Half-height of the refined band [mm]; 0.05 D + 5 h_fine if None.
     h_coarse : float or None
-        Largest element height away from the band [mm]; 0.1 D if None.
+        Largest element height away from the band [mm]; 0.1 D if None, at least ``h_fine``.
     notch_radius, notch_width : float
         Notch radius and the width at mid-height, relative to D (0.725 and 0.6).
     platens : {"glued", "hinged"}
@@ -50,6 +50,11 @@ class DogBone:
     hinge_offset : float
         Eccentricity of the hinge from the specimen's axis [mm] (hinged platens only; the nearest
         node of the platen's top edge is used).
+
+    The mesh defaults (None) scale with D: coarse elements of 10 mm and a band of half-height 15 mm
+    for the default D = 100 mm and h_fine = 2 mm. They stay None in the fields (the run key of a
+    specimen built with None is not that of one given the numbers) and follow D through
+    ``dataclasses.replace``.
 
     Controls: ``elongation`` (default; passes snap-back) and ``platen_displacement`` (plain
     displacement control). Observer: ``fpz_width`` [mm], across the mid-height section.
@@ -96,9 +101,14 @@ class DogBone:
 
     def refined(self, factor: float = 2.0, everywhere: bool = False) -> "DogBone":
         """The same specimen with the process-zone elements (or all elements) divided by ``factor``."""
-        coarse = self.h_coarse or 0.1 * self.size
+        coarse = self._h_coarse
         return replace(self, h_fine=self.h_fine / factor, fine_height=self._fine_height,
                        h_coarse=coarse / factor if everywhere else coarse)
+
+    @property
+    def _h_coarse(self) -> float:
+        """h_coarse, or 0.1 D (at least h_fine) if None [mm]."""
+        return self.h_coarse if self.h_coarse is not None else max(self.h_fine, 0.1 * self.size)
 
     @property
     def _fine_height(self) -> float:
@@ -116,7 +126,7 @@ class DogBone:
         """Keypoints and element-size function of the lines in height, the number of elements across
         the half-width, and the number of element rows of a hinged platen (0 if glued)."""
         D, h = self.size, self.h_fine
-        fine, coarse = self._fine_height, self.h_coarse or 0.1 * D
+        fine, coarse = self._fine_height, self._h_coarse
         R = self.notch_radius * D
         end_of_arc = math.sqrt(max(R * R - (0.5 * D - (0.5 * self.notch_width * D + R)) ** 2, 0.0))
         keys = sorted({0.0, self._gauge / 2, min(end_of_arc, 0.75 * D), 0.75 * D})

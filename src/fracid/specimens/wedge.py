@@ -12,10 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.specimens.checks import require_positive
+from fracid.specimens.checks import require_positive, resolve_defaults
 from fracid.specimens.description import Description
 from fracid.specimens.mesh import MeshSpecimen, plane_mesh
 from fracid.specimens.meshing import graded_lines, structured_quad8
+
+COARSE_PER_SIZE = 0.125  # default h_coarse / min(width, height): 25 mm for the default 200 mm cube
 
 
 @dataclass(frozen=True)
@@ -28,25 +30,52 @@ class WedgeSplitting:
     support under the notch. F_sp = F_v / (2 tan(alpha/2)) from the machine's vertical force F_v
     (:meth:`splitting_force`).
 
+    The whole specimen, front view (x = 0 is the notch plane; depths count down from the top face
+    y = H, heights up from the bottom face y = 0; the notch depth includes the groove's)::
+
+                  |<- groove_width ->|
+        +---------+                  +---------+  y = H: the top face
+        |   F_sp <[]    wedge       []> F_sp   |  y = load_height: centre of the loading pieces []
+        |         |                  |         |
+        |         +------+    +------+         |  y = H - groove_depth: the groove's floor
+        |                |    |<- notch_width  |
+        |                |    |                |
+        |                +----+                |  y = H - notch_depth: the notch tip
+        |                  ::                  |
+        |                  :: ligament         |  ligament = H - notch_depth
+        |                  ::                  |
+        +------------------/\\------------------+  y = 0: the bottom face
+                     support (x = 0)
+        |<------------- width B -------------->|
+
+    ``[]`` are the loading pieces on the groove walls x = +-groove_width / 2, each ``load_piece`` high
+    and centred at ``y = load_height``; they must lie on the wall, between ``H - groove_depth`` and H.
+
     Parameters
     ----------
     width, height, thickness : float
-        Whole specimen's width B, height H and thickness t [mm].
+        Whole specimen's width B (across the notch, x), height H (y) and thickness t (out of plane) [mm].
     groove_width, groove_depth : float
-        The groove at the top that holds the wedge and the loading pieces [mm].
+        The groove at the top that holds the wedge and the loading pieces: its full width (centred on
+        the notch) and its depth below the top face [mm].
     notch_depth : float
-        Depth of the groove plus the starter notch from the top [mm]: the ligament is H - notch_depth.
+        Depth of the notch tip below the top face, the groove included (groove_depth + the starter
+        notch below the groove's floor) [mm]: the ligament is H - notch_depth.
     notch_width : float
-        Width of the starter notch [mm].
+        Full width of the starter notch [mm], less than ``groove_width``.
     load_height : float
-        Height of the splitting force's line above the bottom [mm] (on the groove walls).
+        Height of the splitting force's line above the bottom face [mm] (on the groove walls).
     load_piece : float
         Height of the loading piece on the groove wall [mm]: the forces are spread over it (the piece
         turns with the half, as on its roller; a rigid tie would keep it upright).
     wedge_angle : float
         Full angle of the wedge [degrees].
-    h_fine, h_coarse : float
-        Element sizes along the ligament and far from it [mm].
+    h_fine : float
+        Element size along the ligament [mm]; the size grows away from it (slope 0.3) up to ``h_coarse``.
+    h_coarse : float or None
+        Largest element size [mm]; None: min(B, H) / 8, at least ``h_fine`` (25 mm for the default
+        200 mm cube). Resolved when the specimen is built (the field then holds the number, and the
+        run key is that of a specimen given it); ``dataclasses.replace`` keeps it.
 
     Controls: ``cmod`` (the opening at the load line, twice the mean u_x of the loading piece; the default) [mm].
     Observable: ``fpz_width`` across the ligament (damage models).
@@ -63,7 +92,7 @@ class WedgeSplitting:
     load_piece: float = 10.0
     wedge_angle: float = 15.0
     h_fine: float = 5.0
-    h_coarse: float = 25.0
+    h_coarse: float | None = None
 
     default_control = "cmod"
     controls = ("cmod",)
@@ -71,8 +100,9 @@ class WedgeSplitting:
 
     def __post_init__(self):
         require_positive(self, ("width", "height", "thickness", "groove_width", "groove_depth", "notch_depth",
-                                "notch_width", "load_height", "load_piece", "wedge_angle", "h_fine", "h_coarse"),
-                         " [mm]")
+                                "notch_width", "load_height", "load_piece", "wedge_angle", "h_fine"), " [mm]")
+        resolve_defaults(self, {"h_coarse": lambda: max(self.h_fine, COARSE_PER_SIZE * min(self.width, self.height))})
+        require_positive(self, ("h_coarse",), " [mm]")
         if not self.notch_width < self.groove_width < self.width:
             raise ValueError(f"need notch_width = {self.notch_width} < groove_width = {self.groove_width} < "
                              f"width = {self.width}")
