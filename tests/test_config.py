@@ -289,6 +289,27 @@ def test_single_curve_with_relative_std(tmp_path):
     np.testing.assert_allclose(data.std, np.maximum(0.05 * np.abs(data.y), 0.01 * np.abs(data.y).max()))
 
 
+@pytest.mark.parametrize("sampling", [None, "equally-spaced", "measured"])
+def test_sampling_reaches_the_data_and_keeps_the_measured_peak(tmp_path, sampling):
+    text = BEAM if sampling is None else variant("n_points = 40", f'n_points = 40\nsampling = "{sampling}"')
+    cfg = load_config(write(tmp_path, text))
+    assert cfg.experiments[0].sampling == (sampling or "equally-spaced")
+    data = build_data(cfg)
+    assert data.n_y == 40 and data.y.max() == 978.6185 and data.control[np.argmax(data.y)] == 0.01934611
+    measured = sampling == "measured"
+    assert any(("measured points" in note) == measured for note in data.notes if "control points" in note
+               or "measured points" in note)
+
+
+def test_a_bad_sampling_exits_2_naming_the_key(tmp_path, capsys):
+    from fracid import cli, exits
+
+    path = write(tmp_path, variant("n_points = 40", 'n_points = 40\nsampling = "all"'))
+    assert cli.main(["identify", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == exits.INPUT
+    err = capsys.readouterr().err
+    assert "experiments[0].sampling" in err and "'equally-spaced', 'measured'" in err
+
+
 def test_data_errors_are_wrapped(tmp_path):
     text = variant("n_points = 40", "n_points = 40\ncontrol_range = [0.001, 9.0]")
     cfg = load_config(write(tmp_path, text))
@@ -406,6 +427,11 @@ BAD = [
                  ["study.replicates", "1", ">= 2"], id="one-replicate"),
     pytest.param(variant("vtk_steps = []", "vtk_steps = []\n[study]\nprior = 'flat'"), "identify",
                  ["study.prior", "'flat'", "'knn', 'bounds'"], id="unknown-prior"),
+    pytest.param(variant("n_points = 40", 'n_points = 40\nsampling = "measured-points"'), "identify",
+                 ["experiments[0].sampling", "'measured-points'", "'equally-spaced', 'measured'"],
+                 id="unknown-sampling"),
+    pytest.param(variant("n_points = 40", "n_points = 40\nsampling = 1"), "identify",
+                 ["experiments[0].sampling", "1", "must be one of 'equally-spaced', 'measured'"], id="sampling-number"),
 ]
 
 

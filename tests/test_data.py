@@ -529,9 +529,10 @@ def test_gregoire_bundled_data():
     assert data.y.shape == (40,) and data.covariance.shape == (40, 40)
     assert data.blocks == (("gregoire2013_beam4", 0, 40),)
     assert data.control[0] == pytest.approx(2e-5) and data.control[-1] == pytest.approx(0.2031462)
-    # the sampled peak: 40 points 0.0052 mm apart miss the raw peak (978.6 N at 0.0193 mm) slightly
+    # the sampled peak is the raw peak (978.6185 N at 0.01934611 mm): the grid point nearest it moved onto it
     i = int(np.argmax(data.y))
-    assert abs(data.control[i] - 0.0193) < 0.0052 and data.y[i] == pytest.approx(979.0, rel=0.03)
+    assert data.control[i] == 0.01934611 and data.y[i] == 978.6185
+    assert np.count_nonzero(data.control != np.linspace(2e-5, 0.2031462, 40)) == 1
     assert any("s = (max - min)/4 from the min/max envelope" in note for note in data.notes)
     assert any("1 backtracking point dropped" in note and "row 3" in note for note in data.notes)
     assert np.all(data.std > 0)

@@ -102,7 +102,7 @@ def test_estimates_stay_inside_the_bounds_and_are_flagged(groups):
     assert np.all(asked >= lower - reach) and np.all(asked <= upper + reach)
     assert np.all(result.x >= lower) and np.all(result.x <= upper)
     assert result.at_bound.tolist() == [False, True, False] and result.x[1] == lower[1]
-    assert not result.failed and result.status in ("converged",) or result.status.startswith("not converged")
+    assert not result.failed and result.status.startswith(("converged", "not converged"))
     for entry in result.history:
         assert np.all(entry["x"] >= lower) and np.all(entry["x"] <= upper)
 

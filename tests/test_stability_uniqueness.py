@@ -117,3 +117,30 @@ def test_valley_figure_places_multi_start_ends_in_each_pairs_columns():
     for ax, (i, j) in zip(fig.axes[:3], [(0, 1), (0, 2), (1, 2)]):  # the pair axes come before the colour bars
         [line] = [ln for ln in ax.get_lines() if ln.get_label() == "multi-start ends"]
         np.testing.assert_allclose(np.column_stack(line.get_data()), ends[:, [i, j]])
+
+
+def test_study_valley_is_centred_on_the_estimate():
+    """A twin (bar, noisy data): the objective maps and the valley are measured from the identification's
+    estimate and its objective, not from the best population point (which fits worse)."""
+    from fracid.data import ExperimentalData
+    from fracid.inverse.knn import objective
+    from fracid.inverse.study import StudySettings, run_study
+
+    operator = _bar_operator([100.0])
+    y = operator(TRUTH).y
+    std = 0.01 * np.abs(y).max()
+    y = y + np.random.default_rng(3).normal(scale=std, size=y.size)
+    data = ExperimentalData(control=np.linspace(0.004, 0.04, 10), y=y, covariance=np.eye(y.size) * std**2,
+                            blocks=[("global", 0, y.size)])
+    study = run_study(operator, data, SPACE, StudySettings().replace(starts=0, replicates=0, n=16, k=3))
+    ident, [m] = study.identification, study.maps
+    f_estimate = objective(y, data.covariance, ident.y_fit)[0]
+    population = np.asarray(ident.knn["f"], float)
+    population = population[np.isfinite(population)]
+    assert m.centred and np.array_equal(m.points[0], ident.x) and m.f[0] == pytest.approx(f_estimate)
+    np.testing.assert_array_equal(m.f[1:], population)
+    assert f_estimate < population.min() - valley_level(2)  # the fit is better than any population point
+    assert m.valley[0] and np.all(m.f[m.valley] - f_estimate <= m.level)
+    assert not np.any(m.valley[1:])  # no population point within the chi^2 level of the estimate ...
+    assert np.sum(population - population.min() <= m.level) >= 1  # ... which the best point's level circled
+    np.testing.assert_array_equal(study.valley_extent, np.zeros(2))  # the valley is the estimate alone

@@ -59,14 +59,14 @@ def _experiment_data(cfg: Config, exp: ExperimentConfig):
     if exp.quantity == "force":
         require_positive_force(curves)
     _check_control_scale(cfg, exp, max(float(np.max(curve.control)) for curve in curves))
-    span = exp.control_range_mm
+    span, sampling = exp.control_range_mm, {"sampling": exp.sampling}
     if exp.kind == "repeats":
-        return from_repeats(curves, exp.n_points, span, name=exp.name)
+        return from_repeats(curves, exp.n_points, span, name=exp.name, **sampling)
     if exp.kind == "envelope":
-        return from_envelope(*curves, exp.n_points, span, name=exp.name)
+        return from_envelope(*curves, exp.n_points, span, name=exp.name, **sampling)
     if exp.std is not None:
-        return with_std(curves[0], exp.std * exp.force_scale, exp.n_points, span, name=exp.name)
-    return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True)
+        return with_std(curves[0], exp.std * exp.force_scale, exp.n_points, span, name=exp.name, **sampling)
+    return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True, **sampling)
 
 
 def _stacked_data(cfg: Config, experiments):

@@ -23,6 +23,7 @@ from fracid.config.schema import (
     SpecimenConfig,
 )
 from fracid.config.sections import _check_specimen, _check_specimen_size, _specimen_options
+from fracid.data.experimental import SAMPLINGS
 
 
 def _data_limit_text(n_y: int, what: str) -> str:
@@ -91,6 +92,7 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
     n_points = ck.integer(f"{prefix}.n_points", required("n_points"), "must be an integer >= 3", lambda v: v >= 3)
     if n_points > MAX_DATA_VALUES:
         ck.fail(f"{prefix}.n_points", n_points, _data_limit_text(n_points, "this block alone has"))
+    sampling = ck.choice(f"{prefix}.sampling", raw.get("sampling", SAMPLINGS[0]), SAMPLINGS)
 
     delimiter = raw.get("delimiter", ",")
     if not isinstance(delimiter, str) or delimiter not in _DELIMITERS:
@@ -179,7 +181,7 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
                             force_unit=force_unit, kind=kind, n_points=n_points, control_range=control_range,
                             quantity=quantity, name=name, specimen=overrides, weight=weight,
                             damage_threshold=threshold, role=role, delimiter=delimiter, decimal=decimal,
-                            backtrack_tolerance=backtrack, negate=negate, **options)
+                            backtrack_tolerance=backtrack, negate=negate, sampling=sampling, **options)
 
 
 _REQUIRED_TEXT = {

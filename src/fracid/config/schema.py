@@ -57,7 +57,12 @@ present they are always validated. Every other key is optional unless marked *re
     mean_column = "load_mean_N"
     lower_column = "load_min_N"
     upper_column = "load_max_N"
-    n_points = 40                       # required: integer >= 3, equally spaced control values
+    n_points = 40                       # required: integer >= 3, the number of data values
+    sampling = "equally-spaced"         # "equally-spaced" (default): n_points equally spaced control
+                                        #   values, the one nearest the measured peak moved onto it (the
+                                        #   data keep the peak) | "measured": the measured points
+                                        #   themselves, all if there are at most n_points, else n_points of
+                                        #   them by arc length along the normalised curve (ends, peak kept)
     # negate = ["control", "force"]    # columns a machine records with a negative sign, multiplied by -1
     control_range = [0.001, 0.2]        # optional [start, stop], 0 < start < stop, in control_unit;
                                         #   default: the range common to the columns
@@ -164,7 +169,7 @@ _MODEL_KEYS = ("type", "parameters")
 _EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                     "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
                     "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
-                    "backtrack_tolerance", "negate")
+                    "backtrack_tolerance", "negate", "sampling")
 _KIND_KEYS = {
     "repeats": ("force_columns",),
     "envelope": ("mean_column", "lower_column", "upper_column"),
@@ -267,6 +272,7 @@ class ExperimentConfig:
     decimal: str = "."
     backtrack_tolerance: float | None = None  # in control_unit, as given; None: 1 % of the control range
     negate: tuple = ()  # of "control", "force": columns the machine records with a negative sign
+    sampling: str = "equally-spaced"  # or "measured" (fracid.data.experimental.SAMPLINGS)
 
     def sign(self, column: str) -> float:
         """-1 if the ``column`` ("control" or "force") is to be negated, else 1."""

@@ -1,7 +1,9 @@
 """The measured vector y_exp and its covariance C_exp, built from curves by documented rules.
 
 y_exp holds forces [N] at n_y equally spaced values of the control quantity [mm] (the thesis's choice,
-docs/theory.md, section 3.1), optionally followed by local data (e.g. FPZ width [mm]). Its covariance is diagonal per
+docs/theory.md, section 3.1; the one nearest the measured peak is moved onto it, so the data keep the
+peak), or at the measured points themselves (``sampling="measured"``), optionally followed by local data
+(e.g. FPZ width [mm]). Its covariance is diagonal per
 block, from the scatter of repeated tests, from a min/max envelope, or from a standard deviation
 the user gives; several blocks (specimens, local data) are stacked block-diagonally.
 
@@ -176,38 +178,121 @@ def sample_points(start: float, stop: float, n: int) -> np.ndarray:
     return np.linspace(a, b, n)
 
 
-def _resolve_points(curves: Sequence[Curve], n_points: int, control_range) -> tuple[np.ndarray, str]:
-    """Sampling points inside every curve and a note saying where they come from (never extrapolate)."""
+#: the ``sampling`` values: equally spaced control values (the measured peak kept), or the measured points
+SAMPLINGS = ("equally-spaced", "measured")
+
+
+def _control_range(curves: Sequence[Curve], control_range) -> tuple[float, float, str]:
+    """(start, stop, how): the sampled range inside every curve (never extrapolate)."""
     lo = max(curve.control[0] for curve in curves)
     hi = min(curve.control[-1] for curve in curves)
     if control_range is None:
         if not lo < hi:
             ranges = "; ".join(f"{c.source}: [{c.control[0]:g}, {c.control[-1]:g}] mm" for c in curves)
             raise DataError(f"the curves share no control range ({ranges})")
-        points = sample_points(lo, hi, n_points)
-        how = "the common control range of the curves"
-    else:
-        try:
-            a, b = (real_number(v, "control_range") for v in control_range)
-        except (TypeError, ValueError):
-            raise DataTypeError(f"control_range must be a pair of numbers (start, stop) [mm], got "
-                                f"{shown(control_range)}") from None
-        points = sample_points(a, b, n_points)
-        slack = _RANGE_SLACK * (b - a)
-        for curve in curves:
-            c0, c1 = curve.control_range
-            if a < c0 - slack or b > c1 + slack:
-                raise DataError(
-                    f"the requested control range [{a:g}, {b:g}] mm exceeds the data of {curve.source} "
-                    f"([{c0:g}, {c1:g}] mm); data are never extrapolated"
-                )
-        points = np.clip(points, lo, hi)
-        how = "the requested control range"
-    note = (
+        return lo, hi, "the common control range of the curves"
+    try:
+        a, b = (real_number(v, "control_range") for v in control_range)
+    except (TypeError, ValueError):
+        raise DataTypeError(f"control_range must be a pair of numbers (start, stop) [mm], got "
+                            f"{shown(control_range)}") from None
+    sample_points(a, b, 2)  # finite start < stop
+    slack = _RANGE_SLACK * (b - a)
+    for curve in curves:
+        c0, c1 = curve.control_range
+        if a < c0 - slack or b > c1 + slack:
+            raise DataError(
+                f"the requested control range [{a:g}, {b:g}] mm exceeds the data of {curve.source} "
+                f"([{c0:g}, {c1:g}] mm); data are never extrapolated"
+            )
+    return max(a, lo), min(b, hi), "the requested control range"
+
+
+def _measured_curve(curves: Sequence[Curve], a: float, b: float, ends: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The measured control values of ``curves`` in [a, b] (and a, b themselves if ``ends``) and the mean of
+    the curves there: piecewise linear between these knots, so its peak is at one of them."""
+    knots = np.unique(np.concatenate([c.control[(c.control >= a) & (c.control <= b)] for c in curves]
+                                     + ([np.array([a, b])] if ends else [])))
+    return knots, np.mean([_interpolate(curve, knots) for curve in curves], axis=0)
+
+
+def _with_peak(points: np.ndarray, peak: float) -> np.ndarray:
+    """``points`` with the interior point nearest ``peak`` moved onto it (the count and the order kept)."""
+    if np.any(points == peak) or points.size < 3:
+        return points
+    i = int(np.clip(np.argmin(np.abs(points - peak)), 1, points.size - 2))
+    out = points.copy()
+    out[i] = peak
+    return out
+
+
+def decimate(control, y, n: int, keep: int) -> np.ndarray:
+    """Indices of n of the points (control, y), chosen by arc length along the curve normalised by its
+    ranges (more points where it bends or changes fast), the first, the last and ``keep`` among them.
+
+    All the indices when there are no more than n points.
+    """
+    control, y = np.asarray(control, float), np.asarray(y, float)
+    if control.size <= n:
+        return np.arange(control.size)
+    u = (control - control[0]) / (control[-1] - control[0])
+    v = y / max(float(np.max(np.abs(y))), np.finfo(float).tiny)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(u), np.diff(v)))])
+    must = sorted({0, control.size - 1, int(keep)})
+    targets = list(np.linspace(0.0, s[-1], n))
+    for i in must:  # each kept point takes the place of the target nearest to it
+        targets.pop(int(np.argmin(np.abs(np.array(targets) - s[i]))))
+    taken = set(must)
+    for t in targets:
+        taken.add(_nearest_free(s, t, taken))
+    return np.array(sorted(taken))
+
+
+def _nearest_free(s: np.ndarray, target: float, taken: set) -> int:
+    """The index of s (increasing) nearest ``target`` that is not taken."""
+    hi = int(np.searchsorted(s, target))
+    lo = hi - 1
+    while lo >= 0 and lo in taken:
+        lo -= 1
+    while hi < s.size and hi in taken:
+        hi += 1
+    if hi >= s.size or (lo >= 0 and target - s[lo] <= s[hi] - target):
+        return lo
+    return hi
+
+
+def _resolve_points(curves: Sequence[Curve], n_points: int, control_range, sampling: str = "equally-spaced",
+                    reference: Sequence[Curve] | None = None) -> tuple[np.ndarray, str]:
+    """Sampling points inside every curve and a note saying where they come from (never extrapolate).
+
+    ``reference``: the curves whose mean is the measured curve (default all): its peak is always a
+    sampling point, so the data keep the measured peak exactly.
+    """
+    if sampling not in SAMPLINGS:
+        raise DataError(f"sampling = {sampling!r}; choose " + " or ".join(map(repr, SAMPLINGS)))
+    a, b, how = _control_range(curves, control_range)
+    n = integer_at_least(n_points, 2, "the number of points")
+    measured = sampling == "measured"
+    knots, values = _measured_curve(reference or curves, a, b, ends=not measured)
+    if knots.size < 2:
+        raise DataError(f"sampling = 'measured': fewer than 2 measured points in [{a:g}, {b:g}] mm")
+    peak = int(np.argmax(np.abs(values)))
+    if measured:
+        kept = decimate(knots, values, n, peak)
+        points = knots[kept]
+        chosen = (f"all the {knots.size} measured points" if kept.size == knots.size else
+                  f"{kept.size} of the {knots.size} measured points, chosen by arc length along the normalised "
+                  "curve (the ends and the peak kept)")
+        return points, (f"{chosen} from {points[0]:.6g} to {points[-1]:.6g} mm ({how}); no interpolation of the "
+                        "mean curve")
+    grid = sample_points(a, b, n)
+    points = _with_peak(grid, knots[peak])
+    moved = "is one of them" if np.array_equal(points, grid) else "replaces the nearest of them"
+    return points, (
         f"{len(points)} equally spaced control points from {points[0]:.6g} to {points[-1]:.6g} mm "
-        f"(step {points[1] - points[0]:.6g} mm, {how}); curves interpolated linearly, never extrapolated"
+        f"(step {(b - a) / (n - 1):.6g} mm, {how}); the measured peak ({knots[peak]:.6g} mm, |y| = "
+        f"{abs(values[peak]):.6g}) {moved}; curves interpolated linearly, never extrapolated"
     )
-    return points, note
 
 
 def _interpolate(curve: Curve, points: np.ndarray) -> np.ndarray:
@@ -279,8 +364,9 @@ def from_repeats(
     name: str = "global",
     *,
     std_floor: float = DEFAULT_STD_FLOOR,
+    sampling: str = "equally-spaced",
 ) -> ExperimentalData:
-    """y_exp and C_exp from repeated tests: mean and sample variance at equally spaced points.
+    """y_exp and C_exp from repeated tests: mean and sample variance at the sampling points.
 
     Parameters
     ----------
@@ -294,6 +380,8 @@ def from_repeats(
         Block name.
     std_floor : float
         Floor on the standard deviation as a fraction of the peak |mean| (see module docstring).
+    sampling : {"equally-spaced", "measured"}
+        See :func:`with_std`; the measured points are those of all the repeats (the knots of their mean).
 
     Returns
     -------
@@ -312,7 +400,7 @@ def from_repeats(
             f"from_repeats needs at least 2 curves to estimate a covariance, got {len(curves)}; "
             "a covariance needs repeats, or a min/max envelope (from_envelope), or an explicit std (with_std)"
         )
-    points, sampling = _resolve_points(curves, n_points, control_range)
+    points, sampling = _resolve_points(curves, n_points, control_range, sampling)
     forces = np.array([_interpolate(curve, points) for curve in curves])
     y = forces.mean(axis=0)
     s = forces.std(axis=0, ddof=1)
@@ -348,6 +436,7 @@ def from_envelope(
     name: str = "global",
     *,
     std_floor: float = DEFAULT_STD_FLOOR,
+    sampling: str = "equally-spaced",
 ) -> ExperimentalData:
     """y_exp and C_exp from a mean curve and its min/max envelope.
 
@@ -366,6 +455,8 @@ def from_envelope(
         Block name.
     std_floor : float
         Floor on s as a fraction of the peak |mean| (see module docstring).
+    sampling : {"equally-spaced", "measured"}
+        See :func:`with_std`; the measured points and the peak are the mean curve's.
 
     Returns
     -------
@@ -379,7 +470,7 @@ def from_envelope(
     """
     divisor = _envelope_divisor(rule)
     curves = _as_curves([mean_curve, lower_curve, upper_curve])
-    points, sampling = _resolve_points(curves, n_points, control_range)
+    points, sampling = _resolve_points(curves, n_points, control_range, sampling, reference=curves[:1])
     y, lower, upper = (_interpolate(curve, points) for curve in curves)
     width = upper - lower
     crossing = np.flatnonzero(width < -1e-12 * np.max(np.abs(y)))
@@ -411,6 +502,7 @@ def with_std(
     *,
     relative: bool = False,
     std_floor: float = DEFAULT_STD_FLOOR,
+    sampling: str = "equally-spaced",
 ) -> ExperimentalData:
     """y_exp from a single curve with a standard deviation given by the user.
 
@@ -430,6 +522,11 @@ def with_std(
         Read ``std`` as a fraction of |y| per point; the floor then applies (|y| may vanish).
     std_floor : float
         Floor on s as a fraction of the peak |y|, relative std only.
+    sampling : {"equally-spaced", "measured"}
+        ``"equally-spaced"`` (default): n_points equally spaced control values, the one nearest the
+        measured peak moved onto it (the data keep the peak exactly). ``"measured"``: the measured points
+        themselves, all of them when there are no more than n_points, else n_points of them chosen by arc
+        length along the normalised curve, the ends and the peak kept (:func:`decimate`).
 
     Returns
     -------
@@ -437,7 +534,7 @@ def with_std(
         y = the curve at the points [N], covariance = diag(s^2).
     """
     curve = _as_curves([curve])[0]
-    points, sampling = _resolve_points([curve], n_points, control_range)
+    points, sampling = _resolve_points([curve], n_points, control_range, sampling)
     y = _interpolate(curve, points)
     given = numeric_array(std, "std")
     if given.ndim == 0:
@@ -587,7 +684,8 @@ def gregoire2013_beam4_path() -> Path:
     return path
 
 
-def gregoire2013_beam4(n_points: int = 40, control_range: tuple[float, float] | None = None) -> ExperimentalData:
+def gregoire2013_beam4(n_points: int = 40, control_range: tuple[float, float] | None = None,
+                       sampling: str = "equally-spaced") -> ExperimentalData:
     """The bundled real test of Gregoire, Rojas-Solano & Pijaudier-Cabot (2013) as y_exp.
 
     Notched three-point bending beam, D = 50 mm; control CMOD [mm], force = load [N]. Built with
@@ -596,9 +694,11 @@ def gregoire2013_beam4(n_points: int = 40, control_range: tuple[float, float] | 
     Parameters
     ----------
     n_points : int
-        Number of equally spaced CMOD values.
+        Number of CMOD values (equally spaced, the measured peak kept, by default).
     control_range : (float, float), optional
         CMOD range [mm]; default the whole recorded range.
+    sampling : {"equally-spaced", "measured"}
+        See :func:`with_std`.
 
     Returns
     -------
@@ -610,4 +710,5 @@ def gregoire2013_beam4(n_points: int = 40, control_range: tuple[float, float] | 
         control_column="cmod_mm",
         force_columns=["load_mean_N", "load_min_N", "load_max_N"],
     )
-    return from_envelope(mean, lower, upper, n_points, control_range, rule="range/4", name="gregoire2013_beam4")
+    return from_envelope(mean, lower, upper, n_points, control_range, rule="range/4", name="gregoire2013_beam4",
+                         sampling=sampling)

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from fracid.inverse.kalman_status import GaussianEstimate, KalmanResult, judge_last_pass, relaxed  # noqa: F401
 from fracid.inverse.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
 
 
@@ -37,62 +36,6 @@ def kalman_update(x, C, S, innovation, R):
     I_KS = np.eye(x.size) - K @ S
     C_new = I_KS @ C @ I_KS.T + K @ R @ K.T
     return x + K @ innovation, 0.5 * (C_new + C_new.T), K
-
-
-class GaussianEstimate:
-    """Mixin of the results that hold an estimate's covariance ``C``: its standard deviations and
-    correlation matrix."""
-
-    @property
-    def std(self) -> np.ndarray:
-        return np.sqrt(np.diag(self.C))
-
-    @property
-    def correlation(self) -> np.ndarray:
-        return self.C / np.outer(self.std, self.std)
-
-
-@dataclass
-class KalmanResult(GaussianEstimate):
-    """Estimates of a Kalman-filter identification.
-
-    Attributes
-    ----------
-    x, C : ndarray
-        Final estimate and covariance.
-    history : list of dict
-        Per global iteration and step: ``{"iteration", "step", "observations", "x", "C"}``.
-    iterations : int
-        Global iterations done; ``converged`` says whether the estimate stopped changing.
-    y : ndarray
-        Computed observations at the final estimate (NaN where the run at it failed).
-    runs : int
-        Forward runs asked for; ``run_equivalents`` weights each by the share of the curve it computed.
-    status : str
-        ``"converged"``, ``"not converged: ..."`` or ``"stopped: ..."`` (forward runs failed at and
-        around the filter's point, or the objective no longer decreased along the step).
-    failures : list of dict
-        Failed forward runs at points the filter wanted: ``{"iteration", "step", "x", "error"}``.
-    at_bound : ndarray of bool
-        Parameters whose estimate lies on a bound of the box (see :func:`kalman_filter`, Notes).
-    """
-
-    x: np.ndarray
-    C: np.ndarray
-    history: list = field(default_factory=list)
-    iterations: int = 0
-    converged: bool = False
-    y: np.ndarray | None = None
-    runs: int = 0
-    run_equivalents: float = 0.0
-    status: str = ""
-    failures: list = field(default_factory=list)
-    at_bound: np.ndarray | None = None
-
-    @property
-    def failed(self) -> bool:
-        """No forward run succeeded at the final estimate (its y is not finite)."""
-        return self.y is None or not np.all(np.isfinite(self.y))
 
 
 def project_to_box(x, C, lower, upper) -> np.ndarray:
@@ -197,6 +140,11 @@ class _Linearizer:
             return point, y, S
         return None
 
+    def objective_at(self, x, objective):
+        """The objective at x from a full run (remembered: no new run for a point already run); inf if it fails."""
+        record = evaluate_points(self.evaluate, [x], None, self.executor)[0]
+        return objective(x, record.y) if record.ok else np.inf
+
     def _fail(self, point, error, where):
         self.result.runs += 1
         self.last_error = error
@@ -219,6 +167,8 @@ def kalman_filter(
     bounds=None,
     callback=None,
     max_backtracks: int = 4,
+    names=None,
+    damping: bool = True,
 ) -> KalmanResult:
     """Step-by-step Kalman filter with global iterations (docs/theory.md, section 4.3), bounded and failure tolerant.
 
@@ -262,12 +212,19 @@ def kalman_filter(
     callback : callable(iteration, step, x, C), optional
     max_backtracks : int
         Halvings of a step towards the last good point when the run at the filter's point fails.
+    names : sequence of str, optional
+        Parameter names, for the status (a valley names its pair).
+    damping : bool
+        Under-relax the steps when the estimates of successive passes alternate (see Notes); False: the
+        oscillation is only reported.
 
     Returns
     -------
     KalmanResult
         Never raises for a failed forward run: when no point near the filter's runs, the stage
-        stops with the last complete estimate and ``status = "stopped: ..."``.
+        stops with the last complete estimate and ``status = "stopped: ..."``. The status judges
+        convergence on the last pass's step in std and objective change
+        (:func:`~fracid.inverse.kalman_status.judge`): the loop itself stops at ``tol``.
 
     Notes
     -----
@@ -277,6 +234,10 @@ def kalman_filter(
     linearised posterior's, unchanged by the projection. For a parameter on a bound it describes the
     curvature of the objective there, not the spread of a posterior cut by the bound: the true
     posterior is one-sided, and the parameter is flagged in ``at_bound``.
+
+    Oscillation: when the estimates of successive passes alternate
+    (:func:`~fracid.inverse.kalman_status.oscillates`), the steps are under-relaxed, halved at each
+    detection down to :data:`~fracid.inverse.kalman_status.MIN_RELAXATION` (``result.relaxation``).
     """
     if restart not in ("linearize", "prior-mean"):
         raise ValueError(f"restart = {restart!r}; choose 'linearize' or 'prior-mean'")
@@ -286,13 +247,14 @@ def kalman_filter(
     groups = _observation_groups(y_exp.size, groups)
     lower, upper = _box(bounds, x0.size)
     x0 = np.clip(x0, lower, upper)
-    result = KalmanResult(x=x0.copy(), C=C0.copy())
+    result = KalmanResult(x=x0.copy(), C=C0.copy(), passes=[{"iteration": 0, "x": x0.copy()}])
     lin = _Linearizer(evaluate, sensitivity, executor, result, max_backtracks, y_exp.size)
-    objective = _map_objective(y_exp, C_exp, x0, C0)
-    previous, stopped = x0.copy(), ""
+    objective = _map_objective(y_exp, C_exp, x0, C0 if restart == "linearize" else None)
+    previous, stopped, last = x0.copy(), "", None
     for iteration in range(1, max_iterations + 1):
         fixed_point = restart == "linearize" and iteration > 1
         x, C = (x0.copy() if restart == "linearize" else previous.copy()), C0.copy()
+        f_start = None
         if fixed_point:  # one linearisation for the whole pass
             anchor = lin.last_full[0] if lin.last_full is not None else None
             accept = None if anchor is None else _decreases(objective, *lin.last_full)
@@ -302,6 +264,8 @@ def kalman_filter(
                 result.x = anchor if anchor is not None else result.x
                 break
             previous, y_lin, S_lin = got
+            f_start = objective(previous, y_lin)
+            result.passes[-1]["objective"] = f_start
         last_point = None
         for step, rows in enumerate(groups, start=1):
             if fixed_point:
@@ -323,23 +287,26 @@ def kalman_filter(
         if stopped:
             break
         result.iterations = iteration
-        done = iteration > 1 and _converged(x, previous, C, tol)
-        moved = np.max(np.abs(x - previous) / np.sqrt(np.diag(C)))
+        last = (previous, x, f_start)
+        result.converged = iteration > 1 and _converged(x, previous, C, tol)
+        x = relaxed(result, x, previous, C) if damping else x
         previous, result.x, result.C = x, x, C
-        if done:
-            result.converged = True
+        result.passes.append({"iteration": iteration, "x": x.copy()})
+        if result.converged:
             break
-    _finish(result, lin, lower, upper, stopped, max_iterations, moved if not stopped and result.iterations else None)
+    if not _finish(result, lin, lower, upper, stopped):
+        judge_last_pass(result, lambda x: lin.objective_at(x, objective), objective, last, max_iterations, names)
     return result
 
 
 def _map_objective(y_exp, C_exp, x0, C0):
-    """(x, y) -> (y_exp - y)^T C_exp^-1 (y_exp - y) + (x - x0)^T C0^-1 (x - x0)."""
-    W_exp, W0 = np.linalg.inv(C_exp), np.linalg.inv(C0)
+    """(x, y) -> (y_exp - y)^T C_exp^-1 (y_exp - y) + (x - x0)^T C0^-1 (x - x0); without the prior's term
+    when C0 is None."""
+    W_exp, W0 = np.linalg.inv(C_exp), None if C0 is None else np.linalg.inv(C0)
 
     def f(x, y):
         r, d = y_exp - y, x - x0
-        return float(r @ W_exp @ r + d @ W0 @ d)
+        return float(r @ W_exp @ r + (0.0 if W0 is None else d @ W0 @ d))
 
     return f
 
@@ -355,8 +322,9 @@ def _decreases(objective, anchor, y_anchor):
     return lambda x, y: bool(np.all(np.isfinite(y))) and objective(x, y) <= reference + OBJECTIVE_SLACK
 
 
-def _finish(result, lin, lower, upper, stopped, max_iterations, moved):
-    """The run at the final estimate (backtracking to the last full run if it fails), status and bound flags."""
+def _finish(result, lin, lower, upper, stopped) -> str:
+    """The run at the final estimate (backtracking to the last full run if it fails), the status of a stop
+    and the bound flags; returns why the filter stopped ("" if it did not)."""
     got = lin.at(result.x, lin.last_full[0] if lin.last_full is not None else None, None,
                  {"iteration": result.iterations, "step": "final"})
     if got is not None:
@@ -365,14 +333,11 @@ def _finish(result, lin, lower, upper, stopped, max_iterations, moved):
         result.y = np.full(result.y.size if result.y is not None else lin.n_outputs, np.nan)
         stopped = stopped or f"the forward run at the final estimate failed: {lin.last_error}"
     if stopped:
+        result.converged = False
         result.status = f"stopped: {stopped}"
-    elif result.converged:
-        result.status = "converged"
-    else:
-        result.status = (f"not converged: {max_iterations} global iterations reached, the last moved the estimate "
-                         f"by {moved:.3g} std")
     span = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
     result.at_bound = (np.abs(result.x - lower) <= 1e-9 * span) | (np.abs(upper - result.x) <= 1e-9 * span)
+    return stopped
 
 
 def batch_kalman(

@@ -146,6 +146,21 @@ class KnnResult:
     def n_failed(self) -> int:
         return sum(s != "ok" for s in self.status)
 
+    def next_starts(self, m: int, avoid=(), separation: float = 0.25) -> list:
+        """Indices of up to m successful points in the order of f, each at least ``separation`` away (in unit
+        coordinates) from the points ``avoid`` and from the ones already chosen: starting points that probe
+        different parts of the space (multi-start check, restarts of the Kalman filter)."""
+        unit = self.space.to_unit(self.points)
+        taken = [u for u in self.space.to_unit(np.asarray(avoid, float).reshape(-1, self.points.shape[1]))]
+        chosen = []
+        for i in self.order:
+            if len(chosen) == m or not np.isfinite(self.f[i]):
+                break
+            if all(np.linalg.norm(unit[i] - u) >= separation for u in taken):
+                chosen.append(int(i))
+                taken.append(unit[i])
+        return chosen
+
     def table(self, rows: int | None = None) -> str:
         """Ranked table: rank, objective, parameters, status."""
         header = f"{'rank':>4} {'f':>12} " + " ".join(f"{n:>12}" for n in self.space.names) + "  status"

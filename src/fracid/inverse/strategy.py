@@ -15,6 +15,7 @@ import numpy as np
 
 from fracid.inverse.gauss_newton import gauss_newton
 from fracid.inverse.kalman import kalman_filter
+from fracid.inverse.kalman_status import DEFAULT_MAX_STARTS, restarted
 from fracid.inverse.knn import ParameterSpace, knn_search
 from fracid.inverse.method import InverseMethod, MethodResult, check_problem, identification_bounds, result_fields
 from fracid.inverse.runs import StoredOperator
@@ -92,12 +93,17 @@ class KalmanSettings:
         Convergence: no parameter moves by more than ``tol`` of its standard deviation [-].
     restart : {"linearize", "prior-mean"}
         How a global iteration starts again (see :func:`~fracid.inverse.kalman.kalman_filter`).
+    max_starts : int
+        Starts of the filter at most: when it ends at a poor point from the KNN prior, it starts again
+        from the next-best population points (:func:`~fracid.inverse.kalman_status.restarted`). Not part
+        of :meth:`options` (the filters of the study's checks start once).
     """
 
     groups: object = None
     max_iterations: int = 10
     tol: float = 0.01
     restart: str = "linearize"
+    max_starts: int = DEFAULT_MAX_STARTS
 
     def options(self, n_y: int, blocks=()) -> dict:
         """Keyword arguments of :func:`~fracid.inverse.kalman.kalman_filter` for ``n_y`` observations in
@@ -148,7 +154,7 @@ class KnnKalman:
         """The Kalman stage from the prior of ``knn``: :func:`refine` with these settings."""
         return refine(operator, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes,
                       method=self.knn.method, seed=self.knn.seed, started=started, C0=C0, progress=progress,
-                      **self.kalman.options(np.size(y_exp), blocks))
+                      max_starts=self.kalman.max_starts, **self.kalman.options(np.size(y_exp), blocks))
 
     def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
                  retry_failed=False, blocks=(), notes=()) -> IdentificationResult:
@@ -228,8 +234,8 @@ _DEFAULT_METHOD_KEYWORDS = {**{f.name: f.default for f in fields(KnnSettings)},
 
 
 def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMethod | str | None = None, n=64,
-             seed=0, k=5, groups=None, max_iterations=10, tol=0.01, restart="linearize", executor=None, store=None,
-             blocks=(), notes=(), progress=None, retry_failed=False) -> MethodResult:
+             seed=0, k=5, groups=None, max_iterations=10, tol=0.01, restart="linearize", max_starts=DEFAULT_MAX_STARTS,
+             executor=None, store=None, blocks=(), notes=(), progress=None, retry_failed=False) -> MethodResult:
     """Identify the parameters of ``space`` from the data with an inverse method (by default KNN over a
     population for a global overview and the prior, then the Kalman filter to refine).
 
@@ -247,7 +253,7 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
         (``"sobol"`` when None, ``"lhs"``, ``"grid"``).
     n, seed, k
         KNN population and neighbours of the default method (:class:`KnnSettings`).
-    groups, max_iterations, tol, restart
+    groups, max_iterations, tol, restart, max_starts
         Kalman filter settings of the default method (:class:`KalmanSettings`); ``groups`` may be
         ``"blocks"`` or ``"all"``.
     executor, store
@@ -280,11 +286,12 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
         raise TypeError(f"method is a {type(method).__name__}; give an InverseMethod (e.g. KnnKalman()), a population "
                         "design ('sobol', 'lhs', 'grid') or None")
     given = {"n": n, "seed": seed, "k": k, "groups": groups, "max_iterations": max_iterations, "tol": tol,
-             "restart": restart}
+             "restart": restart, "max_starts": max_starts}
     if method is None or isinstance(method, str):
         design = {} if method is None else {"method": method}
         method = KnnKalman(KnnSettings(n=n, seed=seed, k=k, **design),
-                           KalmanSettings(groups=groups, max_iterations=max_iterations, tol=tol, restart=restart))
+                           KalmanSettings(groups=groups, max_iterations=max_iterations, tol=tol, restart=restart,
+                                          max_starts=max_starts))
     else:
         changed = [name for name, value in given.items() if not _is_default(value, _DEFAULT_METHOD_KEYWORDS[name])]
         if changed:
@@ -304,13 +311,17 @@ def _is_default(value, default) -> bool:
 
 def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0.01, restart="linearize",
            executor=None, blocks=(), notes=(), method="", seed=0, started=None, C0=None,
-           progress=False) -> IdentificationResult:
+           progress=False, max_starts=DEFAULT_MAX_STARTS) -> IdentificationResult:
     """The Kalman filter from the prior of a KNN search (x0, C0): the second stage of :class:`KnnKalman`.
 
     ``C0`` replaces the KNN covariance as the prior's (e.g. the bounds' covariance, so that the
     posterior holds the information of the data alone). ``operator`` may be a
     :class:`~fracid.inverse.runs.StoredOperator` (its runs are then stored and counted). ``method``
     and ``seed`` are the population's design, recorded in the result.
+
+    When the filter from the KNN prior ends at a poor point, it starts again from the next-best population
+    points, ``max_starts`` starts in all (:func:`~fracid.inverse.kalman_status.restarted`: the status says
+    how many were tried and which won; the winner's ``history``, the runs of all).
 
     The filter stays inside the KNN space's bounds and does not raise on failed forward runs. When
     it could not evaluate any estimate of its own (every run near its points failed), the result is
@@ -322,9 +333,12 @@ def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0
     evaluate, sensitivity = exact_sensitivity(operator)
     before = _counters(evaluate)
     with kalman_progress(progress, groups, y_exp.size, max_iterations) as callback:
-        kalman = kalman_filter(evaluate, y_exp, C_exp, knn.x0, C0, groups=groups, max_iterations=max_iterations,
-                               tol=tol, restart=restart, executor=executor, bounds=bounds, callback=callback,
-                               sensitivity=sensitivity)
+        def run(x0):
+            return kalman_filter(evaluate, y_exp, C_exp, x0, C0, groups=groups, max_iterations=max_iterations,
+                                 tol=tol, restart=restart, executor=executor, bounds=bounds, callback=callback,
+                                 sensitivity=sensitivity, names=knn.space.names)
+
+        kalman = restarted(run, run(knn.x0), knn, y_exp, C_exp, max_starts)
     x, C, y_fit, status = kalman.x, kalman.C, kalman.y, kalman.status
     if kalman.failed and np.isfinite(knn.f[knn.order[0]]):
         best = knn.order[0]

@@ -1,8 +1,8 @@
 """The identification strategy as one study (docs/theory.md, section 4.4), ending in a verdict per parameter.
 
 KNN over a population (overview, prior) -> sensitivity along the load history at the KNN estimate
-(which stage of the test informs which parameter) -> uniqueness (valley of the objective over the
-population) -> Kalman filter -> multi-start check -> stability under noise -> prediction of data not
+(which stage of the test informs which parameter) -> Kalman filter -> uniqueness (valley of the
+objective over the population, measured from the estimate and its objective) -> multi-start check -> stability under noise -> prediction of data not
 used for calibration -> verdict. The sensitivities need a point, which is why they follow the KNN
 search rather than precede it; every other stage runs in the order of the thesis's strategy (docs/theory.md, section 4.4).
 
@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.inverse.knn import objective
 from fracid.inverse.method import check_problem, identification_bounds
 from fracid.inverse.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
@@ -79,6 +80,15 @@ def predict(operator, data, x, C, *, executor=None, name="prediction") -> Predic
         return Prediction(name, data.control, data.y, data.std, nan, nan, status=str(err))
     std = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", S, C, S), 0.0))
     return Prediction(name, data.control, data.y, data.std, y, std)
+
+
+def estimate_objective(ident, y, C):
+    """(x, f): the identification's estimate and its objective (y - y_fit)^T C^-1 (y - y_fit), the centre of
+    the objective maps and valley; None when the run at the estimate failed."""
+    y_fit = np.asarray(ident.y_fit, float) if ident.y_fit is not None else None
+    if y_fit is None or not np.all(np.isfinite(y_fit)):
+        return None
+    return np.asarray(ident.x, float), float(objective(y, C, y_fit)[0])
 
 
 def describe_data(operator) -> DataDescription:
@@ -346,12 +356,13 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
         history = None
         notes.append(f"sensitivity history skipped: {err}")
     count("sensitivity", mark)
-    maps, extent = objective_maps(knn), valley_extent(knn)
     log("Kalman filter from the KNN prior")
     mark = (evaluate.computed + evaluate.reused, evaluate.failed)
     ident = method.refine(evaluate, y, C, knn, executor=executor, blocks=list(data.blocks), notes=list(data.notes),
                           C0=C0, progress=progress)
     count("Kalman", mark)
+    centre = estimate_objective(ident, y, C)
+    maps, extent = objective_maps(knn, centre=centre), valley_extent(knn, centre=centre)
     ms = None
     starts, replicates = settings.starts, settings.replicates
     if starts > 1:

@@ -1,7 +1,8 @@
 """Uniqueness of the estimate (docs/theory.md, section 4.6): maps of the objective, its valley, multi-start.
 
 The population of a KNN search is an overview of the objective f over the parameter space. Its
-*valley* is the set of parameter sets the data cannot tell from the best one: f - f_min below the
+*valley* is the set of parameter sets the data cannot tell from the estimate (the identification's, when
+given; else the best population point): f - f_estimate below the
 95 % quantile of chi^2 with p degrees of freedom (the likelihood-ratio confidence region of a
 Gaussian measurement error; p the number of identified parameters). A valley stretched along a line
 means correlated parameters; several separated pieces mean several minima.
@@ -47,6 +48,9 @@ class ObjectiveMap:
     correlation : float
         Correlation of the pair over the valley points (in the population's unit coordinates);
         NaN with fewer than 3 valley points.
+    centred : bool
+        The first point is the identification's estimate (the centre of the map), the others the
+        population's; f_min is then the estimate's objective unless a population point fits better.
     """
 
     names: tuple
@@ -55,52 +59,67 @@ class ObjectiveMap:
     valley: np.ndarray
     level: float
     correlation: float
+    centred: bool = False
 
     @property
     def best(self) -> np.ndarray:
         return self.points[np.argmin(self.f)]
 
 
-def objective_maps(knn, level: float | None = None) -> list[ObjectiveMap]:
-    """Objective maps of every parameter pair of a :class:`~fracid.inverse.knn.KnnResult`.
+def centred_population(knn, centre=None):
+    """The successful population points and their objective, with the estimate ``centre`` = (x, f) first
+    when given: the reference of the valley (f - f_ref <= level) is then the estimate's objective
+    (or the best point's, if a population point fits better).
 
-    The valley is taken in the full parameter space (all p parameters), then shown per pair.
+    Returns
+    -------
+    points : ndarray, shape (N, p)
+    f : ndarray, shape (N,)
+    reference : float
+        The objective the valley is measured from.
     """
-    names = knn.space.names
     ok = np.isfinite(knn.f)
     points, f = knn.points[ok], knn.f[ok]
+    if centre is not None and np.isfinite(centre[1]):
+        x, f_x = centre
+        points, f = np.vstack([np.asarray(x, float)[None, :], points]), np.concatenate([[float(f_x)], f])
+    return points, f, float(f.min())
+
+
+def objective_maps(knn, level: float | None = None, centre=None) -> list[ObjectiveMap]:
+    """Objective maps of every parameter pair of a :class:`~fracid.inverse.knn.KnnResult`.
+
+    The valley is taken in the full parameter space (all p parameters), then shown per pair. ``centre``
+    = (x, f): the identification's estimate and its objective, the centre of the maps and the reference
+    of the valley (see :func:`centred_population`); without it, the best population point.
+    """
+    names = knn.space.names
+    points, f, reference = centred_population(knn, centre)
     level = valley_level(len(names)) if level is None else float(level)
-    valley = f - f.min() <= level
+    valley = f - reference <= level
     unit = knn.space.to_unit(points)
     maps = []
     for i, j in combinations(range(len(names)), 2):
         corr = float(np.corrcoef(unit[valley, i], unit[valley, j])[0, 1]) if valley.sum() >= 3 else float("nan")
-        maps.append(ObjectiveMap((names[i], names[j]), points[:, [i, j]], f, valley, level, corr))
+        maps.append(ObjectiveMap((names[i], names[j]), points[:, [i, j]], f, valley, level, corr,
+                                 centred=len(f) > int(np.isfinite(knn.f).sum())))
     return maps
 
 
-def valley_extent(knn, level: float | None = None) -> np.ndarray:
-    """Per parameter: range of the valley points / range of the population (0 = pinned, 1 = anywhere)."""
-    ok = np.isfinite(knn.f)
-    unit = knn.space.to_unit(knn.points[ok])
+def valley_extent(knn, level: float | None = None, centre=None) -> np.ndarray:
+    """Per parameter: range of the valley points / range of the population (0 = pinned, 1 = anywhere);
+    ``centre`` as in :func:`objective_maps`."""
+    points, f, reference = centred_population(knn, centre)
+    unit = knn.space.to_unit(points)
     level = valley_level(len(knn.space.names)) if level is None else float(level)
-    valley = knn.f[ok] - knn.f[ok].min() <= level
+    valley = f - reference <= level
     return unit[valley].max(axis=0) - unit[valley].min(axis=0)
 
 
 def starting_points(knn, m: int = 3, separation: float = 0.25) -> np.ndarray:
     """m starting points: the best population points, each at least ``separation`` away from the
     ones already chosen (in unit coordinates), so the starts probe different parts of the valley."""
-    unit = knn.space.to_unit(knn.points)
-    chosen = []
-    for i in knn.order:
-        if not np.isfinite(knn.f[i]):
-            break
-        if all(np.linalg.norm(unit[i] - unit[j]) >= separation for j in chosen):
-            chosen.append(i)
-        if len(chosen) == m:
-            break
-    return knn.points[chosen]
+    return knn.points[knn.next_starts(m, separation=separation)]
 
 
 @dataclass
