@@ -23,8 +23,9 @@ from fracid.report.posterior import (comparison_table, corner_figure, predictive
 
 
 def valley_figure(maps, multi_start=None, truth=None, names=None):
-    """Objective over each parameter pair (population coloured by log10(f - f_min + 1)), the valley
-    (points within the chi^2 level of the minimum) and the multi-start starts and ends.
+    """Objective over each parameter pair (population coloured by log10(f - f_ref + 1)), the valley
+    (points within the chi^2 level of the reference: the estimate's objective on a centred map, unless a
+    population point fits better) and the multi-start starts and ends.
 
     ``names`` orders the columns of the multi-start points and of ``truth`` (the pair's own order
     when omitted, which only fits two parameters)."""
@@ -33,12 +34,15 @@ def valley_figure(maps, multi_start=None, truth=None, names=None):
     fig = _new_figure(5.2 * len(maps), 4.4)
     axes = np.atleast_1d(fig.subplots(1, len(maps)))
     for ax, m in zip(axes, maps):
+        reference = "f_estimate" if m.centred and m.f[0] <= m.f.min() else "f_min"
         excess = m.f - m.f.min()
         sc = ax.scatter(m.points[:, 0], m.points[:, 1], c=np.log10(excess + 1.0), cmap="viridis_r", s=25,
                         edgecolors="none")
-        fig.colorbar(sc, ax=ax, label="log10(f - f_min + 1) [-]")
+        fig.colorbar(sc, ax=ax, label=f"log10(f - {reference} + 1) [-]")
         ax.plot(m.points[m.valley, 0], m.points[m.valley, 1], "o", mfc="none", mec=_NEIGHBOUR, ms=10, mew=1.6,
-                label=f"valley: f - f_min <= {m.level:.3g} ({int(m.valley.sum())} points)")
+                label=f"valley: f - {reference} <= {m.level:.3g} ({int(m.valley.sum())} points)")
+        if m.centred:
+            ax.plot([m.points[0, 0]], [m.points[0, 1]], "D", color=_ESTIMATE, ms=8, mec="k", mew=0.6, label="estimate")
         i, j = (list(names).index(m.names[0]), list(names).index(m.names[1])) if names is not None else (0, 1)
         if multi_start is not None:
             for a, b in zip(multi_start.starts, multi_start.ends):
@@ -171,8 +175,8 @@ def study_sections(study, figures: dict, posterior_figures: dict | None = None) 
     captions = {
         "sensitivity": "Normalised sensitivities along the load history and the share of each parameter's prior "
                        "(bounds) variance removed by the data up to each point.",
-        "valley": "Objective over the population; circled: the valley of sets the data cannot tell from the best "
-                  "(chi^2 95 % level); arrows: Kalman filters from distinct starting points.",
+        "valley": "Objective over the population around the estimate (diamond); circled: the valley of sets the "
+                  "data cannot tell from the estimate (chi^2 95 % level); arrows: Kalman filters from distinct starting points.",
         "stability": "Estimates from data with noise added (fixed seeds): the scatter against the estimate's +-2 std.",
         "predictions": "Data not used for calibration, predicted at the estimate (+-2 std propagated from its "
                        "covariance).",
