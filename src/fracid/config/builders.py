@@ -240,7 +240,7 @@ def identify_settings(cfg: Config) -> dict:
 
     ``n``, ``method``, ``seed``, ``k``, ``groups`` (``groups`` consecutive index arrays covering
     the n_y observations; :data:`DEFAULT_KALMAN_GROUPS` when not given), ``max_iterations``,
-    ``tol`` and ``restart`` (only when ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
+    ``tol``, ``max_starts`` and ``restart`` (only when ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
     (executor, store, progress) is not configuration: add it at the call.
     """
     from fracid.inverse.strategy import identify
@@ -250,7 +250,7 @@ def identify_settings(cfg: Config) -> dict:
     count = kalman.groups if kalman.groups is not None else min(DEFAULT_KALMAN_GROUPS, cfg.n_y)
     groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), count)]
     out = {"n": knn.n, "method": knn.method, "seed": knn.seed, "k": knn.k, "groups": groups,
-           "max_iterations": kalman.max_iterations, "tol": kalman.tol}
+           "max_iterations": kalman.max_iterations, "tol": kalman.tol, "max_starts": kalman.max_starts}
     if "restart" in inspect.signature(identify).parameters:
         out["restart"] = kalman.restart
     elif kalman.restart != "linearize":

@@ -125,5 +125,7 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         tol=ck.number("identify.kalman.tol", raw_kf.get("tol", 0.01), "must be a number > 0 [standard deviations]",
                       lambda v: v > 0),
         restart=ck.choice("identify.kalman.restart", raw_kf.get("restart", "linearize"), _RESTARTS),
+        max_starts=ck.integer("identify.kalman.max_starts", raw_kf.get("max_starts", 3),
+                              "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1),
     )
     return IdentifyConfig(parameters=names, lower=tuple(lower), upper=tuple(upper), log=log, knn=knn, kalman=kalman)

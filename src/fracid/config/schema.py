@@ -104,6 +104,8 @@ present they are always validated. Every other key is optional unless marked *re
     max_iterations = 10                 # integer >= 1, default 10
     tol = 0.01                          # > 0, in standard deviations, default 0.01
     restart = "linearize"               # "linearize" (default) | "prior-mean"
+    max_starts = 3                      # integer >= 1, default 3: after a poor end (chi^2 per point > 10), the
+                                        #   filter starts again from the next-best population points
 
     [study]                             # optional: the checks of `fracid study`
     starts = 3                          # multi-start Kalman filters from distinct population points
@@ -177,7 +179,7 @@ _KIND_KEYS = {
 }
 _IDENTIFY_KEYS = ("parameters", "bounds", "knn", "kalman")
 _KNN_KEYS = ("n", "method", "k", "seed")
-_KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart")
+_KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
@@ -323,6 +325,7 @@ class KalmanConfig:
     max_iterations: int = 10
     tol: float = 0.01
     restart: str = "linearize"
+    max_starts: int = 3
 
 
 @dataclass(frozen=True)
