@@ -1,6 +1,7 @@
 """The fracid command: each subcommand on a small configuration, and configuration errors."""
 
 import json
+import re
 import runpy
 import subprocess
 import sys
@@ -24,7 +25,6 @@ def bar_study(tmp_path):
 
 
 def test_simulate_writes_curve_plot_and_vtk(tmp_path):
-    pytest.importorskip("meshio")
     assert cli.main(["simulate", str(CONFIGS / "bar_simulate.toml"), "--out", str(tmp_path), "--quiet"]) == 0
     curve = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
     header = (tmp_path / "curve.csv").read_text().splitlines()[0].split(",")
@@ -32,6 +32,29 @@ def test_simulate_writes_curve_plot_and_vtk(tmp_path):
     assert force.max() > 1.5 and force[-1] < 0.1 * force.max()
     assert (tmp_path / "curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert {p.name for p in (tmp_path / "vtk").glob("*.vtu")} >= {"step_0010.vtu", "step_0020.vtu"}
+
+
+@pytest.mark.parametrize("vtk_steps, skipped", [("[]", False), ("[10]", True)])
+def test_vtk_skipped_is_said_only_when_vtk_was_asked_for(tmp_path, capsys, monkeypatch, vtk_steps, skipped):
+    import fracid.report.vtk
+
+    def no_meshio(*args, **kwargs):
+        raise ImportError("writing VTK files needs meshio")
+
+    monkeypatch.setattr(fracid.report.vtk, "write_result_vtk", no_meshio)
+    text = (CONFIGS / "bar_simulate.toml").read_text()
+    text = re.sub(r"^vtk_steps = .*$", f"vtk_steps = {vtk_steps}", text, flags=re.M)
+    assert f"vtk_steps = {vtk_steps}" in text
+    (tmp_path / "cfg.toml").write_text(text)
+    assert cli.main(["simulate", str(tmp_path / "cfg.toml"), "--out", str(tmp_path / "out")]) == 0
+    out, err = capsys.readouterr()
+    assert ("VTK output skipped" in err) is skipped and "VTK" not in out
+    assert "wrote in" in out and "curve.csv, curve.png" in out
+
+
+@pytest.mark.parametrize("count, text", [(1, "1 run"), (2, "2 runs"), (0, "0 runs")])
+def test_plural(count, text):
+    assert cli._plural(count, "run") == text
 
 
 def test_identify_writes_result_fit_figures_and_report(bar_study, tmp_path):

@@ -9,11 +9,11 @@ import fracid
 FLOORS = {
     "fem": 0,
     "specimens": 1,
-    "models": 2, "forward": 2, "data": 2, "store": 2, "tables": 2, "parallel": 2, "progress": 2,
+    "models": 2, "forward": 2, "data": 2, "store": 2, "tables": 2, "parallel": 2, "progress": 2, "provenance": 2,
     "inverse": 3,
     "report": 4,
     "config": 5,
-    "cli": 6, "cli_studies": 6, "exits": 6, "lock": 6, "outputs": 6, "__main__": 6, "__init__": 6,
+    "cli": 6, "cli_studies": 6, "cli_init": 6, "cli_check": 6, "exits": 6, "lock": 6, "outputs": 6, "__main__": 6, "__init__": 6,
 }
 
 

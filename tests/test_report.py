@@ -220,27 +220,58 @@ def find_browser():
     return None
 
 
-def test_images_load_in_a_browser(report, tmp_path):
+def render(path, tmp_path):
+    """The DOM of ``path`` after a headless Chromium loaded it (its load script run), and the browser's log;
+    skips without a browser."""
     browser = find_browser()
     if browser is None:
-        pytest.skip("no browser")
-    _, path, _ = report
+        pytest.skip("no browser (.ci/run installs chromium where apt-get can)")
     command = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
                "--disable-background-networking", "--disable-component-update", "--disable-sync",
-               f"--user-data-dir={tmp_path / 'profile'}", "--virtual-time-budget=5000", "--dump-dom",
-               path.resolve().as_uri()]
+               "--enable-logging=stderr", "--v=0", f"--user-data-dir={tmp_path / 'profile'}",
+               "--virtual-time-budget=5000", "--dump-dom", path.resolve().as_uri()]
     try:
         done = subprocess.run(command, check=False, capture_output=True, text=True, timeout=90)
     except subprocess.TimeoutExpired:
         pytest.fail(f"{browser} did not finish within 90 s")
     assert done.returncode == 0, done.stderr[-2000:]
-    body = re.search(r"<body[^>]*>", done.stdout)
-    assert body, f"no <body> in the dumped DOM: {done.stdout[:500]!r} {done.stderr[-1000:]}"
+    return done.stdout, done.stderr
+
+
+def check_rendered(dom, log, images, cells=()):
+    """Every one of ``images`` figures decoded, no console error, and the table ``cells`` in the DOM."""
+    body = re.search(r"<body[^>]*>", dom)
+    assert body, f"no <body> in the dumped DOM: {dom[:500]!r} {log[-1000:]}"
     loaded = re.search(r'data-images-loaded="(\d+)"', body.group(0))
     total = re.search(r'data-images-total="(\d+)"', body.group(0))
     assert loaded and total, f"the load script did not run: {body.group(0)}"
-    assert int(total.group(1)) == 5
+    assert int(total.group(1)) == images
     assert int(loaded.group(1)) == int(total.group(1))
+    console = [line for line in log.splitlines() if "CONSOLE" in line or "Uncaught" in line]
+    assert console == []
+    text = re.sub(r"<[^>]+>", " ", dom)
+    for cell in cells:
+        assert re.search(rf"<t[dh][^>]*>\s*{re.escape(cell)}", dom), cell
+        assert cell in text
+
+
+def test_images_load_in_a_browser(report, tmp_path):
+    _, path, _ = report
+    check_rendered(*render(path, tmp_path), images=5, cells=NAMES)
+
+
+def test_posterior_page_renders_in_a_browser(tmp_path):
+    from fracid.inverse.posterior import PosteriorResult
+    from fracid.report.posterior import write_posterior_page
+
+    x = np.random.default_rng(1).normal([2.0, 250.0], [0.1, 10.0], size=(50, 2))
+    w = np.full(50, 1 / 50)
+    result = PosteriorResult(["c", "beta"], x, w, np.zeros(50), np.zeros((50, 0)), np.zeros(0), np.zeros(0), 50.0, 1,
+                             0, np.array([2.0, 250.0]), np.diag([0.01, 100.0]), (x.min(axis=0), x.max(axis=0)),
+                             status="converged")
+    png = figures.to_png(figures.correlation_figure(make_result()))
+    path = write_posterior_page(tmp_path / "posterior.html", result, {"corner": png, "posterior_predictive": png})
+    check_rendered(*render(path, tmp_path), images=2, cells=["c", "beta"])
 
 
 def test_warnings_head_the_report_poor_fit_bound_and_failed_runs(tmp_path):
@@ -254,6 +285,9 @@ def test_warnings_head_the_report_poor_fit_bound_and_failed_runs(tmp_path):
     assert "fit is poor" in text and f"{poor.rms_percent:.3g} %" in text and "beta = " in text
     assert "not converged" in text and "2 in the Kalman stage" in text and "1 of 20 KNN" in text
     html = write_report(tmp_path / "r.html", poor, control=CONTROL).read_text(encoding="utf-8")
-    assert html.count('<span class="warn">warning</span>') == 4 and "beta (at a bound)" in html
-    assert make_result().warnings() == ["failed forward runs: 1 of 20 KNN, 0 in the Kalman stage (recorded; see "
-                                        "report.html)"]
+    # poor fit, the peak 50 % below the measured one, the bound, not converged, failed runs
+    assert html.count('<span class="warn">warning</span>') == 5 and "beta (at a bound)" in html
+    assert "the model&#x27;s peak is 50 % below the measured one in block &#x27;global&#x27;" in html
+    assert "report.html" not in html  # the warnings do not send the reader to the page they are in
+    assert make_result().warnings() == ["failed forward runs: 1 of 20 KNN, 0 in the Kalman stage (each with its "
+                                        "reason, in the result)"]

@@ -12,6 +12,9 @@
                               configured parameter values
     fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
     fracid demo               identification of the bundled real test (Gregoire et al. 2013 beam)
+    fracid init               a commented configuration to start from (:mod:`fracid.cli_init`)
+    fracid check CONFIG       validate a configuration and print its plan and cost (:mod:`fracid.cli_check`)
+    fracid --version
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
 Every expected failure ends with a one-paragraph message and a documented exit status (see
@@ -31,6 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.progress import progress_lines
+
 
 def _parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
@@ -41,6 +46,7 @@ def _parser() -> argparse.ArgumentParser:
     common.add_argument("--retry-failed", action="store_true", help="run again the forward runs stored as failed")
     common.add_argument("--debug", action="store_true", help="show the traceback of a failure")
     parser = argparse.ArgumentParser(prog="fracid", description="Parameter identification for localized-failure models.")
+    parser.add_argument("--version", action="version", version=f"fracid {version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("simulate", "forward analysis of the configured specimen"),
                        ("identify", "identify parameters from measured data (KNN + Kalman filter)"),
@@ -55,7 +61,23 @@ def _parser() -> argparse.ArgumentParser:
         if name == "size-effect":
             p.add_argument("--sizes", type=float, nargs="+", help="sizes D [mm] (default: those of the experiments)")
     sub.add_parser("demo", parents=[common], help="identify the bundled real beam test (Gregoire et al. 2013)")
+    from fracid import cli_check, cli_init
+
+    cli_init.add_parser(sub)
+    cli_check.add_parser(sub, common)
     return parser
+
+
+def version() -> str:
+    """The installed fracid's version (its metadata), else :data:`fracid.__version__` (a source tree)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("fracid")
+    except metadata.PackageNotFoundError:
+        from fracid import __version__
+
+        return __version__
 
 
 def demo_config_path() -> Path:
@@ -66,6 +88,17 @@ def demo_config_path() -> Path:
 def _say(args, text):
     if not args.quiet:
         print(text, flush=True)
+
+
+def _wrote(args, out, names):
+    """Say which files a command wrote into ``out``: the names, those of a subdirectory counted when many."""
+    groups = {}
+    for name in map(str, names):
+        folder, _, _ = name.rpartition("/")
+        groups.setdefault(folder, []).append(name)
+    shown = [name for folder, items in groups.items()
+             for name in (items if len(items) <= 3 or not folder else [f"{folder}/ ({len(items)} files)"])]
+    _say(args, f"wrote in {out}: " + ", ".join(shown))
 
 
 def _warn(text):
@@ -167,11 +200,13 @@ def run_simulate(args) -> int:
     try:
         from fracid.report.vtk import write_result_vtk
 
-        written += [str(p.relative_to(out)) for p in write_result_vtk(out / "vtk", specimen, result)]
+        written += [p.relative_to(out).as_posix() for p in write_result_vtk(out / "vtk", specimen, result)]
     except ImportError as err:
-        _say(args, f"VTK output skipped: {err}")
+        if cfg.output.vtk_steps:  # asked for; the last step alone is a bonus, skipped silently
+            _warn(f"[output] vtk_steps: VTK output skipped: {err}")
     _say(args, f"peak force {result.peak_force:.6g} N; {result.status}; {result.stats.steps} steps, "
-               f"{result.stats.time_total:.1f} s\nwrote in {out}: " + ", ".join(written))
+               f"{result.stats.time_total:.1f} s")
+    _wrote(args, out, written)
     return 0
 
 
@@ -191,7 +226,7 @@ def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
     from fracid.inverse.strategy import identify_data
 
-    _say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names)))
+    _say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
     start = time.perf_counter()
     result = identify_data(job.operator, job.data, job.space, executor=executor, store=store,
                            progress=_progress(args), retry_failed=args.retry_failed, **job.settings)
@@ -218,7 +253,9 @@ def _write_identification(args, job, out, result) -> None:
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
                         for stage, c in result.stage_runs().items())
     _say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {stages}; "
-               f"{result.runs['wall_seconds']:.0f} s\nwrote in {out}: result.json, fit.csv, report.html, figures/*.png")
+               f"{result.runs['wall_seconds']:.0f} s")
+    figures_written = sorted(p.relative_to(out).as_posix() for p in (out / "figures").glob("*.png"))
+    _wrote(args, out, ["result.json", "fit.csv", "report.html", *figures_written, "runs.sqlite"])
     for text in result.warnings():
         _warn(text)
 
@@ -261,7 +298,8 @@ def run_posterior_command(args) -> int:
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     _say(args, post.summary())
     _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
-               f"the run store, {post.failed} failed)\nwrote in {out}: " + ", ".join(written))
+               f"the run store, {post.failed} failed)")
+    _wrote(args, out, written)
     if post.sampling_failed:
         print(f"fracid: posterior {post.status}. The draws are in {out / 'posterior.csv'}, without credible "
               "intervals.", file=sys.stderr)
@@ -271,16 +309,20 @@ def run_posterior_command(args) -> int:
     return 0
 
 
-def _stage_costs(settings, n_y, p) -> str:
-    """What the Kalman stage will cost, said before the work starts."""
-    groups = settings.get("groups")
-    steps = n_y if groups is None else len(groups)
-    per_step = 2 * p + 1
-    first = per_step * (steps + 1) / 2  # step t runs up to observation t/steps of the curve
-    return (f"KNN: {settings['n']} forward runs. Kalman filter: {steps} steps per pass "
-            f"({per_step} runs per step: the run and 2 per parameter); the first pass costs about {first:.0f} "
-            f"full-curve runs, each later one {per_step}, at most {settings['max_iterations']} passes "
-            "([identify.kalman] groups, max_iterations).")
+def _stage_costs(settings, n_y, p, operator=None) -> str:
+    """What the KNN and Kalman stages will cost, said before the work starts."""
+    from fracid.cli_check import kalman_cost
+
+    cost = kalman_cost(operator, settings, n_y, p)
+    return (f"KNN: {settings['n']} forward runs. Kalman filter: {cost['steps']} steps per pass "
+            f"({_plural(cost['per_step'], 'run')} per step: {cost['how']}); the first pass costs about "
+            f"{cost['first']:.0f} full-curve runs, each later one {cost['later']}, at most {cost['passes']} passes, then "
+            f"{cost['final']} at the estimate ([identify.kalman] groups, max_iterations).")
+
+
+def _plural(count, noun) -> str:
+    """``"1 run"``, ``"2 runs"``."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def _write_figures(directory: Path, result, control) -> None:
@@ -304,11 +346,12 @@ def main(argv=None) -> int:
     with exits.stop_signals():
         try:
             args = _parser().parse_args(argv)
-            if args.workers is not None and args.workers < 1:
+            if getattr(args, "workers", None) is not None and args.workers < 1:
                 print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
                 return exits.INPUT
             args.store_path = args.out_dir = None
-            return _dispatch(args)
+            with progress_lines(not getattr(args, "quiet", False)):
+                return _dispatch(args)
         except SystemExit:
             raise
         except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
@@ -323,6 +366,10 @@ def main(argv=None) -> int:
 
 
 def _dispatch(args) -> int:
+    if args.command in ("init", "check"):
+        from fracid import cli_check, cli_init
+
+        return cli_init.run_init(args) if args.command == "init" else cli_check.run_check(args)
     if args.command == "simulate":
         return run_simulate(args)
     if args.command == "identify":

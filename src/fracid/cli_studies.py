@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli import _executor, _load, _out_dir, _progress, _say, _warn, _working_in
+from fracid.cli import _executor, _load, _out_dir, _progress, _say, _warn, _working_in, _wrote
 
 
 def run(args) -> int:
@@ -95,8 +95,7 @@ def run_study_command(args) -> int:
     written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
                           size_effect=size.figure_arguments() if size is not None else None)
     _say(args, study.summary())
-    _say(args, f"wrote in {out}: " + ", ".join(p if isinstance(p, str) else str(Path(p).relative_to(out))
-                                              for p in written))
+    _wrote(args, out, [p if isinstance(p, str) else Path(p).relative_to(out).as_posix() for p in written])
     for text in study.identification.warnings():
         _warn(text)
     if study.posterior is not None and not study.posterior.converged:
@@ -130,7 +129,8 @@ def run_sensitivity_command(args) -> int:
     (out / "sensitivity.png").write_bytes(to_png(sensitivity_figure(history, data.control)))
     final = ", ".join(f"{n} {v:.0%}" for n, v in zip(space.names, history.variance_share[-1]))
     _say(args, f"sensitivities at {dict(zip(space.names, x.tolist()))}; share of the prior (bounds) variance removed "
-               f"by all data: {final}\nwrote in {out}: sensitivity.csv, sensitivity.png")
+               f"by all data: {final}")
+    _wrote(args, out, ["sensitivity.csv", "sensitivity.png", "runs.sqlite"])
     return 0
 
 
@@ -155,5 +155,6 @@ def run_size_effect_command(args) -> int:
     fit, series = size.computed, size.series
     text = "" if fit is None else f"; Bazant fit B f_t = {fit.B_ft:.4g} MPa, D0 = {fit.D0:.4g} mm"
     _say(args, "nominal strength [MPa]: " + ", ".join(f"D {D:g}: {s:.4g}" for D, s in zip(series.sizes, series.sigma_N))
-         + text + f"\nwrote in {out}: size_effect.csv, size_effect.json, size_effect.png")
+         + text)
+    _wrote(args, out, ["size_effect.csv", "size_effect.json", "size_effect.png"])
     return 0

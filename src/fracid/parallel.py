@@ -350,7 +350,8 @@ def run_batch(
     study : str
         Label stored with the runs.
     progress : None, bool or callable
-        ``None``: a one-line progress report on stderr if stderr is a terminal; ``False``: none;
+        ``None``: a one-line progress report on stderr if stderr is a terminal (else lines of text within
+        :func:`fracid.progress.progress_lines`, as the command line does); ``False``: none;
         ``True``: the report on stderr in any case; a callable: called as ``progress(done, total)``.
     stats : BatchStats, optional
         Filled in (overwritten) with the counters of this call.
@@ -385,7 +386,7 @@ def run_batch(
     keys = _check_store_and_keys(tasks, store, keys)
     stats = stats if stats is not None else BatchStats()
     stats._reset(len(tasks))
-    report = _progress_reporter(progress)
+    report = _progress_reporter(progress, stats)
     records: list = [None] * len(tasks)
 
     groups = _reuse_stored(records, store, keys, retry_failed, stats)
@@ -564,7 +565,11 @@ def _as_completed(executor, futures):
 # -- progress --------------------------------------------------------------------------------------
 
 
-def _progress_reporter(progress) -> Callable[[int, int], None]:
+def _progress_reporter(progress, stats: BatchStats | None = None) -> Callable[[int, int], None]:
+    from fracid.progress import batch_lines, lines_wanted
+
+    if lines_wanted(progress):  # stderr is not a terminal and the command line asked for lines
+        return batch_lines("forward runs", failed=(lambda: stats.failed) if stats is not None else None)
     if progress is None:
         progress = _stderr_is_terminal()
     if progress is True:

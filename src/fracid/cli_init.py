@@ -1,0 +1,324 @@
+"""``fracid init``: a commented configuration that runs as written, for a (specimen, model) pair.
+
+Every key of the specimen (the fields of its class in :data:`fracid.specimens.SPECIMENS`) and of the
+model's parameters (:data:`fracid.models.MODEL_TYPES`) is written with its value, and a comment with its
+default, unit, allowed values and meaning. The meanings are read from the numpydoc ``Parameters`` section
+of the classes' docstrings (:func:`numpydoc_parameters`), the ranges and units from the parameter classes.
+The notched beam with the gradient-damage model starts from the bundled demo (Grégoire et al. 2013): its
+values, its identification settings and its data file; the other pairs get an ``[[experiments]]`` block
+commented out, to fill in with the lab's file. The Gmsh mesh specimen is not offered: it needs the user's
+``.msh`` (README, "Your own specimen: a Gmsh mesh").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import re
+import sys
+import tomllib
+from pathlib import Path
+
+#: the parameters a first identification looks for, per ``[model] type`` (others: the two after E and nu)
+IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("kappa_i", "beta", "c"),
+              "local-damage": ("kappa_i", "beta"), "cohesive-crack": ("ft", "Gf"), "crack-band": ("ft", "Gf")}
+#: (specimen, model) whose configuration is the bundled demo's, with its data file
+DEMO_PAIR = ("notched-beam", "gradient-damage")
+_ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
+#: specimen fields changed from their defaults for a pair, and why (the written comment says so)
+PAIR_SPECIMEN = {("wedge-splitting", "crack-band"): ({"h_fine": 4.0}, "at h_fine = 5 the crack band stops converging "
+                                                      "after the peak (cmod 0.046 mm); 4 runs through")}
+#: comment column of the written ``key = value`` lines
+_COLUMN = 36
+
+_EXPERIMENT_COMMENTS = {
+    "file": "REPLACE with your data file (CSV with a header row; relative paths start from this file)",
+    "control_column": "the column of the control (CMOD, displacement ...)",
+    "control_unit": '"mm" | "um" | "m"',
+    "force_unit": '"N" | "kN" | "MN"',
+    "kind": '"repeats" (force_columns, >= 2) | "envelope" (mean/lower/upper columns) | "single" (one force column)',
+    "mean_column": "envelope: the mean force",
+    "lower_column": "envelope: the lowest force of the repeats (std = (upper - lower) / 4)",
+    "upper_column": "envelope: the highest force of the repeats",
+    "force_columns": 'repeats: >= 2 columns; single: one column and std = ... or relative_std = ...',
+    "std": "single: the standard deviation of every force value, in force_unit",
+    "n_points": "equally spaced control values taken from the curve (>= 3)",
+    "control_range": "[start, stop] in control_unit, 0 < start < stop",
+}
+#: the commented-out data block of the pairs without bundled data
+_EXPERIMENT_TEMPLATE = {"file": "my_test.csv", "control_column": "u_mm", "control_unit": "mm", "force_unit": "N",
+                        "kind": "single", "force_columns": ["F_N"], "std": 10.0, "n_points": 24}
+
+
+def numpydoc_parameters(cls) -> dict:
+    """The entries of the numpydoc ``Parameters`` section of ``cls``'s docstring.
+
+    Parameters
+    ----------
+    cls : type
+        A class whose docstring has a ``Parameters`` section.
+
+    Returns
+    -------
+    dict
+        name -> (type text, description on one line); an entry naming several fields
+        (``width, height : float``) gives each of them the shared description.
+    """
+    doc = inspect.getdoc(cls) or ""
+    match = re.search(r"^Parameters\n-+\n(.*?)(?:\n\n(?! )|\Z)", doc, re.S | re.M)
+    entries, names = {}, []
+    for line in (match.group(1).splitlines() if match else []):
+        if line and not line.startswith(" "):
+            names_text, _, kind = line.partition(" : ")
+            names = [n.strip() for n in names_text.split(",")]
+            for i, name in enumerate(names):
+                entries[name] = (kind.strip() if len(names) == 1 else
+                                 f"{kind.strip()}; {_ORDINALS[i]} of {', '.join(names)}", "")
+        elif names:
+            for name in names:
+                kind, text = entries[name]
+                entries[name] = (kind, f"{text} {line.strip()}".strip())
+    return entries
+
+
+def summary(cls) -> str:
+    """The first paragraph of ``cls``'s docstring, on one line."""
+    return " ".join((inspect.getdoc(cls) or "").split("\n\n")[0].split())
+
+
+def description(cls) -> list:
+    """The paragraphs of ``cls``'s docstring outside its numpydoc sections (Parameters, Examples ...),
+    each on one line."""
+    kept, skipping = [], False
+    for paragraph in (inspect.getdoc(cls) or "").split("\n\n"):
+        heading = re.match(r"[A-Z][a-z ]+\n-+\n", paragraph)
+        skipping = bool(heading) or (skipping and paragraph.startswith(" "))
+        if not skipping:
+            kept.append(" ".join(paragraph.split()))
+    return kept
+
+
+def runnable_pairs() -> list:
+    """The (specimen type, model type) pairs ``fracid init`` writes: every built-in specimen of
+    :data:`fracid.specimens.SPECIMENS` with every model of :data:`fracid.models.MODEL_TYPES` that
+    runs on its default instance (:func:`fracid.models.runs_on`)."""
+    from fracid.models import MODEL_TYPES, runs_on
+    from fracid.specimens import SPECIMENS
+
+    pairs = []
+    for kind, cls in SPECIMENS.items():
+        description = cls().describe()
+        pairs += [(kind, name) for name, make in MODEL_TYPES.items() if runs_on(make(), description)]
+    return pairs
+
+
+def toml_value(value) -> str:
+    """``value`` (number, string, bool or list of them) as TOML."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(value)
+
+
+def _line(key: str, value, comment: str = "", commented: bool = False) -> str:
+    text = f"{'# ' if commented else ''}{key} = {toml_value(value)}"
+    return f"{text.ljust(_COLUMN - 1)} # {comment}" if comment else text
+
+
+def _comments(text: str, width: int = 100) -> list:
+    """``text`` as ``#`` lines of at most ``width`` characters."""
+    lines, current = [], "#"
+    for word in text.split():
+        if len(current) + 1 + len(word) > width and current != "#":
+            lines.append(current)
+            current = "#"
+        current += " " + word
+    return lines + [current] if current != "#" else lines
+
+
+def _demo() -> dict:
+    from fracid.cli import demo_config_path
+
+    with open(demo_config_path(), "rb") as f:
+        return tomllib.load(f)
+
+
+def _model_lines(model_type: str, given: dict) -> list:
+    """``[model]`` and ``[model.parameters]``: every parameter with its unit, range and meaning."""
+    from fracid.models import model_from_type
+
+    cls = model_from_type(model_type).parameters
+    docs = numpydoc_parameters(cls)
+    lines = ["[model]", _line("type", model_type, "one of fracid.models.MODEL_TYPES"),
+             "[model.parameters]"] + _comments(summary(cls))
+    for field in dataclasses.fields(cls):
+        rng, meaning = cls.ranges[field.name], docs.get(field.name, ("", ""))[1]
+        value = given.get(field.name, field.default)
+        default = "" if value == field.default else f"default {field.default!r}; "
+        lines.append(_line(field.name, value, f"[{rng.unit}] {default}{rng.describe(field.name)}: {meaning}"))
+    return lines
+
+
+def _specimen_lines(kind: str, given: dict) -> list:
+    """``[specimen]``: the class's summary, then every field with its default and meaning (fields whose
+    default is None are written commented out: TOML has no null)."""
+    from fracid.specimens import SPECIMENS
+
+    cls = SPECIMENS[kind]
+    docs = numpydoc_parameters(cls)
+    lines = ["[specimen]"] + [line for paragraph in description(cls) for line in _comments(paragraph) + ["#"]] + [
+        _line("type", kind, " | ".join(SPECIMENS)),
+        _line("control", cls.controls[0], "one of " + ", ".join(cls.controls))]
+    for field in dataclasses.fields(cls):
+        kind_text, meaning = docs.get(field.name, (str(field.type), ""))
+        value = given.get(field.name, field.default)
+        note = "" if value == field.default else f"default {field.default!r}; "
+        if value is None:
+            lines.append(f"# {field.name} = ".ljust(_COLUMN - 1) + f" # ({kind_text}) default None: {meaning}")
+        else:
+            lines.append(_line(field.name, value, f"({kind_text}) {note}{meaning}"))
+    return lines
+
+
+def _experiment_lines(experiment: dict | None) -> list:
+    """One ``[[experiments]]`` block: the demo's (active) or a template (commented out)."""
+    commented = experiment is None
+    block = _EXPERIMENT_TEMPLATE if commented else experiment
+    lines = ["# the measured curve: without it only `fracid simulate` runs; uncomment and fill in to identify"
+             if commented else "# the measured curve (README, Configuration: the other keys of a data block)",
+             ("# " if commented else "") + "[[experiments]]"]
+    return lines + [_line(key, value, _EXPERIMENT_COMMENTS.get(key, ""), commented) for key, value in block.items()]
+
+
+def _bounds(cls, name: str, value: float) -> list:
+    """Bounds around ``value``: a factor 3 each way, inside the usual range and the valid one."""
+    from fracid.models import USUAL_RANGES
+
+    low, high = cls.valid_bounds([name])
+    usual = USUAL_RANGES.get(name, (-float("inf"), float("inf")))
+    lower = max(value / 3.0, usual[0], float(low[0]))
+    upper = min(value * 3.0, usual[1], float(high[0]))
+    return [float(f"{lower:.3g}"), float(f"{upper:.3g}")]
+
+
+def _identify_lines(model_type: str, demo: dict | None, params) -> list:
+    """``[identify]``: the demo's, or the pair's usual parameters with bounds from their ranges."""
+    if demo is not None:
+        names, bounds = demo["parameters"], {k: v for k, v in demo["bounds"].items() if k != "log"}
+        log, n, k, groups = demo["bounds"].get("log", []), demo["knn"]["n"], demo["knn"]["k"], demo["kalman"]["groups"]
+    else:
+        names = list(IDENTIFIED.get(model_type, params.names()[2:4]))
+        bounds = {name: _bounds(type(params), name, getattr(params, name)) for name in names}
+        log, n, k, groups = [name for name in names if name == "beta"], 32, 5, 4
+    return ["[identify]                          # for `fracid identify` (needs [[experiments]])",
+            _line("parameters", names, "identified; the others keep their [model.parameters] value"),
+            "[identify.bounds]                   # [lower, upper], inside the valid range of each"] + [
+        _line(name, bounds[name], f"valid: {type(params).ranges[name].describe(name)}") for name in names] + [
+        _line("log", log, "sampled uniformly in log(x)"),
+        "[identify.knn]", _line("n", n, "population of forward runs (the bulk of the cost)"),
+        _line("method", "sobol", '"sobol" | "lhs" | "grid"'), _line("k", k, "neighbours giving the Kalman prior"),
+        "[identify.kalman]", _line("groups", groups, "filter steps per pass (one run each with exact sensitivities)"),
+        _line("max_iterations", 10, "passes at most")]
+
+
+def _tail_lines() -> list:
+    return ["[simulate]                          # optional",
+            _line("target", 0.3, "final control value [mm]; omit for the specimen's default", commented=True),
+            _line("stop_force_fraction", 0.1, "stop below this fraction of the peak force"),
+            _line("damage_threshold", 0.0, "damage counted in the zone widths (fpz_width ...)"),
+            "", "[output]",
+            _line("directory", "results", "relative to this file (or --out DIR)"),
+            _line("vtk_steps", [], "simulate: steps whose fields go to VTK (with meshio), the last one always")]
+
+
+def _start_values(specimen: str, model: str) -> tuple:
+    """The values written instead of the defaults: ([model.parameters], [specimen] fields, notes saying why).
+    On the notched beam, the demo's mesh (a run in seconds) and, for the demo's model, its values (fitted
+    to the Gregoire beam; the integral model's neighbourhood at c = 9 mm^2 would make a run last a minute)."""
+    params, shape, notes = {}, {}, []
+    if specimen == DEMO_PAIR[0]:
+        demo = _demo()
+        shape = {k: v for k, v in demo["specimen"].items() if k not in ("type", "control")}
+        notes.append("The mesh is the bundled demo's (h_fine, h_coarse: a run in seconds).")
+        if model == DEMO_PAIR[1]:
+            params = demo["model"]["parameters"]
+            notes.append("The parameter values are those of the demo, fitted to the Gregoire et al. (2013) beam.")
+    if (specimen, model) in PAIR_SPECIMEN:
+        changes, why = PAIR_SPECIMEN[specimen, model]
+        shape = {**shape, **changes}
+        notes.append(f"Specimen: {why}.")
+    return params, shape, notes
+
+
+def config_text(specimen: str, model: str) -> str:
+    """The configuration ``fracid init --specimen SPECIMEN --model MODEL`` writes.
+
+    Parameters
+    ----------
+    specimen, model : str
+        A pair of :func:`runnable_pairs`.
+
+    Returns
+    -------
+    str
+        A TOML configuration that :func:`fracid.config.load_config` accepts and ``fracid simulate`` runs
+        (``fracid identify`` too for the demo pair, whose data file is the bundled one).
+    """
+    from fracid.cli import demo_config_path
+    from fracid.models import model_from_type
+
+    demo = _demo() if (specimen, model) == DEMO_PAIR else None
+    given, shape, notes = _start_values(specimen, model)
+    params = model_from_type(model).parameters(**given)
+    experiment = None
+    if demo:
+        experiment = {**demo["experiments"][0], "file": str(demo_config_path().parent / demo["experiments"][0]["file"])}
+    head = [f"# fracid configuration: {model} on the {specimen} (written by `fracid init`).",
+            f"# Check it: fracid check FILE; run it: fracid simulate FILE, fracid identify FILE.",
+            "# Units: N, mm, MPa. Every key is shown with its value; the comment gives the default,",
+            "# the unit and the allowed values. README, Configuration, documents every section.", ""]
+    head[-1:] = [line for note in notes for line in _comments(note)] + [""]
+    sections = [_model_lines(model, given), _specimen_lines(specimen, shape),
+                _experiment_lines(experiment), _identify_lines(model, demo and demo["identify"], params),
+                _tail_lines()]
+    return "\n".join(head + [line for section in sections for line in section + [""]])
+
+
+def run_init(args) -> int:
+    """``fracid init``: print or write the configuration (``-o FILE``, not over an existing file unless
+    ``--force``), or list the pairs (``--list``)."""
+    from fracid.exits import UsageError
+
+    pairs = runnable_pairs()
+    if args.list:
+        print("\n".join(f"--specimen {s} --model {m}" for s, m in pairs))
+        return 0
+    if (args.specimen, args.model) not in pairs:
+        raise UsageError(f"--specimen {args.specimen} --model {args.model}: no configuration for this pair; "
+                         "`fracid init --list` gives those that run (a Gmsh mesh: README, 'Your own specimen')")
+    text = config_text(args.specimen, args.model)
+    if args.output is None:
+        sys.stdout.write(text)
+        return 0
+    path = Path(args.output).expanduser()
+    if path.is_dir():
+        raise UsageError(f"-o {path}: a directory; give a file name such as {path / 'fracid.toml'}")
+    if (path.exists() or path.is_symlink()) and not args.force:
+        raise UsageError(f"-o {path}: the file exists; fracid init does not overwrite it (give --force to replace it)")
+    path.write_text(text, encoding="utf-8")
+    print(f"wrote {path}: check it with `fracid check {path}`", file=sys.stderr)
+    return 0
+
+
+def add_parser(sub) -> None:
+    """The ``init`` subcommand's arguments."""
+    p = sub.add_parser("init", help="write a commented configuration to start from")
+    p.add_argument("--specimen", default=DEMO_PAIR[0], help=f"specimen type (default {DEMO_PAIR[0]})")
+    p.add_argument("--model", default=DEMO_PAIR[1], help=f"model type (default {DEMO_PAIR[1]})")
+    p.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
+    p.add_argument("--force", action="store_true", help="replace an existing -o file")
+    p.add_argument("--list", action="store_true", help="list the (specimen, model) pairs")
+    p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
