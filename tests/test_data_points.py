@@ -4,8 +4,7 @@ measured points themselves, decimated by arc length to n_points (the ends and th
 import numpy as np
 import pytest
 
-from fracid.data import Curve, DataError, from_envelope, from_repeats, gregoire2013_beam4, with_std
-from fracid.data.experimental import decimate
+from fracid.data import Curve, DataError, decimate, from_envelope, from_repeats, gregoire2013_beam4, with_std
 
 
 def softening_curve(n=400, peak_at=0.0237, source="test"):
@@ -85,3 +84,15 @@ def test_bad_sampling_is_refused():
         with_std(curve, 5.0, 20, sampling="measure")
     with pytest.raises(DataError, match="fewer than 2 measured points"):
         with_std(curve, 5.0, 20, (0.10001, 0.10002), sampling="measured")
+
+
+def test_the_sampling_names_are_importable_where_they_were():
+    """The sampling moved to fracid.data.sampling; fracid.data.experimental still exports what it did."""
+    import fracid.data as data
+    from fracid.data import dataset, experimental, sampling
+
+    assert experimental.SAMPLINGS is sampling.SAMPLINGS is data.SAMPLINGS == ("equally-spaced", "measured")
+    assert experimental.decimate is sampling.decimate is data.decimate
+    assert experimental.sample_points is sampling.sample_points is data.sample_points
+    assert experimental.ExperimentalData is dataset.ExperimentalData is data.ExperimentalData
+    assert experimental.stack is dataset.stack is data.stack

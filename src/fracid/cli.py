@@ -231,7 +231,19 @@ def _identification(args, job, store, executor):
     result = identify_data(job.operator, job.data, job.space, executor=executor, store=store,
                            progress=_progress(args), retry_failed=args.retry_failed, **job.settings)
     result.runs["wall_seconds"] = time.perf_counter() - start
+    result.provenance = provenance(args, job.cfg, job.operator, job.space, store)
     return result
+
+
+def provenance(args, cfg, operator, space, store=None) -> dict:
+    """How this run was made (:func:`fracid.provenance.collect`), also kept in the run store's meta table."""
+    from fracid.provenance import collect
+
+    record = collect(argv=getattr(args, "argv", ["fracid"]), config=cfg, data_files=[e.file for e in cfg.experiments],
+                     specimen=operator.observations[0].specimen, parameters=operator.base, bounds=space)
+    if store is not None:
+        store.put_meta(f"provenance:{args.command}", record)
+    return record
 
 
 def _write_identification(args, job, out, result) -> None:
@@ -294,7 +306,7 @@ def run_posterior_command(args) -> int:
         evaluate = StoredOperator(job.operator, store, study="posterior", retry_failed=args.retry_failed)
         post = sample_posterior(evaluate, job.data, job.space, result, settings, executor=executor,
                                 progress=_progress(args), log=lambda text: _say(args, text))
-    written = write_posterior(out, post, data=job.data, fit=result.y_fit,
+    written = write_posterior(out, post, data=job.data, fit=result.y_fit, provenance=result.provenance,
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     _say(args, post.summary())
     _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
@@ -346,6 +358,7 @@ def main(argv=None) -> int:
     with exits.stop_signals():
         try:
             args = _parser().parse_args(argv)
+            args.argv = ["fracid", *(sys.argv[1:] if argv is None else argv)]
             if getattr(args, "workers", None) is not None and args.workers < 1:
                 print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
                 return exits.INPUT

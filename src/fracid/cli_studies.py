@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli import _executor, _load, _out_dir, _progress, _say, _warn, _working_in, _wrote
+from fracid.cli import provenance, _executor, _load, _out_dir, _progress, _say, _warn, _working_in, _wrote
 
 
 def run(args) -> int:
@@ -86,13 +86,14 @@ def run_study_command(args) -> int:
                           retry_failed=args.retry_failed)
         size = None
         if args.command == "study" and not _has_size(cfg):
-            _say(args, "size effect: skipped (the specimen declares no characteristic size and nominal "
-                       "section: a mesh specimen has none)")
+            _say(args, f"size effect: skipped (the specimen {cfg.specimen.type!r} declares no characteristic size "
+                       "and nominal section)")
         elif args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
+        record = provenance(args, cfg, operator, space, store)
     if size is not None:
         size.save(out)
-    written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}",
+    written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}", provenance=record,
                           size_effect=size.figure_arguments() if size is not None else None)
     _say(args, study.summary())
     _wrote(args, out, [p if isinstance(p, str) else Path(p).relative_to(out).as_posix() for p in written])
@@ -141,7 +142,8 @@ def run_size_effect_command(args) -> int:
     cfg = _load(args, args.config, "simulate")
     if not _has_size(cfg):
         print(f"fracid: size-effect: the specimen {type(build_specimen(cfg)).__name__} declares no characteristic size "
-              "and nominal section (a mesh specimen has none): use a built-in specimen", file=sys.stderr)
+              "and nominal section (a Gmsh mesh or the wedge-splitting test has none): use a notched beam, a dog-bone or "
+              "a bar", file=sys.stderr)
         return 2
     out = _out_dir(args, cfg)
     with _working_in(args, out), _executor(args) as executor:

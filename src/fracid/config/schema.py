@@ -185,9 +185,9 @@ _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
 _POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
 _ROLES = ("calibration", "prediction")
-#: Kalman steps per pass when [identify.kalman] groups is not given. One observation per step costs
-#: 2 p + 1 partial runs per observation (a 30-point curve: over 100 full-run equivalents per pass);
-#: with linearised restarts the later passes use one linearisation each whatever the grouping.
+#: Kalman steps per pass when [identify.kalman] groups is not given. A step costs one run (with exact
+#: sensitivities) up to its last observation, so one observation per step would cost a 30-point curve about
+#: 15 full-run equivalents per pass; with linearised restarts the later passes use one run each.
 DEFAULT_KALMAN_GROUPS = 4
 
 

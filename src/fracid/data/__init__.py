@@ -16,24 +16,25 @@ from fracid.data.curves import (
     read_curve_csv,
     require_positive_force,
 )
+from fracid.data.dataset import ExperimentalData, stack
 from fracid.data.experimental import (
-    ExperimentalData,
     from_envelope,
     from_repeats,
     gregoire2013_beam4,
     gregoire2013_beam4_path,
     local_block,
-    sample_points,
-    stack,
     with_std,
 )
+from fracid.data.sampling import SAMPLINGS, decimate, sample_points
 
 __all__ = [
     "Curve",
     "DataError",
     "DataTypeError",
     "ExperimentalData",
+    "SAMPLINGS",
     "curve_from_arrays",
+    "decimate",
     "from_envelope",
     "from_repeats",
     "gregoire2013_beam4",

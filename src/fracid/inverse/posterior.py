@@ -205,7 +205,7 @@ class PosteriorResult:
 
     def summary(self) -> str:
         lines = [f"posterior: {len(self.x)} draws in {self.rounds} rounds, ESS {self.ess:.0f}, "
-                 f"{self.failed} failed runs; {self.status}"]
+                 f"{self.failed} failed run{'' if self.failed == 1 else 's'}; {self.status}"]
         if self.sampling_failed:
             return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
         intervals = self.credible_intervals(0.9)

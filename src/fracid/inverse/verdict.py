@@ -218,7 +218,8 @@ def parameter_verdicts(names, x, C, C_prior, *, data: DataDescription = DataDesc
             status = "correlated" if status == "identified" and others else status
         if stability is not None and stability.ok.sum() >= 2:
             remarks.append(f"scatter under noise: {stability.relative_scatter[j]:.1%} "
-                           f"({stability.amplification[j]:.1f} x the data noise {stability.noise_level:.1%})")
+                           f"({stability.amplification[j]:.1f} x the data noise, whose std is {stability.noise_level:.1%} "
+                           "of the measured values in RMS)")
         suggestions = () if status == "identified" else _suggestions(data)
         interval = () if intervals is None else (float(intervals[j, 0]), float(intervals[j, 1]))
         verdicts.append(ParameterVerdict(name, status, float(value[j]), float(std[j]), float(conditional[j]),

@@ -1,6 +1,6 @@
 """Fields of a damage analysis as a VTK unstructured grid (.vtu) for ParaView.
 
-Optional dependency: meshio (``pip install 'fracid[vtk]'``), imported when writing.
+meshio (a core dependency) is imported when writing.
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def write_vtk(
     try:
         import meshio
     except ImportError as err:
-        raise ImportError("writing VTK files needs meshio: pip install 'fracid[vtk]'") from err
+        raise ImportError("writing VTK files needs meshio, a dependency of fracid: pip install meshio") from err
     if cell_type not in _CELL_TYPES:
         raise ValueError(f"cell_type = {cell_type!r}; supported: {sorted(_CELL_TYPES)}")
     nodes = np.asarray(nodes, dtype=float)

@@ -1,5 +1,5 @@
 """The user's own plane-stress specimen: a Gmsh mesh whose physical groups name the supports, the loaded
-edge or point, symmetry lines and the measuring points (read with meshio, the ``vtk`` extra).
+edge or point, symmetry lines and the measuring points (read with meshio).
 
 The mesh may be linear or quadratic, of triangles or quadrilaterals (one family per mesh): only the
 element corners are read, and fracid adds the mid-edge nodes of its quadratic elements (T6 with linear

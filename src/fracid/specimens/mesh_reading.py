@@ -78,7 +78,7 @@ def _meshio_mesh(path, mtime, size) -> tuple:
     try:
         import meshio
     except ImportError as err:
-        raise ImportError(f"reading {path} needs meshio: pip install 'fracid[vtk]' ({err})") from err
+        raise ImportError(f"reading {path} needs meshio, a dependency of fracid: pip install meshio ({err})") from err
     raw = _meshio_read(meshio, path)
     return raw.points, [(block.type, block.data) for block in raw.cells], _physical_groups(raw)
 
