@@ -25,16 +25,18 @@ Every expected failure ends with a one-paragraph message and a documented exit s
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
 import time
 import traceback
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
+from fracid.cli_common import (command_executor, demo_config_path, load, out_dir, plural, progress_choice, provenance,
+                               say, warn, working_in, wrote)
 from fracid.progress import progress_lines
+
+__all__ = ["demo_config_path", "main", "provenance", "version"]
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -80,115 +82,20 @@ def version() -> str:
         return __version__
 
 
-def demo_config_path() -> Path:
-    """The bundled demo configuration (next to the Gregoire data)."""
-    return Path(str(resources.files("fracid.data") / "gregoire2013_beam4" / "demo.toml"))
-
-
-def _say(args, text):
-    if not args.quiet:
-        print(text, flush=True)
-
-
-def _wrote(args, out, names):
-    """Say which files a command wrote into ``out``: the names, those of a subdirectory counted when many."""
-    groups = {}
-    for name in map(str, names):
-        folder, _, _ = name.rpartition("/")
-        groups.setdefault(folder, []).append(name)
-    shown = [name for folder, items in groups.items()
-             for name in (items if len(items) <= 3 or not folder else [f"{folder}/ ({len(items)} files)"])]
-    _say(args, f"wrote in {out}: " + ", ".join(shown))
-
-
-def _warn(text):
-    print(f"fracid: warning: {text}", file=sys.stderr, flush=True)
-
-
-def _load(args, path, purpose):
-    from fracid.config import load_config
-
-    cfg = load_config(path, purpose=purpose)
-    for text in cfg.warnings:
-        _warn(text)
-    return cfg
-
-
-def _out_dir(args, cfg) -> Path:
-    """The output directory, made if needed, once the command's outputs are known to replace neither an
-    input of the run nor a file fracid did not write (:func:`fracid.outputs.claim_outputs`)."""
-    from fracid.outputs import claim_outputs
-
-    out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
-    if out.exists() and not out.is_dir():
-        raise NotADirectoryError(20, "not a directory", str(out))
-    out.mkdir(parents=True, exist_ok=True)
-    claim_outputs(out, args.command, _inputs(cfg))
-    args.out_dir = out
-    return out
-
-
-def _inputs(cfg):
-    """(what it is, path) of every file the run reads: the configuration, the data files, a mesh."""
-    yield "the configuration", Path(cfg.path)
-    for exp in cfg.experiments:
-        yield f"experiments[{exp.index}].file", Path(exp.file)
-    mesh = dict(cfg.specimen.options).get("path")
-    if mesh is not None:
-        yield "specimen.file", Path(mesh)
-
-
-@contextlib.contextmanager
-def _working_in(args, out, store=False):
-    """The output directory's lock, and (``store``) its run store; the store's path goes to messages."""
-    from fracid.lock import directory_lock
-    from fracid.store import RunStore
-
-    with directory_lock(out):
-        if not store:
-            yield None
-            return
-        args.store_path = out / "runs.sqlite"
-        with RunStore(args.store_path) as runs:
-            yield runs
-
-
-def _progress(args):
-    return False if args.quiet else None
-
-
-@contextlib.contextmanager
-def _executor(args):
-    """The executor of --workers / --scheduler; an unusable option is named (exit 2)."""
-    from fracid.exits import UsageError
-    from fracid.parallel import executor_session
-
-    if args.scheduler is not None and args.workers is not None:
-        raise UsageError(f"--workers {args.workers} and --scheduler {args.scheduler}: give one of them (the Dask "
-                         "cluster has its own workers)")
-    stack = contextlib.ExitStack()
-    try:
-        executor = stack.enter_context(executor_session(args.workers, args.scheduler))
-    except (ValueError, ImportError, OSError) as err:
-        raise UsageError(f"--scheduler {args.scheduler}: cannot use this Dask scheduler ({err}); give its address "
-                         "as tcp://host:port, with the dask extra installed (pip install 'fracid[dask]')") from None
-    with stack:
-        yield executor
-
-
 def run_simulate(args) -> int:
     from fracid.config import build_model, build_parameters, build_specimen, simulate_settings
     from fracid.progress import progress_bar
     from fracid.report.figures import curve_figure, to_png
 
-    cfg = _load(args, args.config, "simulate")
+    cfg = load(args, args.config, "simulate")
     model, specimen, params = build_model(cfg), build_specimen(cfg), build_parameters(cfg)
     settings = simulate_settings(cfg)
     settings.pop("regularization", None)  # the model carries its own
     if settings.get("target") is None:
         settings["target"] = model.default_target(specimen, params)
-    out = _out_dir(args, cfg)
-    with _working_in(args, out), progress_bar(settings["target"], "forward analysis", _progress(args), unit="mm") as bar:
+    out = out_dir(args, cfg)
+    with (working_in(args, out),
+          progress_bar(settings["target"], "forward analysis", progress_choice(args), unit="mm") as bar):
         result = model.simulate(specimen, params, callback=lambda step, tau, force: bar.update(tau - bar.n),
                                 **settings)
     columns = {result.control_name: result.control, "force_N": result.force, **result.observables}
@@ -203,10 +110,10 @@ def run_simulate(args) -> int:
         written += [p.relative_to(out).as_posix() for p in write_result_vtk(out / "vtk", specimen, result)]
     except ImportError as err:
         if cfg.output.vtk_steps:  # asked for; the last step alone is a bonus, skipped silently
-            _warn(f"[output] vtk_steps: VTK output skipped: {err}")
-    _say(args, f"peak force {result.peak_force:.6g} N; {result.status}; {result.stats.steps} steps, "
-               f"{result.stats.time_total:.1f} s")
-    _wrote(args, out, written)
+            warn(f"[output] vtk_steps: VTK output skipped: {err}")
+    say(args, f"peak force {result.peak_force:.6g} N; {result.status}; {result.stats.steps} steps, "
+              f"{result.stats.time_total:.1f} s")
+    wrote(args, out, written)
     return 0
 
 
@@ -216,7 +123,7 @@ def _identify_job(args, config_path):
 
     from fracid.config import build_data, build_operator, build_space, identify_settings
 
-    cfg = _load(args, config_path, "identify")
+    cfg = load(args, config_path, "identify")
     data = build_data(cfg)
     return SimpleNamespace(cfg=cfg, data=data, operator=build_operator(cfg, data), space=build_space(cfg),
                            settings=identify_settings(cfg))
@@ -226,24 +133,13 @@ def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
     from fracid.inverse.strategy import identify_data
 
-    _say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
+    say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
     start = time.perf_counter()
     result = identify_data(job.operator, job.data, job.space, executor=executor, store=store,
-                           progress=_progress(args), retry_failed=args.retry_failed, **job.settings)
+                           progress=progress_choice(args), retry_failed=args.retry_failed, **job.settings)
     result.runs["wall_seconds"] = time.perf_counter() - start
     result.provenance = provenance(args, job.cfg, job.operator, job.space, store)
     return result
-
-
-def provenance(args, cfg, operator, space, store=None) -> dict:
-    """How this run was made (:func:`fracid.provenance.collect`), also kept in the run store's meta table."""
-    from fracid.provenance import collect
-
-    record = collect(argv=getattr(args, "argv", ["fracid"]), config=cfg, data_files=[e.file for e in cfg.experiments],
-                     specimen=operator.observations[0].specimen, parameters=operator.base, bounds=space)
-    if store is not None:
-        store.put_meta(f"provenance:{args.command}", record)
-    return record
 
 
 def _write_identification(args, job, out, result) -> None:
@@ -261,21 +157,21 @@ def _write_identification(args, job, out, result) -> None:
     write_report(out / "report.html", result, control=data.control,
                  title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes)
     _write_figures(out / "figures", result, data.control)
-    _say(args, result.summary())
+    say(args, result.summary())
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
                         for stage, c in result.stage_runs().items())
-    _say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {stages}; "
-               f"{result.runs['wall_seconds']:.0f} s")
+    say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {stages}; "
+              f"{result.runs['wall_seconds']:.0f} s")
     figures_written = sorted(p.relative_to(out).as_posix() for p in (out / "figures").glob("*.png"))
-    _wrote(args, out, ["result.json", "fit.csv", "report.html", *figures_written, "runs.sqlite"])
+    wrote(args, out, ["result.json", "fit.csv", "report.html", *figures_written, "runs.sqlite"])
     for text in result.warnings():
-        _warn(text)
+        warn(text)
 
 
 def run_identify(args, config_path=None) -> int:
     job = _identify_job(args, config_path or args.config)
-    out = _out_dir(args, job.cfg)
-    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+    out = out_dir(args, job.cfg)
+    with working_in(args, out, store=True) as store, command_executor(args) as executor:
         result = _identification(args, job, store, executor)
     _write_identification(args, job, out, result)
     if not np.all(np.isfinite(result.x)) or not np.all(np.isfinite(result.y_fit)):
@@ -295,8 +191,8 @@ def run_posterior_command(args) -> int:
 
     job = _identify_job(args, args.config)
     settings = posterior_settings(job.cfg)
-    out = _out_dir(args, job.cfg)
-    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+    out = out_dir(args, job.cfg)
+    with working_in(args, out, store=True) as store, command_executor(args) as executor:
         result = _identification(args, job, store, executor)
         _write_identification(args, job, out, result)
         if not (np.all(np.isfinite(result.x)) and np.all(np.isfinite(result.C))):
@@ -305,19 +201,19 @@ def run_posterior_command(args) -> int:
             return FAILED
         evaluate = StoredOperator(job.operator, store, study="posterior", retry_failed=args.retry_failed)
         post = sample_posterior(evaluate, job.data, job.space, result, settings, executor=executor,
-                                progress=_progress(args), log=lambda text: _say(args, text))
+                                progress=progress_choice(args), log=lambda text: say(args, text))
     written = write_posterior(out, post, data=job.data, fit=result.y_fit, provenance=result.provenance,
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
-    _say(args, post.summary())
-    _say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
-               f"the run store, {post.failed} failed)")
-    _wrote(args, out, written)
+    say(args, post.summary())
+    say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
+              f"the run store, {post.failed} failed)")
+    wrote(args, out, written)
     if post.sampling_failed:
         print(f"fracid: posterior {post.status}. The draws are in {out / 'posterior.csv'}, without credible "
               "intervals.", file=sys.stderr)
         return FAILED
     if not post.converged:
-        _warn(f"posterior: {post.status}")
+        warn(f"posterior: {post.status}")
     return 0
 
 
@@ -327,14 +223,9 @@ def _stage_costs(settings, n_y, p, operator=None) -> str:
 
     cost = kalman_cost(operator, settings, n_y, p)
     return (f"KNN: {settings['n']} forward runs. Kalman filter: {cost['steps']} steps per pass "
-            f"({_plural(cost['per_step'], 'run')} per step: {cost['how']}); the first pass costs about "
+            f"({plural(cost['per_step'], 'run')} per step: {cost['how']}); the first pass costs about "
             f"{cost['first']:.0f} full-curve runs, each later one {cost['later']}, at most {cost['passes']} passes, then "
             f"{cost['final']} at the estimate ([identify.kalman] groups, max_iterations).")
-
-
-def _plural(count, noun) -> str:
-    """``"1 run"``, ``"2 runs"``."""
-    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def _write_figures(directory: Path, result, control) -> None:

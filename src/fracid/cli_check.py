@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli import _load, _plural, _warn
+from fracid.cli_common import load, plural, warn
 
 #: one forward run slower than this [s] is warned about
 SLOW_RUN = 30.0
@@ -131,9 +131,9 @@ def plan_lines(cfg, plan) -> list:
     """The stages of the identification and their forward runs; what ``fracid posterior`` adds."""
     cost, knn = plan["cost"], cfg.identify.knn
     lines = [f"stage KNN: {plan['knn']} forward runs side by side ({knn.method}, k = {knn.k}; [identify.knn] n)",
-             f"stage Kalman filter: {cost['steps']} steps per pass, {_plural(cost['per_step'], 'run')} per step "
+             f"stage Kalman filter: {cost['steps']} steps per pass, {plural(cost['per_step'], 'run')} per step "
              f"({cost['how']}), at most {cost['passes']} passes and a run at the estimate: at most "
-             f"{_plural(plan['kalman'], 'run')} one after another without backtracking, "
+             f"{plural(plan['kalman'], 'run')} one after another without backtracking, "
              f"about {plan['kalman_full']:.0f} full-curve runs ([identify.kalman] groups, max_iterations)"]
     post = cfg.posterior
     lines.append(f"fracid posterior adds at most {post.samples_per_round * post.max_rounds} runs "
@@ -164,8 +164,8 @@ def time_lines(cfg, seconds, plan, workers) -> list:
     """The time estimate, and a warning for a slow run or plan naming the key that makes it so."""
     lines = [f"time: one forward run at [model.parameters] took {seconds:.1f} s"]
     if seconds > SLOW_RUN:
-        _warn(f"one forward run takes {seconds:.0f} s (over {SLOW_RUN:.0f} s): the mesh makes it so "
-              f"({mesh_key(cfg)}); a coarser mesh runs faster, if it still resolves the process zone")
+        warn(f"one forward run takes {seconds:.0f} s (over {SLOW_RUN:.0f} s): the mesh makes it so "
+             f"({mesh_key(cfg)}); a coarser mesh runs faster, if it still resolves the process zone")
     if plan is None:
         return lines
     knn_s = math.ceil(plan["knn"] / workers) * seconds
@@ -176,9 +176,9 @@ def time_lines(cfg, seconds, plan, workers) -> list:
     if total > SLOW_PLAN:
         key = (f"[identify.knn] n = {cfg.identify.knn.n}" if knn_s >= kalman_s else
                "[identify.kalman] groups and max_iterations")
-        _warn(f"the identification may take {_duration(total)} (over {_duration(SLOW_PLAN)}) on {workers} worker(s): "
-              f"mostly because of {key}, with each run taking {seconds:.1f} s ({mesh_key(cfg)}); --workers or a "
-              "Dask cluster (--scheduler) shares the KNN stage")
+        warn(f"the identification may take {_duration(total)} (over {_duration(SLOW_PLAN)}) on {workers} worker(s): "
+             f"mostly because of {key}, with each run taking {seconds:.1f} s ({mesh_key(cfg)}); --workers or a "
+             "Dask cluster (--scheduler) shares the KNN stage")
     return lines
 
 
@@ -196,7 +196,7 @@ def run_check(args) -> int:
     from fracid.config import identify_settings
     from fracid.parallel import available_cores
 
-    cfg = _load(args, args.config, "simulate")  # [[experiments]] and [identify] validated when present
+    cfg = load(args, args.config, "simulate")  # [[experiments]] and [identify] validated when present
     purpose = "identify" if cfg.experiments and cfg.identify is not None else "simulate"
     model, params = build_model(cfg), build_parameters(cfg)
     lines = [f"configuration {cfg.path}: valid (for fracid {purpose}{' and simulate' if purpose == 'identify' else ''})"]

@@ -140,7 +140,7 @@ def _comments(text: str, width: int = 100) -> list:
 
 
 def _demo() -> dict:
-    from fracid.cli import demo_config_path
+    from fracid.cli_common import demo_config_path
 
     with open(demo_config_path(), "rb") as f:
         return tomllib.load(f)
@@ -267,7 +267,7 @@ def config_text(specimen: str, model: str) -> str:
         A TOML configuration that :func:`fracid.config.load_config` accepts and ``fracid simulate`` runs
         (``fracid identify`` too for the demo pair, whose data file is the bundled one).
     """
-    from fracid.cli import demo_config_path
+    from fracid.cli_common import demo_config_path
     from fracid.models import model_from_type
 
     demo = _demo() if (specimen, model) == DEMO_PAIR else None

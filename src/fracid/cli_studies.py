@@ -1,7 +1,7 @@
 """The ``fracid`` commands that study the identification rather than make it: ``study`` (and its parts
 ``uniqueness`` and ``stability``), ``sensitivity`` and ``size-effect``. :func:`fracid.cli.main` dispatches
 here; the shared plumbing (loading, output directory and run store, executor, messages) is in
-:mod:`fracid.cli`.
+:mod:`fracid.cli_common`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli import provenance, _executor, _load, _out_dir, _progress, _say, _warn, _working_in, _wrote
+from fracid.cli_common import (command_executor, load, out_dir, progress_choice, provenance, say, warn, working_in,
+                               wrote)
 
 
 def run(args) -> int:
@@ -72,22 +73,22 @@ def run_study_command(args) -> int:
     from fracid.inverse.study import StudySettings, run_study
     from fracid.report.study import write_study
 
-    cfg = _load(args, args.config, "identify")
+    cfg = load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     settings = StudySettings().replace(**{**study_settings(cfg), **_STUDY_PARTS[args.command]})
     if cfg.study.posterior and settings.posterior is None:
-        _say(args, f"posterior: skipped ([study] posterior = true is for `fracid study`, not `fracid {args.command}`)")
+        say(args, f"posterior: skipped ([study] posterior = true is for `fracid study`, not `fracid {args.command}`)")
     held_out = build_held_out(cfg) if args.command == "study" else []
-    out = _out_dir(args, cfg)
-    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+    out = out_dir(args, cfg)
+    with working_in(args, out, store=True) as store, command_executor(args) as executor:
         study = run_study(operator, data, space, settings, held_out=held_out, executor=executor, store=store,
-                          progress=_progress(args), log=lambda text: _say(args, text),
+                          progress=progress_choice(args), log=lambda text: say(args, text),
                           retry_failed=args.retry_failed)
         size = None
         if args.command == "study" and not _has_size(cfg):
-            _say(args, f"size effect: skipped (the specimen {cfg.specimen.type!r} declares no characteristic size "
-                       "and nominal section)")
+            say(args, f"size effect: skipped (the specimen {cfg.specimen.type!r} declares no characteristic size "
+                      "and nominal section)")
         elif args.command == "study":
             size = _size_effect(cfg, operator.parameters(study.identification.x), executor, quiet=args.quiet)
         record = provenance(args, cfg, operator, space, store)
@@ -95,14 +96,14 @@ def run_study_command(args) -> int:
         size.save(out)
     written = write_study(out, study, data, title=f"fracid study: {Path(cfg.path).name}", provenance=record,
                           size_effect=size.figure_arguments() if size is not None else None)
-    _say(args, study.summary())
-    _wrote(args, out, [p if isinstance(p, str) else Path(p).relative_to(out).as_posix() for p in written])
+    say(args, study.summary())
+    wrote(args, out, [p if isinstance(p, str) else Path(p).relative_to(out).as_posix() for p in written])
     for text in study.identification.warnings():
-        _warn(text)
+        warn(text)
     if study.posterior is not None and not study.posterior.converged:
-        _warn(f"posterior: {study.posterior.status}")
+        warn(f"posterior: {study.posterior.status}")
     elif settings.posterior is not None and study.posterior is None:
-        _warn("posterior: not sampled (see the notes of verdict.txt); the verdict reads the Gaussian std")
+        warn("posterior: not sampled (see the notes of verdict.txt); the verdict reads the Gaussian std")
     return 0
 
 
@@ -113,13 +114,13 @@ def run_sensitivity_command(args) -> int:
     from fracid.inverse.uniqueness import bounds_covariance
     from fracid.report.figures import sensitivity_figure, to_png
 
-    cfg = _load(args, args.config, "identify")
+    cfg = load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     params = build_parameters(cfg)
     x = np.array([getattr(params, n) for n in space.names])
-    out = _out_dir(args, cfg)
-    with _working_in(args, out, store=True) as store, _executor(args) as executor:
+    out = out_dir(args, cfg)
+    with working_in(args, out, store=True) as store, command_executor(args) as executor:
         history = sensitivity_history(StoredOperator(operator, store, retry_failed=args.retry_failed), x,
                                       data.covariance, bounds_covariance(space), names=space.names,
                                       blocks=data.blocks, executor=executor)
@@ -129,9 +130,9 @@ def run_sensitivity_command(args) -> int:
                delimiter=",", header=",".join(columns), comments="")
     (out / "sensitivity.png").write_bytes(to_png(sensitivity_figure(history, data.control)))
     final = ", ".join(f"{n} {v:.0%}" for n, v in zip(space.names, history.variance_share[-1]))
-    _say(args, f"sensitivities at {dict(zip(space.names, x.tolist()))}; share of the prior (bounds) variance removed "
-               f"by all data: {final}")
-    _wrote(args, out, ["sensitivity.csv", "sensitivity.png", "runs.sqlite"])
+    say(args, f"sensitivities at {dict(zip(space.names, x.tolist()))}; share of the prior (bounds) variance removed "
+              f"by all data: {final}")
+    wrote(args, out, ["sensitivity.csv", "sensitivity.png", "runs.sqlite"])
     return 0
 
 
@@ -139,14 +140,14 @@ def run_size_effect_command(args) -> int:
     from fracid.config import build_parameters, build_specimen
     from fracid.report.figures import size_effect_figure, to_png
 
-    cfg = _load(args, args.config, "simulate")
+    cfg = load(args, args.config, "simulate")
     if not _has_size(cfg):
         print(f"fracid: size-effect: the specimen {type(build_specimen(cfg)).__name__} declares no characteristic size "
               "and nominal section (a Gmsh mesh or the wedge-splitting test has none): use a notched beam, a dog-bone or "
               "a bar", file=sys.stderr)
         return 2
-    out = _out_dir(args, cfg)
-    with _working_in(args, out), _executor(args) as executor:
+    out = out_dir(args, cfg)
+    with working_in(args, out), command_executor(args) as executor:
         size = _size_effect(cfg, build_parameters(cfg), executor, sizes=args.sizes or (), quiet=args.quiet)
     if size is None:
         print("fracid: size-effect needs at least three sizes: give --sizes or experiments with "
@@ -156,7 +157,7 @@ def run_size_effect_command(args) -> int:
     (out / "size_effect.png").write_bytes(to_png(size_effect_figure(**size.figure_arguments())))
     fit, series = size.computed, size.series
     text = "" if fit is None else f"; Bazant fit B f_t = {fit.B_ft:.4g} MPa, D0 = {fit.D0:.4g} mm"
-    _say(args, "nominal strength [MPa]: " + ", ".join(f"D {D:g}: {s:.4g}" for D, s in zip(series.sizes, series.sigma_N))
-         + text)
-    _wrote(args, out, ["size_effect.csv", "size_effect.json", "size_effect.png"])
+    say(args, "nominal strength [MPa]: " + ", ".join(f"D {D:g}: {s:.4g}" for D, s in zip(series.sizes, series.sigma_N))
+        + text)
+    wrote(args, out, ["size_effect.csv", "size_effect.json", "size_effect.png"])
     return 0

@@ -392,11 +392,6 @@ class Config:
     warnings: tuple = ()  # of str: valid but probably unintended settings, for the user to read
 
     @property
-    def base_dir(self) -> Path:
-        """Directory against which relative paths are resolved."""
-        return self.path.parent
-
-    @property
     def calibration(self) -> tuple:
         """The experiments used for calibration (role "calibration")."""
         return tuple(e for e in self.experiments if e.role == "calibration")

@@ -17,10 +17,6 @@ import numpy as np
 
 from fracid.fem.forms import _bt
 
-#: the elastic and regularisation parameters every continuum formulation differentiates itself
-#: (the softening and equivalent-strain parameters come from the law's ``parameter_derivatives``)
-CONTINUUM_PARAMETERS = ("E", "nu", "c")
-
 
 def check_names(names, known) -> tuple:
     """``names`` as a tuple, or ValueError naming the unknown ones and the known."""

@@ -1,30 +1,21 @@
-"""Linear-solver backends behind one small interface.
-
-A backend is any object with ``solve(matrix, rhs) -> x`` for a square sparse CSC matrix and a
-right-hand side of shape (n,) or (n, k), and optionally ``factorize(matrix) -> solve(rhs)``, which keeps
-a factorization for several right-hand sides given at different times (see :func:`factorize`). It raises :class:`SingularMatrixError` when the matrix
-cannot be factorized, which the Newton solver treats as a failed iteration (the step is cut).
+"""Linear-solver backends behind one small interface (:mod:`fracid.fem.linear_backend`: a backend has
+``solve(matrix, rhs) -> x`` and optionally ``factorize(matrix) -> solve(rhs)``, and raises
+:class:`SingularMatrixError` when the matrix cannot be factorized): SuperLU, PARDISO
+(:mod:`fracid.fem.pardiso`, loaded when asked for) and :func:`linear_solver`, which picks one.
 """
 
 from __future__ import annotations
 
 import functools
 import threading
-from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from fracid.fem.linear_backend import LinearSolver, SingularMatrixError, factorize
 
-class SingularMatrixError(RuntimeError):
-    """The tangent matrix could not be factorized."""
-
-
-class LinearSolver(Protocol):
-    name: str
-
-    def solve(self, matrix, rhs: np.ndarray) -> np.ndarray: ...
+__all__ = ["LinearSolver", "SingularMatrixError", "SuperLUSolver", "SymmetricOrdering", "factorize", "linear_solver"]
 
 
 class SuperLUSolver:
@@ -145,15 +136,6 @@ def _pymetis():
     except ImportError as err:
         raise ImportError(f"the METIS ordering needs pymetis: pip install 'fracid[metis]' ({err})") from err
     return pymetis
-
-
-def factorize(solver, matrix):
-    """``rhs -> x`` solving with ``matrix``: the backend's kept factorization if it has ``factorize``,
-    else a solve (a new factorization) per call."""
-    keep = getattr(solver, "factorize", None)
-    if keep is not None:
-        return keep(matrix)
-    return lambda rhs: solver.solve(matrix, rhs)
 
 
 _SHARED = threading.local()

@@ -19,7 +19,7 @@ import weakref
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.fem.linear_solvers import SingularMatrixError
+from fracid.fem.linear_backend import SingularMatrixError
 
 _MTYPE = 11  # real unsymmetric
 _ERRORS = {
@@ -121,7 +121,7 @@ class PardisoSolver:
         When PARDISO had to perturb pivots (it never stops on a zero pivot: it perturbs it and
         refines), the solution is accepted only if ``||A x - b|| <= residual_rtol ||b||``; otherwise
         the analysis is redone with the current values and, if that does
-        not help either, :class:`~fracid.fem.linear_solvers.SingularMatrixError` is raised.
+        not help either, :class:`~fracid.fem.linear_backend.SingularMatrixError` is raised.
         The default is loose on purpose: the damage tangents mix rows of order E t (equilibrium)
         with rows of order mm^2 (diffusion), so even a sound factorization of the virgin state
         leaves relative residuals near 1e-7 (SuperLU too), and the Newton iteration only needs a
@@ -241,7 +241,7 @@ class PardisoSolver:
 
         A solution with perturbed pivots is checked as in :meth:`solve`; a rejected one redoes the
         analysis with these values once before raising
-        :class:`~fracid.fem.linear_solvers.SingularMatrixError`.
+        :class:`~fracid.fem.linear_backend.SingularMatrixError`.
         """
         matrix, data, fresh = self._prepare(matrix)
         self._factor(data)

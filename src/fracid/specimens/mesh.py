@@ -104,10 +104,6 @@ class MeshSpecimen:
     def default_control(self) -> str:
         return self.controls[0][0]
 
-    @property
-    def control_names(self) -> tuple:
-        return tuple(name for name, _ in self.controls)
-
     def describe(self) -> Description:
         return self.describe_mesh(read_mesh(self.path))
 

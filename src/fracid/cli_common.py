@@ -1,0 +1,133 @@
+"""The plumbing every ``fracid`` command shares: loading the configuration, the output directory and its
+claim, the directory's lock and run store, the executor of ``--workers`` / ``--scheduler``, the progress
+choice, the provenance record and the messages (``say``, ``warn``, ``wrote``, ``plural``).
+
+:mod:`fracid.cli` (the parser, the dispatch and simulate / identify / posterior / demo),
+:mod:`fracid.cli_studies`, :mod:`fracid.cli_init` and :mod:`fracid.cli_check` import from here, so none of
+them imports another's internals.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+from importlib import resources
+from pathlib import Path
+
+
+def demo_config_path() -> Path:
+    """The bundled demo configuration (next to the Gregoire data)."""
+    return Path(str(resources.files("fracid.data") / "gregoire2013_beam4" / "demo.toml"))
+
+
+def say(args, text) -> None:
+    """Print ``text`` unless ``--quiet``."""
+    if not args.quiet:
+        print(text, flush=True)
+
+
+def wrote(args, out, names) -> None:
+    """Say which files a command wrote into ``out``: the names, those of a subdirectory counted when many."""
+    groups = {}
+    for name in map(str, names):
+        folder, _, _ = name.rpartition("/")
+        groups.setdefault(folder, []).append(name)
+    shown = [name for folder, items in groups.items()
+             for name in (items if len(items) <= 3 or not folder else [f"{folder}/ ({len(items)} files)"])]
+    say(args, f"wrote in {out}: " + ", ".join(shown))
+
+
+def warn(text) -> None:
+    """A warning on stderr, even with ``--quiet``."""
+    print(f"fracid: warning: {text}", file=sys.stderr, flush=True)
+
+
+def plural(count, noun) -> str:
+    """``"1 run"``, ``"2 runs"``."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
+def load(args, path, purpose):
+    """The configuration at ``path`` checked for ``purpose`` (:func:`fracid.config.load_config`); its
+    warnings go to stderr."""
+    from fracid.config import load_config
+
+    cfg = load_config(path, purpose=purpose)
+    for text in cfg.warnings:
+        warn(text)
+    return cfg
+
+
+def out_dir(args, cfg) -> Path:
+    """The output directory, made if needed, once the command's outputs are known to replace neither an
+    input of the run nor a file fracid did not write (:func:`fracid.outputs.claim_outputs`)."""
+    from fracid.outputs import claim_outputs
+
+    out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(20, "not a directory", str(out))
+    out.mkdir(parents=True, exist_ok=True)
+    claim_outputs(out, args.command, _inputs(cfg))
+    args.out_dir = out
+    return out
+
+
+def _inputs(cfg):
+    """(what it is, path) of every file the run reads: the configuration, the data files, a mesh."""
+    yield "the configuration", Path(cfg.path)
+    for exp in cfg.experiments:
+        yield f"experiments[{exp.index}].file", Path(exp.file)
+    mesh = dict(cfg.specimen.options).get("path")
+    if mesh is not None:
+        yield "specimen.file", Path(mesh)
+
+
+@contextlib.contextmanager
+def working_in(args, out, store=False):
+    """The output directory's lock, and (``store``) its run store; the store's path goes to messages."""
+    from fracid.lock import directory_lock
+    from fracid.store import RunStore
+
+    with directory_lock(out):
+        if not store:
+            yield None
+            return
+        args.store_path = out / "runs.sqlite"
+        with RunStore(args.store_path) as runs:
+            yield runs
+
+
+def progress_choice(args):
+    """The ``progress`` argument of the API for this command: False with ``--quiet``, else None (bars on a
+    terminal, lines otherwise)."""
+    return False if args.quiet else None
+
+
+@contextlib.contextmanager
+def command_executor(args):
+    """The executor of --workers / --scheduler; an unusable option is named (exit 2)."""
+    from fracid.exits import UsageError
+    from fracid.parallel import executor_session
+
+    if args.scheduler is not None and args.workers is not None:
+        raise UsageError(f"--workers {args.workers} and --scheduler {args.scheduler}: give one of them (the Dask "
+                         "cluster has its own workers)")
+    stack = contextlib.ExitStack()
+    try:
+        executor = stack.enter_context(executor_session(args.workers, args.scheduler))
+    except (ValueError, ImportError, OSError) as err:
+        raise UsageError(f"--scheduler {args.scheduler}: cannot use this Dask scheduler ({err}); give its address "
+                         "as tcp://host:port, with the dask extra installed (pip install 'fracid[dask]')") from None
+    with stack:
+        yield executor
+
+
+def provenance(args, cfg, operator, space, store=None) -> dict:
+    """How this run was made (:func:`fracid.provenance.collect`), also kept in the run store's meta table."""
+    from fracid.provenance import collect
+
+    record = collect(argv=getattr(args, "argv", ["fracid"]), config=cfg, data_files=[e.file for e in cfg.experiments],
+                     specimen=operator.observations[0].specimen, parameters=operator.base, bounds=space)
+    if store is not None:
+        store.put_meta(f"provenance:{args.command}", record)
+    return record
