@@ -395,7 +395,7 @@ def time_case(name, directory, candidates, repeat, limit):
     for cand_name in candidates:
         try:
             cand = CANDIDATES[cand_name]()
-            t_prepare, note = _best(lambda: cand.prepare(first), 1, limit)
+            t_prepare, note = _best(lambda: cand.prepare(first), 1, limit)  # noqa: F821 - called here, before `del cand`
         except ImportError as err:
             print(f"{cand_name:21s} unavailable: {err}")
             continue
@@ -403,8 +403,8 @@ def time_case(name, directory, candidates, repeat, limit):
             print(f"{cand_name:21s} {'once':9s} {t_prepare[0]:10.3f} {t_prepare[1]:7.3f} {'':9s} {'':7s} {'':8s}  {note}")
         for state, (matrix, rhs) in states.items():
             try:
-                t_factor, (solve, info) = _best(lambda: cand.factor(matrix), repeat, limit)
-                t_solve, x = _best(lambda: solve(rhs), repeat, limit)
+                t_factor, (solve, info) = _best(lambda: cand.factor(matrix), repeat, limit)  # noqa: F821 - as above
+                t_solve, x = _best(lambda: solve(rhs), repeat, limit)  # noqa: F821 - called here, before `del solve`
             except Exception as err:  # noqa: BLE001 - report and go on
                 print(f"{cand_name:21s} {state:9s} failed: {type(err).__name__}: {err}")
                 continue

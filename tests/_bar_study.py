@@ -2,6 +2,7 @@
 configuration, and the number of runs in a store."""
 
 import sqlite3
+from pathlib import Path
 
 import numpy as np
 
@@ -44,7 +45,7 @@ directory = "results"
 """
 
 
-def write_bar_study(directory, *, n_elements=60, n=16, k=4, c_lower=0.5, kalman="") -> "Path":
+def write_bar_study(directory, *, n_elements=60, n=16, k=4, c_lower=0.5, kalman="") -> Path:
     """bar.csv (the bar with ``n_elements`` at (c, beta) = (2, 250)) and study.toml in ``directory``."""
     run = fracid.simulate(fracid.BarWithWeakZone(n_elements=n_elements), fracid.DamageParameters(c=2.0, beta=250.0),
                           target=0.032, stop_force_fraction=None, checkpoints=np.linspace(0.001, 0.032, 40))

@@ -8,6 +8,8 @@ import fracid
 from fracid.specimens.beam import NotchedBeam
 
 # internal length sqrt(2 c) = 4.2 mm, resolved by the default 1 mm process-zone elements
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
+
 PARAMS = fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=8.4e-5, alpha=0.99, beta=600.0, c=9.0)
 
 

@@ -173,6 +173,7 @@ def bar_series(tmp_path):
     return tmp_path / "series.toml"
 
 
+@pytest.mark.slow
 def test_study_writes_verdict_figures_predictions_and_size_effect(bar_series, tmp_path):
     out = tmp_path / "out"
     assert cli.main(["study", str(bar_series), "--out", str(out), "--workers", "2", "--quiet"]) == 0
@@ -202,6 +203,7 @@ def test_sensitivity_and_size_effect_commands(bar_series, tmp_path):
     assert (out / "size_effect.png").exists()
 
 
+@pytest.mark.slow
 def test_uniqueness_command_runs_only_its_stages(bar_series, tmp_path):
     out = tmp_path / "u"
     assert cli.main(["uniqueness", str(bar_series), "--out", str(out), "--workers", "1", "--quiet"]) == 0

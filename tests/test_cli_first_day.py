@@ -42,6 +42,7 @@ def test_list_names_the_pairs_and_leaves_out_those_that_do_not_run(capsys):
 
 
 @pytest.mark.parametrize("specimen, model", PAIRS, ids=[f"{s}-{m}" for s, m in PAIRS])
+@pytest.mark.slow
 def test_every_pair_is_checked_and_simulated(tmp_path, capsys, specimen, model):
     text = init(tmp_path, "--specimen", specimen, "--model", model)
     (tmp_path / "fracid.toml").write_text(small(text), encoding="utf-8")
@@ -98,6 +99,7 @@ def test_init_to_stdout_and_an_unknown_pair(capsys):
     assert "--list" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_init_then_identify_the_bundled_data(tmp_path, capsys):
     text = small(init(tmp_path))
     assert "load_cmod.csv" in text and "REPLACE" in text

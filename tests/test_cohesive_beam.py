@@ -56,6 +56,7 @@ def test_cohesive_beam_curve_peaks_then_softens(separated):
     assert np.all(np.diff(result.observables["crack_length"]) >= -1e-9)  # the crack only grows
 
 
+@pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.forward_operator import Observation, ForwardOperator
     from fracid.inverse.knn import ParameterSpace

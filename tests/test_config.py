@@ -523,6 +523,7 @@ def test_simulate_cohesive_beam_from_its_config(tmp_path):
 
 from fracid.models import MODEL_TYPES  # noqa: E402  (every registered model is a valid type)
 
+@pytest.mark.slow
 def test_size_effect_runs_any_model(tmp_path):
     """The size-effect series takes the config's forward model: here the cohesive crack, three depths."""
     from fracid.cli import main
@@ -768,6 +769,7 @@ def test_data_values_are_limited_over_the_calibration_blocks(tmp_path):
     assert load_config(write(tmp_path, predicted)).n_y == 3000
 
 
+@pytest.mark.slow
 def test_beam_supported_at_its_ends():
     """S = L is a valid beam: supports at the end nodes; longer span, softer beam (elastic run)."""
     import fracid

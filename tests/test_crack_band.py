@@ -123,6 +123,7 @@ def test_assembled_tangent_matches_finite_differences_after_the_peak():
         np.testing.assert_allclose(tangent @ v, fd, atol=1e-6 * np.abs(fd).max())
 
 
+@pytest.mark.slow
 def test_beam_curve_converges_with_the_mesh_and_matches_the_cohesive_crack():
     from fracid.models import CohesiveCrackModel
 
@@ -138,6 +139,7 @@ def test_beam_curve_converges_with_the_mesh_and_matches_the_cohesive_crack():
     np.testing.assert_allclose(fine, curve(CohesiveCrackModel(), 2.0), atol=0.02 * fine[3])
 
 
+@pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.forward_operator import ForwardOperator, Observation
     from fracid.inverse.knn import ParameterSpace

@@ -17,6 +17,8 @@ from fracid.fem.path_following import StepOptions
 from fracid.models import CohesiveCrackModel, DamageModel
 from fracid.specimens.beam import NotchedBeam
 
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
+
 BEAM = NotchedBeam(h_fine=5.0, h_coarse=10.0)
 CMOD = np.linspace(0.01, 0.2, 10)  # mm
 COHESIVE = CohesiveParameters(E=37000.0, nu=0.2, ft=3.0, Gf=0.1)

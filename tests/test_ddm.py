@@ -157,12 +157,14 @@ def test_linear_elastic_range_is_differentiated_exactly():
                                rtol=1e-9, atol=1e-18)
 
 
+@pytest.mark.slow
 def test_notched_beam_gradient_model_all_parameters():
     beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0, fine_width=12.0)
     compare(DamageModel("gradient"), beam, fracid.DamageParameters(), ("E", "nu", "kappa_i", "beta", "c", "eta"), 16,
             quantities=("force", "deflection"))
 
 
+@pytest.mark.slow
 def test_dogbone_gradient_model():
     dogbone = SPECIMENS["dogbone"](size=50.0, h_fine=4.0)
     compare(DamageModel("gradient"), dogbone, fracid.DamageParameters(), ("E", "nu", "kappa_i", "alpha", "c"), 30)
@@ -181,6 +183,7 @@ def test_zone_widths_are_differentiated():
     assert run.observables["fpz_width"][-1] > 0
 
 
+@pytest.mark.slow
 def test_pardiso_keeps_the_factorization_for_the_derivatives():
     pytest.importorskip("pypardiso")
     beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0, fine_width=12.0)

@@ -27,6 +27,8 @@ from fracid.fem.cohesive import CohesiveParameters
 from fracid.models import CohesiveCrackModel, CrackBandModel, StepOptions
 from fracid.specimens import SPECIMENS
 
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
+
 PARAMS = CohesiveParameters()
 NAMES = PARAMS.names()  # E, nu, ft, Gf, c1, c2
 REL_STEP = 1e-6

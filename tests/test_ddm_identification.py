@@ -10,7 +10,6 @@ from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import (CentralDifferences, DirectDifferentiation, exact_sensitivity,
                                         sensitivity_label)
-from fracid.inverse.strategy import KnnGaussNewton, KnnKalman, KnnSettings, KalmanSettings, identify
 from fracid.models import CohesiveCrackModel
 from fracid.specimens import SPECIMENS
 from fracid.store import RunStore

@@ -18,6 +18,7 @@ def test_the_default_backend_is_the_fastest_installed():
 
 @pytest.mark.parametrize("specimen, target", [(SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0), 0.12),
                                               (SPECIMENS["dogbone"](size=50.0, h_fine=4.0), 0.02)])
+@pytest.mark.slow
 def test_default_curves_equal_superlu_with_full_newton(specimen, target):
     """The default (fastest backend, modified Newton) traces the curves of SuperLU with a factorization
     per iteration, the default before, at the same steps: forces within 1e-6 of the peak."""

@@ -8,9 +8,13 @@ inside the measured scatter band (between the lower and upper envelopes at the C
 import json
 
 import numpy as np
+import pytest
 
 from fracid import cli
 from fracid.data import gregoire2013_beam4_path
+
+
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
 
 
 def test_demo_fits_the_gregoire_beam(tmp_path):

@@ -114,6 +114,7 @@ def _snap_back_failure(specimen, params, control):
     return info.value, exits.describe(info.value)
 
 
+@pytest.mark.slow
 def test_snap_back_under_deflection_is_named_and_cmod_advised():
     """A brittle beam under deflection control fails past the peak with the force falling steeply: the
     error says the curve snaps back and names cmod, which then traces the curve to 20 % of the peak."""

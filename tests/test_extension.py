@@ -164,6 +164,7 @@ def test_the_cohesive_crack_runs_on_the_new_specimen():
         PLATE.width - PLATE.notch_depth, rel=0.05)  # measured between the outer Gauss points
 
 
+@pytest.mark.slow
 def test_new_specimen_and_law_are_identified_by_the_unchanged_inverse_code(plate_run):
     points = np.linspace(0.005, 0.06, 12)
     op = ForwardOperator([Observation(PLATE, points)], PARAMS, ("kappa_u", "c"), model=MODEL)

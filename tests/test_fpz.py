@@ -20,6 +20,7 @@ def _kappa(points, w):
     return 2.0 * taper * np.exp(-((points[:, 0] / w) ** 2))
 
 
+@pytest.mark.slow
 def test_width_matches_the_analytic_level_set_and_varies_smoothly():
     pts = _points()
     sampler = across_sampler(pts, axis=0, along_range=(0.0, 50.0), lines=101)

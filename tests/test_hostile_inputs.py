@@ -38,6 +38,8 @@ from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, 
                      _unloading, bar_config, case, check, csv_case, run_fracid, sim_case, synthetic_curve, write_csv)
 
 
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
+
 @pytest.fixture(scope="module")
 def curve():
     """Control [mm] and force [N] of the 40-element bar with (c, beta) = TRUTH, the synthetic test."""

@@ -120,6 +120,7 @@ def test_twin_noisy_bar_truth_within_two_sigma(bar_operator, bar_data, tmp_path)
     assert saved["runs"]["knn"] == 32 and saved["runs"]["kalman"] > 0
 
 
+@pytest.mark.slow
 def test_twin_noise_free_dogbone():
     from fracid.specimens.dogbone import DogBone
 
@@ -135,6 +136,7 @@ def test_twin_noise_free_dogbone():
     np.testing.assert_allclose(res.x, truth, rtol=0.01)
 
 
+@pytest.mark.slow
 def test_twin_noisy_dogbone_truth_within_two_sigma():
     from fracid.specimens.dogbone import DogBone
 
@@ -150,6 +152,7 @@ def test_twin_noisy_dogbone_truth_within_two_sigma():
     assert np.all(np.abs(res.x - truth) <= 2 * res.std), (res.x, res.std)
 
 
+@pytest.mark.slow
 def test_global_and_local_blocks_from_experimental_data(bar_operator):
     """Force curve plus the damaged-zone width (local data) as a second block, through fracid.data."""
     from fracid.data import ExperimentalData, stack

@@ -38,6 +38,7 @@ def finished(config, out):
     return json.loads((out / "result.json").read_text())
 
 
+@pytest.mark.slow
 def test_identification_killed_in_its_kalman_stage_resumes(bar_config, tmp_path):
     out = tmp_path / "killed"
     store = out / "runs.sqlite"

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from _bar_study import stored_rows
 from _knn_child import N_RUNS, operator, search
 
@@ -17,6 +18,7 @@ from fracid.store import RunStore
 CHILD = Path(__file__).with_name("_knn_child.py")
 
 
+@pytest.mark.slow
 def test_killed_population_resumes_with_the_same_result(tmp_path):
     path = tmp_path / "population.sqlite"
     child = subprocess.Popen([sys.executable, str(CHILD), str(path)], start_new_session=True, stderr=subprocess.PIPE)

@@ -20,6 +20,7 @@ def test_metis_ordered_lu_solves_and_keeps_its_ordering_per_pattern():
     pattern = (pattern + pattern.T + sp.eye(n) * 10.0).tocsc()  # structurally symmetric, nonsymmetric values
     solver = SuperLUSolver(ordering="metis")
     assert linear_solver("superlu").ordering == "metis"  # SuperLU picks METIS when pymetis is there
+    first = None
     for k in range(3):
         values = sp.csc_matrix((pattern.data * rng.uniform(0.5, 1.5, pattern.nnz), pattern.indices, pattern.indptr),
                                shape=pattern.shape)

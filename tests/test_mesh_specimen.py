@@ -292,6 +292,7 @@ def test_bad_mesh_configs_name_the_key(tmp_path, replace, words):
         assert word in str(err.value)
 
 
+@pytest.mark.slow
 def test_the_triangle_meshed_beam_matches_the_built_in_q8_beam(tmp_path):
     """The beam meshed with triangles (the built-in's quadrilaterals split in two, run as T6) at h_fine 1:
     peak within 0.5 % of the built-in Q8 beam's (measured 0.36 %), force-CMOD within 1.5 % of the peak
@@ -312,6 +313,7 @@ def test_the_triangle_meshed_beam_matches_the_built_in_q8_beam(tmp_path):
     assert np.max(np.abs(difference)) < 1.5e-2 * built_in.peak_force
 
 
+@pytest.mark.slow
 def test_twin_identification_of_c_and_beta_on_a_triangle_meshed_beam(tmp_path):
     """Noise-free CMOD data of the gradient model on the beam meshed with triangles at (c, beta) = (4, 500):
     Gauss-Newton with the exact sensitivities from (6, 400) finds them back within 1 %."""
@@ -432,6 +434,7 @@ def test_identify_with_a_mesh_specimen_writes_result_report_and_vtk(tmp_path):
     assert any(out.rglob("*.html"))
 
 
+@pytest.mark.slow
 def test_study_on_a_mesh_specimen_gives_its_verdict(tmp_path):
     """fracid study on a mesh specimen as on a built-in one: multi-start, noisy replicates and a verdict."""
     from fracid import cli

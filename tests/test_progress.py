@@ -3,6 +3,8 @@ FRACID_PROGRESS_SECONDS (30 s by default) and at the end; none with --quiet."""
 
 import re
 
+import pytest
+
 from fracid import progress
 from hostile import bar_config, run_fracid, synthetic_curve, write_csv
 
@@ -49,6 +51,7 @@ def test_a_bad_interval_is_the_default(monkeypatch):
     assert progress.line_interval() == 2.5
 
 
+@pytest.mark.slow
 def test_identify_prints_progress_lines_into_a_pipe(tmp_path):
     write_csv(tmp_path / "bar.csv", *synthetic_curve())
     (tmp_path / "cfg.toml").write_text(bar_config(), encoding="utf-8")

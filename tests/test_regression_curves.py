@@ -10,6 +10,7 @@ REFERENCE_ARRAYS = np.load(REFERENCE)
 
 
 @pytest.mark.parametrize("name", sorted(cases()))
+@pytest.mark.slow
 def test_curves_are_unchanged(name):
     arrays = run(name)
     expected = {key.split(":", 1)[1]: REFERENCE_ARRAYS[key] for key in REFERENCE_ARRAYS.files if key.startswith(name + ":")}

@@ -25,6 +25,7 @@ def dogbone_runs():
     return [fracid.simulate(s, DOGBONE_PARAMS, stop_force_fraction=0.25) for s in (specimen, specimen.refined(2.0))]
 
 
+@pytest.mark.slow
 def test_dogbone_is_mesh_objective(dogbone_runs):
     default, refined = dogbone_runs
     assert refined.peak_force == pytest.approx(default.peak_force, rel=0.02)
@@ -46,6 +47,7 @@ def test_fpz_width_zero_then_growing_then_finite(dogbone_runs):
     assert default.observables["fpz_width"][-1] < 20 * np.sqrt(DOGBONE_PARAMS.c)
 
 
+@pytest.mark.slow
 def test_snap_back_traced_by_gauge_elongation_not_by_platen_displacement():
     """D = 1600 mm: elongation over a 200 mm gauge passes the snap-back; platen displacement control fails."""
     params = DOGBONE_PARAMS.replace(beta=1000.0, c=100.0)
@@ -61,6 +63,7 @@ def test_snap_back_traced_by_gauge_elongation_not_by_platen_displacement():
     assert 'control = "elongation"' in exits.describe(info.value)[1]
 
 
+@pytest.mark.slow
 def test_size_effect_nominal_strength_decreases():
     params = DOGBONE_PARAMS.replace(c=100.0)
     strengths = []

@@ -74,6 +74,7 @@ def executor():
         yield ex
 
 
+@pytest.mark.slow
 def test_scatter_under_noise_shrinks_with_two_sizes(executor):
     """Same noise level per point (s = 1 % of the peak); two bar lengths vs one."""
     scatter = {}

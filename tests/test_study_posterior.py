@@ -23,6 +23,7 @@ def run(tmp_path_factory):
     return run_bar_command(tmp_path_factory.mktemp("study_posterior"), "study", STUDY + SMALL_POSTERIOR, workers="2")
 
 
+@pytest.mark.slow
 def test_study_samples_the_posterior_and_its_verdict_names_the_measure(run):
     _, out = run
     study = json.loads((out / "study.json").read_text())
@@ -50,6 +51,7 @@ def test_study_samples_the_posterior_and_its_verdict_names_the_measure(run):
     assert html.index("<h2>Verdict</h2>") < html.index("<h2>Posterior</h2>")
 
 
+@pytest.mark.slow
 def test_uniqueness_does_not_sample_and_keeps_the_gaussian_verdict(run, tmp_path, capsys):
     config, out = run
     (tmp_path / "out").mkdir()

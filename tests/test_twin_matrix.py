@@ -14,6 +14,8 @@ import fracid
 from fracid.inverse.knn import ParameterSpace
 from fracid.inverse.twin import dogbone_cases, twin_matrix
 
+pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
+
 BASE = fracid.DamageParameters(E=30000.0, nu=0.2, kappa_i=1e-4, alpha=0.99, beta=300.0, c=25.0)
 TRUTH = np.array([25.0, 300.0])
 SPACE = ParameterSpace(("c", "beta"), [5.0, 100.0], [80.0, 900.0], log=(True, True))

@@ -151,6 +151,7 @@ def test_importing_the_report_package_does_not_import_meshio():
 
 
 @pytest.mark.parametrize("which", ["bar", "beam"])
+@pytest.mark.slow
 def test_write_result_vtk_writes_requested_steps(tmp_path, which):
     meshio = pytest.importorskip("meshio")
     import fracid

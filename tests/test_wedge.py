@@ -65,6 +65,7 @@ def test_damage_model_runs_and_records_the_fpz_width():
     assert run.peak_force > 0 and run.observables["fpz_width"][-1] > 0
 
 
+@pytest.mark.slow
 def test_twin_identification_of_ft_and_gf():
     """Noise-free data of the cohesive crack at (ft, Gf) = (3, 0.1): Gauss-Newton with the exact sensitivities
     from (2.6, 0.13) finds them back within 1 %."""

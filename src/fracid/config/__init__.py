@@ -57,7 +57,8 @@ from fracid.config.builders import (
     study_settings,
 )
 from fracid.config.loading import load_config
-from fracid.config.registry import _SPECIMENS, _specimen_class
+# private, imported from here by the tests (kept for them)
+from fracid.config.registry import _SPECIMENS, _specimen_class  # noqa: F401
 from fracid.config.schema import (
     BAR_BYTES_PER_ELEMENT,
     BYTES_PER_UNKNOWN,
@@ -106,4 +107,13 @@ __all__ = [
     "StudyConfig",
     "posterior_settings",
     "PosteriorConfig",
+    # the limits and constants of the docstring
+    "BAR_BYTES_PER_ELEMENT",
+    "BYTES_PER_UNKNOWN",
+    "CONTROL_SCALE_LIMIT",
+    "DEFAULT_KALMAN_GROUPS",
+    "MAX_BAR_ELEMENTS",
+    "MAX_DATA_VALUES",
+    "MAX_POPULATION",
+    "MAX_UNKNOWNS",
 ]

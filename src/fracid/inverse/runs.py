@@ -7,10 +7,11 @@ so that a rerun of an interrupted or finished identification recomputes nothing.
 
 from __future__ import annotations
 
+import ast
 import functools
 import hashlib
 import threading
-from importlib import resources
+from pathlib import Path
 
 import numpy as np
 
@@ -19,23 +20,110 @@ from fracid.parallel import BatchStats, run_batch
 from fracid.store import key_for
 
 
-@functools.lru_cache(maxsize=1)
-def code_version() -> str:
-    """fracid's version and a hash of the source of its forward chain (models, specimens, operator).
+#: The forward chain, relative to the package: what a forward run executes (the models, the finite
+#: elements, the specimens and the forward operator). Directories are walked (every ``.py`` file, at
+#: any depth), so that a new module is hashed without being listed; the ``fracid`` modules these
+#: import are added by :func:`forward_sources`. The inverse methods, the configuration, the reports
+#: and the command line are not: they choose the runs, they do not change a run's result.
+FORWARD_CHAIN = ("fem", "specimens", "models.py", "forward.py", "inverse/forward_operator.py")
+
+
+@functools.cache
+def _package_root() -> Path:
+    import fracid
+
+    return Path(fracid.__file__).resolve().parent
+
+
+def _imported_modules(path: Path, module: str) -> set[str]:
+    """Dotted names of the modules ``path`` (module ``module``) imports, relative imports resolved;
+    ``from a import b`` gives both ``a`` and ``a.b`` (``b`` may be a module)."""
+    try:
+        tree = ast.parse(path.read_bytes(), filename=str(path))
+    except SyntaxError:
+        return set()
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                parts = parts[:len(parts) - node.level + 1] if node.level > 1 else parts
+                base = ".".join(parts + ([base] if base else []))
+            if base:
+                names.add(base)
+                names.update(f"{base}.{alias.name}" for alias in node.names if alias.name != "*")
+    return names
+
+
+def _module_file(root: Path, name: str) -> Path | None:
+    """The source file of module ``name`` (``fracid.x.y``) under the package ``root``, None if not there."""
+    parts = name.split(".")
+    if parts[0] != "fracid":
+        return None
+    base = root.joinpath(*parts[1:])
+    for candidate in (base.with_suffix(".py") if len(parts) > 1 else None, base / "__init__.py"):
+        if candidate is not None and candidate.is_file():
+            return candidate
+    return None
+
+
+def forward_sources(root: Path | str | None = None) -> list[Path]:
+    """The source files of the forward chain under the package directory ``root`` (the installed
+    ``fracid`` if None), relative to ``root`` and sorted: every ``.py`` file of :data:`FORWARD_CHAIN`
+    and, transitively, every ``fracid`` module they import (not the ``__init__`` of the packages
+    above an imported module: importing ``fracid.x.y`` runs ``fracid/__init__.py``, but what a run
+    computes does not depend on it)."""
+    root = _package_root() if root is None else Path(root)
+    found: set[Path] = set()
+    for entry in FORWARD_CHAIN:
+        path = root / entry
+        if path.is_dir():
+            found.update(p for p in path.rglob("*.py") if "__pycache__" not in p.parts)
+        elif path.is_file():
+            found.add(path)
+    pending = list(found)
+    while pending:
+        path = pending.pop()
+        relative = path.relative_to(root).with_suffix("")
+        module = ".".join(("fracid", *relative.parts))
+        if module.endswith(".__init__"):
+            module = module[: -len(".__init__")]
+        for name in _imported_modules(path, module):
+            source = _module_file(root, name)
+            if source is not None and source not in found and source != root / "__init__.py":
+                found.add(source)
+                pending.append(source)
+    return sorted((p.relative_to(root) for p in found), key=lambda p: p.as_posix())
+
+
+def _read_source(path: Path) -> bytes:
+    return path.read_bytes()
+
+
+@functools.lru_cache(maxsize=8)
+def _source_hash(root: Path) -> str:
+    digest = hashlib.sha256()
+    for relative in forward_sources(root):
+        content = _read_source(root / relative)
+        digest.update(relative.as_posix().encode() + b"\0" + str(len(content)).encode() + b"\0" + content)
+    return digest.hexdigest()
+
+
+def code_version(root: Path | str | None = None) -> str:
+    """fracid's version and a SHA-256 of the source of its forward chain (:func:`forward_sources`
+    under the package directory ``root``, the installed ``fracid`` if None), computed once per process.
 
     Part of every run key, so that runs stored by another version of the forward code are never
-    reused: an upgrade, or an edit of the model code, recomputes.
+    reused: an upgrade, or an edit of the model code (a new module included), recomputes.
     """
     import fracid
 
-    digest = hashlib.sha256()
-    root = resources.files("fracid")
-    sources = [root / "forward.py", root / "models.py", root / "inverse" / "forward_operator.py"]
-    for package in ("fem", "specimens"):
-        sources += sorted((p for p in (root / package).iterdir() if p.name.endswith(".py")), key=lambda p: p.name)
-    for source in sources:
-        digest.update(source.name.encode() + b"\0" + source.read_bytes())
-    return f"{fracid.__version__}+{digest.hexdigest()[:16]}"
+    root = _package_root() if root is None else Path(root).resolve()
+    return f"{fracid.__version__}+{_source_hash(root)[:16]}"
 
 
 def run_key(operator, x, needed: int | None = None) -> str:
