@@ -131,12 +131,18 @@ def _identify_job(args, config_path):
 
 def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
+    from fracid.config import build_method
     from fracid.inverse.strategy import identify_data
 
-    say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
+    method = build_method(job.cfg)  # [identify] method, from fracid.inverse.methods.METHODS
+    if job.cfg.identify.method == "knn-kalman":
+        say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
+    else:
+        say(args, f"KNN: {job.settings['n']} forward runs, then {method.name} (at most "
+                  f"{method.max_iterations} linearisations; [identify.gauss-newton] max_iterations).")
     start = time.perf_counter()
-    result = identify_data(job.operator, job.data, job.space, executor=executor, store=store,
-                           progress=progress_choice(args), retry_failed=args.retry_failed, **job.settings)
+    result = identify_data(job.operator, job.data, job.space, method=method, executor=executor, store=store,
+                           progress=progress_choice(args), retry_failed=args.retry_failed)
     result.runs["wall_seconds"] = time.perf_counter() - start
     result.provenance = provenance(args, job.cfg, job.operator, job.space, store)
     return result

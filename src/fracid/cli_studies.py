@@ -77,6 +77,10 @@ def run_study_command(args) -> int:
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
     settings = StudySettings().replace(**{**study_settings(cfg), **_STUDY_PARTS[args.command]})
+    if cfg.identify.method != "knn-kalman":
+        warn(f"[identify] method = {cfg.identify.method!r}: `fracid {args.command}` runs the KNN + Kalman filter "
+             "strategy (the study of another method is not built yet); `fracid identify` and `fracid posterior` "
+             "use the configured method")
     if cfg.study.posterior and settings.posterior is None:
         say(args, f"posterior: skipped ([study] posterior = true is for `fracid study`, not `fracid {args.command}`)")
     held_out = build_held_out(cfg) if args.command == "study" else []

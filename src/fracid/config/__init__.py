@@ -9,7 +9,7 @@ one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
 resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
-:func:`build_operator`, :func:`build_space`, :func:`identify_settings`, :func:`simulate_settings`,
+:func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`identify_settings`, :func:`simulate_settings`,
 :func:`posterior_settings`)
 are pure functions of the validated :class:`Config`.
 
@@ -46,6 +46,7 @@ from fracid.config.builders import (
     build_data,
     build_experiment_data,
     build_held_out,
+    build_method,
     build_model,
     build_operator,
     build_parameters,
@@ -97,6 +98,7 @@ __all__ = [
     "build_operator",
     "build_parameters",
     "build_space",
+    "build_method",
     "build_specimen",
     "identify_settings",
     "load_config",

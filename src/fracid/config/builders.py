@@ -228,7 +228,7 @@ def posterior_settings(cfg: Config):
 
 def build_space(cfg: Config):
     """The parameter space of the KNN population: identified names, bounds, log flags."""
-    from fracid.inverse.knn import ParameterSpace
+    from fracid.inverse.space import ParameterSpace
 
     identify = _require(cfg, "identify")
     return ParameterSpace(identify.parameters, lower=list(identify.lower), upper=list(identify.upper),
@@ -257,6 +257,27 @@ def identify_settings(cfg: Config) -> dict:
         raise ConfigError(f"{cfg.path}: identify.kalman.restart = {kalman.restart!r}: this version of "
                           "fracid.inverse.strategy.identify cannot forward it; only 'linearize' (the default) is available")
     return out
+
+
+def build_method(cfg: Config):
+    """The configured inverse method (``[identify] method``, a key of
+    :data:`fracid.inverse.methods.METHODS`) with the settings of its stages: for ``"knn-kalman"``
+    ``[identify.knn]`` and ``[identify.kalman]`` (as :func:`identify_settings`), for
+    ``"knn-gauss-newton"`` ``[identify.knn]`` and ``[identify.gauss-newton]``. Give it to
+    :func:`fracid.inverse.strategy.identify_data` as ``method=`` (no other settings)."""
+    from fracid.inverse.methods import METHODS
+    from fracid.inverse.strategy import KalmanSettings, KnnSettings
+
+    identify = _require(cfg, "identify")
+    settings = identify_settings(cfg)
+    knn = KnnSettings(n=settings["n"], method=settings["method"], seed=settings["seed"], k=settings["k"])
+    cls = METHODS[identify.method]
+    if identify.method == "knn-gauss-newton":
+        gn = identify.gauss_newton
+        return cls(knn=knn, max_iterations=gn.max_iterations, tol=gn.tol)
+    kalman = KalmanSettings(groups=settings["groups"], max_iterations=settings["max_iterations"], tol=settings["tol"],
+                            restart=settings.get("restart", "linearize"), max_starts=settings["max_starts"])
+    return cls(knn=knn, kalman=kalman)
 
 
 def simulate_settings(cfg: Config) -> dict:

@@ -1,5 +1,6 @@
 """Validation of the ``[identify]`` section: identified parameters, their bounds and log flags,
-``[identify.knn]`` (with the population limit) and ``[identify.kalman]``."""
+the inverse method, ``[identify.knn]`` (with the population limit), ``[identify.kalman]`` and
+``[identify.gauss-newton]``."""
 
 from __future__ import annotations
 
@@ -8,12 +9,15 @@ import dataclasses
 from fracid.config.checker import _bytes, _Checker
 from fracid.config.registry import _model_of
 from fracid.config.schema import (
+    _GAUSS_NEWTON_KEYS,
     _IDENTIFY_KEYS,
     _KALMAN_KEYS,
     _KNN_KEYS,
     _METHODS,
     _RESTARTS,
+    DEFAULT_INVERSE_METHOD,
     MAX_POPULATION,
+    GaussNewtonConfig,
     IdentifyConfig,
     KalmanConfig,
     KnnConfig,
@@ -57,6 +61,9 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
     if duplicates:
         ck.fail("identify.parameters", value, f"duplicate parameter {', '.join(map(repr, duplicates))}; list each once")
     names = tuple(value)
+    from fracid.inverse.methods import METHODS
+
+    inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
 
     if "bounds" not in raw:
         ck.missing("identify.bounds", "a table with [lower, upper] for " + ", ".join(names))
@@ -128,4 +135,15 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         max_starts=ck.integer("identify.kalman.max_starts", raw_kf.get("max_starts", 3),
                               "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1),
     )
-    return IdentifyConfig(parameters=names, lower=tuple(lower), upper=tuple(upper), log=log, knn=knn, kalman=kalman)
+    raw_gn = ck.table("identify.gauss-newton", raw.get("gauss-newton", {}), _GAUSS_NEWTON_KEYS)
+    gauss_newton = GaussNewtonConfig(
+        max_iterations=ck.integer("identify.gauss-newton.max_iterations", raw_gn.get("max_iterations", 20),
+                                  "must be an integer >= 1 (linearisations at most)", lambda v: v >= 1),
+        tol=ck.number("identify.gauss-newton.tol", raw_gn.get("tol", 0.01),
+                      "must be a number > 0 [standard deviations]", lambda v: v > 0),
+    )
+    if raw_gn and inverse != "knn-gauss-newton":
+        ck.warn(f"[identify.gauss-newton] is given but identify.method = {inverse!r}: its settings are not used "
+                "(set method = \"knn-gauss-newton\" to use them)")
+    return IdentifyConfig(parameters=names, lower=tuple(lower), upper=tuple(upper), log=log, knn=knn, kalman=kalman,
+                          method=inverse, gauss_newton=gauss_newton)

@@ -87,6 +87,10 @@ present they are always validated. Every other key is optional unless marked *re
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
                                             #   no duplicates
+    method = "knn-kalman"               # inverse method (fracid.inverse.methods.METHODS): "knn-kalman"
+                                        #   (default: KNN population, then the Kalman filter) |
+                                        #   "knn-gauss-newton" (KNN, then bounded Gauss-Newton on the same
+                                        #   objective; settings in [identify.gauss-newton])
     [identify.bounds]                   # required: [lower, upper] for every identified parameter,
                                         #   lower < upper, both inside the parameter's valid range
     kappa_i = [4e-5, 1.2e-4]
@@ -106,6 +110,9 @@ present they are always validated. Every other key is optional unless marked *re
     restart = "linearize"               # "linearize" (default) | "prior-mean"
     max_starts = 3                      # integer >= 1, default 3: after a poor end (chi^2 per point > 10), the
                                         #   filter starts again from the next-best population points
+    [identify.gauss-newton]             # optional, read when method = "knn-gauss-newton"
+    max_iterations = 20                 # integer >= 1: linearisations at most, default 20
+    tol = 0.01                          # > 0, in standard deviations, default 0.01
 
     [study]                             # optional: the checks of `fracid study`
     starts = 3                          # multi-start Kalman filters from distinct population points
@@ -177,9 +184,12 @@ _KIND_KEYS = {
     "envelope": ("mean_column", "lower_column", "upper_column"),
     "single": ("force_columns", "std", "relative_std"),
 }
-_IDENTIFY_KEYS = ("parameters", "bounds", "knn", "kalman")
+_IDENTIFY_KEYS = ("parameters", "method", "bounds", "knn", "kalman", "gauss-newton")
 _KNN_KEYS = ("n", "method", "k", "seed")
 _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
+_GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
+#: the default of [identify] method (a key of fracid.inverse.methods.METHODS)
+DEFAULT_INVERSE_METHOD = "knn-kalman"
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
@@ -329,8 +339,17 @@ class KalmanConfig:
 
 
 @dataclass(frozen=True)
+class GaussNewtonConfig:
+    """``[identify.gauss-newton]``: the Gauss-Newton stage of ``method = "knn-gauss-newton"``."""
+
+    max_iterations: int = 20
+    tol: float = 0.01
+
+
+@dataclass(frozen=True)
 class IdentifyConfig:
-    """``[identify]``: identified parameters, their bounds and log flags, KNN and Kalman settings."""
+    """``[identify]``: identified parameters, their bounds and log flags, the inverse method (a key of
+    :data:`fracid.inverse.methods.METHODS`) and the settings of its stages (KNN, Kalman, Gauss-Newton)."""
 
     parameters: tuple
     lower: tuple
@@ -338,6 +357,8 @@ class IdentifyConfig:
     log: tuple = ()  # names sampled in log scale
     knn: KnnConfig = KnnConfig()
     kalman: KalmanConfig = KalmanConfig()
+    method: str = DEFAULT_INVERSE_METHOD
+    gauss_newton: GaussNewtonConfig = GaussNewtonConfig()
 
 
 @dataclass(frozen=True)

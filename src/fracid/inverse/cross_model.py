@@ -32,7 +32,7 @@ import numpy as np
 
 from fracid.data import ExperimentalData
 from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
+from fracid.inverse.space import ParameterSpace
 from fracid.inverse.sensitivity import ForwardRunError
 from fracid.inverse.strategy import IdentificationResult, identify_data
 from fracid.models import ConvergenceError

@@ -332,7 +332,7 @@ def _float_array(name: str, value) -> np.ndarray:
 
 def _check_space(operator, space) -> None:
     if not all(hasattr(space, attr) for attr in ("names", "lower", "upper", "log")):
-        raise TypeError(f"space is a {type(space).__name__}; give a fracid.inverse.knn.ParameterSpace(names, lower, "
+        raise TypeError(f"space is a {type(space).__name__}; give a fracid.inverse.space.ParameterSpace(names, lower, "
                         "upper): the identified parameters and their bounds")
     names = getattr(operator, "names", None)
     if names is not None and tuple(space.names) != tuple(names):

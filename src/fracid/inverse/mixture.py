@@ -1,7 +1,7 @@
 """Gaussian-mixture proposals for importance sampling over the unit cube of the identified parameters.
 
 The posterior of :mod:`fracid.inverse.posterior` lives on the unit cube of
-:class:`~fracid.inverse.knn.ParameterSpace` (where the prior, uniform or log-uniform between the bounds,
+:class:`~fracid.inverse.space.ParameterSpace` (where the prior, uniform or log-uniform between the bounds,
 is uniform). A proposal is a defensive mixture (Hesterberg 1995): a share ``defensive`` of the prior
 itself, which bounds every importance weight by the likelihood over that share, and Student-t
 components (``dof`` degrees of freedom: heavier tails than the target, as importance sampling needs)

@@ -3,7 +3,7 @@ sampling seeded by the Gaussian of the identification.
 
 Target: p(x | y_exp) ~ exp(-1/2 (y(x) - y_exp)^T C_exp^-1 (y(x) - y_exp)) prior(x), with the prior
 uniform between the identification bounds (log-uniform for parameters on a log scale): uniform on the
-unit cube of :class:`~fracid.inverse.knn.ParameterSpace`, where the sampler works.
+unit cube of :class:`~fracid.inverse.space.ParameterSpace`, where the sampler works.
 
 Method (AMIS, Cornuet et al. 2012, with defensive mixtures, Hesterberg 1995): round 0 draws from a
 Gaussian around the estimate (its covariance inflated) plus a share of the prior; every later round

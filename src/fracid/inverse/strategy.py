@@ -16,7 +16,8 @@ import numpy as np
 from fracid.inverse.gauss_newton import gauss_newton
 from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.kalman_status import DEFAULT_MAX_STARTS, restarted
-from fracid.inverse.knn import ParameterSpace, knn_search
+from fracid.inverse.knn import knn_search
+from fracid.inverse.space import ParameterSpace
 from fracid.inverse.method import InverseMethod, MethodResult, check_problem, identification_bounds, result_fields
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import exact_sensitivity, sensitivity_label
