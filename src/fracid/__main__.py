@@ -4,7 +4,7 @@ imported, so that a Ctrl-C while the command starts ends it with a message, not 
 import os
 import sys
 
-from fracid.exits import INTERRUPTED, TERMINATED, stop_signals, stopped_by
+from fracid.exits import describe, stop_signals, stopped_by
 
 
 def run() -> None:
@@ -14,7 +14,7 @@ def run() -> None:
             from fracid.cli import main
         except KeyboardInterrupt as stop:
             print("fracid: stopped while starting; nothing was computed.", file=sys.stderr)
-            status = TERMINATED if type(stop).__name__ == "Terminated" else INTERRUPTED
+            status = describe(stop)[0]
         else:
             status = main()
     if stopped_by() is not None:

@@ -71,15 +71,10 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def version() -> str:
-    """The installed fracid's version (its metadata), else :data:`fracid.__version__` (a source tree)."""
-    from importlib import metadata
+    """The installed fracid's version (:func:`fracid.provenance.fracid_version`)."""
+    from fracid.provenance import fracid_version
 
-    try:
-        return metadata.version("fracid")
-    except metadata.PackageNotFoundError:
-        from fracid import __version__
-
-        return __version__
+    return fracid_version()
 
 
 def run_simulate(args) -> int:

@@ -159,7 +159,7 @@ _DAMAGED = ("it is damaged (truncated, or not written by fracid); move it away (
 
 def _store_text(err, where) -> str:
     """The message of a run-store failure, by SQLite's result code: only a damaged file is to be moved away."""
-    if type(err).__name__ == "NotARunStore":
+    if isinstance(err, _loaded("fracid.store", "NotARunStore")):
         return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
                 "output directory (--out DIR).")
     code = getattr(err, "sqlite_errorcode", None)

@@ -37,6 +37,7 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+from fracid.progress import _is_terminal, clock
 from fracid.store import decode_record, encode_record
 
 __all__ = ["BatchStats", "SerialExecutor", "executor_session", "make_executor", "run_batch"]
@@ -571,7 +572,7 @@ def _progress_reporter(progress, stats: BatchStats | None = None) -> Callable[[i
     if lines_wanted(progress):  # stderr is not a terminal and the command line asked for lines
         return batch_lines("forward runs", failed=(lambda: stats.failed) if stats is not None else None)
     if progress is None:
-        progress = _stderr_is_terminal()
+        progress = _is_terminal()
     if progress is True:
         return _TextProgress(sys.stderr)
     if progress is False:
@@ -579,13 +580,6 @@ def _progress_reporter(progress, stats: BatchStats | None = None) -> Callable[[i
     if callable(progress):
         return progress
     raise TypeError(f"progress must be None, True, False or a callable(done, total), got {progress!r}")
-
-
-def _stderr_is_terminal() -> bool:
-    try:
-        return sys.stderr.isatty()
-    except (AttributeError, ValueError):
-        return False
 
 
 class _TextProgress:
@@ -600,14 +594,8 @@ class _TextProgress:
         if self.first is None:
             self.first = done
         elapsed = time.perf_counter() - self.start
-        line = f"runs {done}/{total} ({100 * done // max(total, 1)} %), {_clock(elapsed)} elapsed"
+        line = f"runs {done}/{total} ({100 * done // max(total, 1)} %), {clock(elapsed)} elapsed"
         if self.first < done < total:
-            line += f", ~{_clock(elapsed / (done - self.first) * (total - done))} left"
+            line += f", ~{clock(elapsed / (done - self.first) * (total - done))} left"
         self.stream.write("\r" + line.ljust(60) + ("\n" if done >= total else ""))
         self.stream.flush()
-
-
-def _clock(seconds: float) -> str:
-    minutes, secs = divmod(int(seconds), 60)
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"

@@ -73,11 +73,13 @@ def data_file(path) -> dict:
 
 
 def fracid_version() -> str:
-    """The installed fracid's version ("unknown" when it is not installed as a package)."""
+    """The installed fracid's version (its metadata), else :data:`fracid.__version__` (a source tree)."""
     try:
         return metadata.version("fracid")
     except metadata.PackageNotFoundError:
-        return "unknown"
+        from fracid import __version__
+
+        return __version__
 
 
 def machine() -> dict:

@@ -14,7 +14,7 @@ import numpy as np
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, _Checker, _read_toml
 from fracid.config.experiments import _data_limit_text, _experiments
 from fracid.config.identify import _identify
-from fracid.config.mesh_section import check_mesh_units
+from fracid.config.mesh_section import c_range, check_mesh_units
 from fracid.config.posterior import _posterior
 from fracid.config.registry import _model_of, _specimen_class
 from fracid.config.schema import (
@@ -111,12 +111,7 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
     """
     if model.regularization not in ("gradient", "integral"):
         return
-    c = _model_parameters(model).c
-    where = f"c = {c:g} mm^2" if "c" in dict(model.parameters) else f"c = {c:g} mm^2 (default)"
-    if identify is not None and "c" in identify.parameters:
-        lower = identify.lower[identify.parameters.index("c")]
-        if lower < c:
-            c, where = lower, f"the lower bound c = {lower:g} mm^2 of identify.bounds.c"
+    (c, where), _ = c_range(model, identify)
     length = math.sqrt(2.0 * c)
     variants = [("specimen", dict(specimen.options), dict(specimen.options))]
     variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))

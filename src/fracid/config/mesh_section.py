@@ -225,7 +225,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
     size = (f"specimen.file = {built.path!r}: the mesh spans {extent[0]:.6g} x {extent[1]:.6g} units of its own, "
             f"{extent[0] * built.scale:.6g} x {extent[1] * built.scale:.6g} mm with specimen.scale = {built.scale:g} "
             "(mm per unit)")
-    (small, small_where), (large, large_where) = _c_range(model, identify)
+    (small, small_where), (large, large_where) = c_range(model, identify)
     length = math.sqrt(2.0 * small)
     if length > extent.max() * built.scale:
         hint = ("is the mesh drawn in metres? then set scale = 1000 under [specimen] (mm per mesh unit)"
@@ -241,7 +241,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
                           f"{large_where}): check specimen.scale ({hint}) and that c is in mm^2")
 
 
-def _c_range(model, identify) -> tuple:
+def c_range(model, identify) -> tuple:
     """((smallest c, where), (largest c, where)) [mm^2] of the model's c and the bounds of an identified c."""
     from fracid.config.loading import _model_parameters
 
