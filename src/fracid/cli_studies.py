@@ -68,19 +68,35 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0, "posterior": None},
                 "stability": {"starts": 0, "posterior": None}}
 
 
+def _study_settings(cfg, command):
+    """The :class:`~fracid.inverse.study.StudySettings` of ``[study]`` with the configured inverse method; a
+    method that cannot run the study's stages is the configuration's error (exit 2)."""
+    from dataclasses import fields
+
+    from fracid.config import ConfigError, build_method, study_settings
+    from fracid.inverse.methods import StudyMethod
+    from fracid.inverse.study import StudySettings
+
+    method = build_method(cfg)
+    if not isinstance(method, StudyMethod):
+        raise ConfigError(f"{cfg.path}: identify.method = {method.name!r}: `fracid {command}` runs the stages of an "
+                          "inverse method (a search over a population, a refinement, a local fit from a point: "
+                          "fracid.inverse.methods.StudyMethod), which this method does not declare; use it with "
+                          "`fracid identify`")
+    checks = {f.name for f in fields(StudySettings)} - {"method"}  # [study]'s; the method's own are in it
+    given = {name: value for name, value in study_settings(cfg).items() if name in checks}
+    return StudySettings(method=method).replace(**{**given, **_STUDY_PARTS[command]})
+
+
 def run_study_command(args) -> int:
-    from fracid.config import build_data, build_held_out, build_operator, build_space, study_settings
-    from fracid.inverse.study import StudySettings, run_study
+    from fracid.config import build_data, build_held_out, build_operator, build_space
+    from fracid.inverse.study import run_study
     from fracid.report.study import write_study
 
     cfg = load(args, args.config, "identify")
     data = build_data(cfg)
     operator, space = build_operator(cfg, data), build_space(cfg)
-    settings = StudySettings().replace(**{**study_settings(cfg), **_STUDY_PARTS[args.command]})
-    if cfg.identify.method != "knn-kalman":
-        warn(f"[identify] method = {cfg.identify.method!r}: `fracid {args.command}` runs the KNN + Kalman filter "
-             "strategy (the study of another method is not built yet); `fracid identify` and `fracid posterior` "
-             "use the configured method")
+    settings = _study_settings(cfg, args.command)
     if cfg.study.posterior and settings.posterior is None:
         say(args, f"posterior: skipped ([study] posterior = true is for `fracid study`, not `fracid {args.command}`)")
     held_out = build_held_out(cfg) if args.command == "study" else []

@@ -8,6 +8,8 @@ parameters: a stable identification has scatter of the order of the posterior st
 
 from __future__ import annotations
 
+from functools import partial
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -68,7 +70,7 @@ def noisy_replicates(y, C_noise, n: int, seed: int = 0) -> np.ndarray:
 
 
 def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int = 0, C_noise=None, bounds=None,
-              executor=None, progress=None, **kalman) -> Stability:
+              executor=None, progress=None, fit=None, **kalman) -> Stability:
     """Identify again from ``replicates`` noisy copies of the data.
 
     Parameters
@@ -85,8 +87,11 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
         Seed of the noise draws.
     C_noise : ndarray, optional
         Covariance of the added noise; C_exp if None.
+    fit : callable, optional
+        The local fit of the replicates, ``fit(evaluate, y, C_exp, x0, C0, bounds=, executor=)`` (an
+        inverse method's ``fit_from``); by default the Kalman filter with the settings ``kalman``.
     kalman
-        Settings of :func:`~fracid.inverse.kalman.kalman_filter`.
+        Settings of :func:`~fracid.inverse.kalman.kalman_filter` (without ``fit``).
     """
     if int(replicates) != replicates or replicates < 2:
         raise ValueError(f"replicates = {replicates!r}: the scatter needs at least 2 replicates")
@@ -97,7 +102,8 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     stds, done = [], []
 
     def run(y):
-        result = kalman_filter(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor, **kalman)
+        fit_once = fit or partial(kalman_filter, **kalman)
+        result = fit_once(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor)
         done.append(result)
         if progress is not None:
             progress(len(done), len(data))

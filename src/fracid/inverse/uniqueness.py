@@ -13,6 +13,8 @@ population: ends that differ by more than their standard deviations expose a non
 
 from __future__ import annotations
 
+from functools import partial
+
 from dataclasses import dataclass, field
 from itertools import combinations
 
@@ -154,7 +156,7 @@ class MultiStart:
         return self.distance <= tolerance
 
 
-def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=None, progress=None,
+def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=None, progress=None, fit=None,
                 **kalman) -> MultiStart:
     """Run the Kalman filter from every starting point with the prior covariance C0.
 
@@ -167,8 +169,11 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
         end to its start).
     progress : callable(done, total), optional
         Called after each filter.
+    fit : callable, optional
+        The local fit from a start, ``fit(evaluate, y_exp, C_exp, x, C0, bounds=, executor=)`` (an inverse
+        method's ``fit_from``); by default the Kalman filter with the settings ``kalman``.
     kalman
-        Settings of :func:`~fracid.inverse.kalman.kalman_filter` (groups, max_iterations, ...).
+        Settings of :func:`~fracid.inverse.kalman.kalman_filter` (groups, max_iterations, ...; without ``fit``).
     """
     from fracid.inverse.knn import objective
 
@@ -176,7 +181,8 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
     done = []
 
     def run(x):
-        result = kalman_filter(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor, **kalman)
+        fit_once = fit or partial(kalman_filter, **kalman)
+        result = fit_once(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor)
         done.append(x)
         if progress is not None:
             progress(len(done), len(starts))
@@ -188,7 +194,7 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
         else:
             results.append(result)
     if not results:
-        raise ForwardRunError("the Kalman filter failed from every starting point: " + "; ".join(failed))
+        raise ForwardRunError("the local fit failed from every starting point: " + "; ".join(failed))
     ends = np.array([r.x for r in results])
     stds = np.array([r.std for r in results])
     f = objective(y_exp, C_exp, np.array([r.y for r in results]))
