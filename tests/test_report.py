@@ -15,6 +15,7 @@ from fracid.inverse.strategy import IdentificationResult
 from fracid.report import fit_metrics, write_report
 
 figures = pytest.importorskip("fracid.report.figures")  # needs matplotlib
+stage_figures = pytest.importorskip("fracid.report.stage_figures")
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 NAMES = ["c", "beta", "kappa_i"]
@@ -172,16 +173,16 @@ def test_figures_have_labelled_axes():
     assert [ax.get_title() for ax in axes] == ["global", "fpz_width"]
     assert [ax.get_xlabel() for ax in axes] == ["control [mm]"] * 2
     assert [ax.get_ylabel() for ax in axes] == ["force [N]", "fpz_width [mm]"]
-    fig = figures.kalman_figure(result)
+    fig = stage_figures.history_figure(result)
     assert [ax.get_ylabel() for ax in fig.axes] == ["c [mm^2]", "beta [-]", "kappa_i [-]"]
     assert sum(1 for line in fig.axes[0].lines if line.get_linestyle() == ":") == 1  # one iteration boundary
-    fig = figures.knn_objective_figure(result)
+    fig = stage_figures.population_objective_figure(result)
     assert fig.axes[0].get_yscale() == "log" and fig.axes[0].get_ylabel() == "objective f [-]"
-    assert figures.strongest_pair(result) == (0, 1)
-    fig = figures.knn_map_figure(result)
+    assert stage_figures.strongest_pair(result) == (0, 1)
+    fig = stage_figures.population_map_figure(result)
     assert fig.axes[0].get_xlabel() == "c [mm^2]" and fig.axes[0].get_ylabel() == "beta [-]"
     # the 2-std ellipse: every point at Mahalanobis distance 2 from the estimate
-    e = figures._ellipse(X[:2], result.C[:2, :2])
+    e = figures.covariance_ellipse(X[:2], result.C[:2, :2])
     d = e - X[:2]
     np.testing.assert_allclose(np.einsum("ni,ij,nj->n", d, np.linalg.inv(result.C[:2, :2]), d), 4.0, rtol=1e-9)
     png = figures.to_png(figures.correlation_figure(result))
@@ -199,9 +200,9 @@ def test_minimal_result_from_json_lists(tmp_path):
         runs={"knn": 20}, notes=[],
     )
     assert None in result.knn["f"]
-    assert figures.knn_map_figure(result) is None and figures.kalman_figure(result) is None
+    assert stage_figures.population_map_figure(result) is None and stage_figures.history_figure(result) is None
     text = write_report(tmp_path / "r.html", result).read_text()
-    assert "No Kalman history in this result." in text and "not converged" in text
+    assert "No history of this stage in this result." in text and "not converged" in text
     assert len(re.findall(r"<img ", text)) == 3  # correlation, fit (index axis), KNN objective
     fig = figures.fit_figure(result)
     assert fig.axes[0].get_xlabel() == "point index in the block [-]"

@@ -232,10 +232,10 @@ def _stage_costs(settings, n_y, p, operator=None) -> str:
 def _write_figures(directory: Path, result, control) -> None:
     """The report's figures as PNG files too."""
     from fracid.report import figures
+    from fracid.report.stage_figures import stage_figures
 
     directory.mkdir(parents=True, exist_ok=True)
-    drawn = {"fit": figures.fit_figure(result, control), "kalman": figures.kalman_figure(result),
-             "knn_objective": figures.knn_objective_figure(result), "knn_map": figures.knn_map_figure(result),
+    drawn = {"fit": figures.fit_figure(result, control), **stage_figures(result),
              "correlation": figures.correlation_figure(result)}
     for name, fig in drawn.items():
         if fig is not None:

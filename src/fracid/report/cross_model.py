@@ -16,12 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.report.figures import _COMPUTED, _MEASURED, _NEIGHBOUR, _new_figure, to_png
-from fracid.report.html import (_e, _fit_section, _image, _parameter_section, _runs_section, _stage_sections, _table,
-                                generated_now, write_document)
+from fracid.report.figures import COMPUTED, MEASURED, NEIGHBOUR, new_figure, to_png
+from fracid.report.html import fit_section, parameter_section
+from fracid.report.markup import esc, generated_now, html_image, html_table, write_document
+from fracid.report.stages import runs_section, stage_sections
 
 #: line colours of the fitted models, in the order of the fits of a panel
-_MODEL_COLOURS = (_COMPUTED, "#2ca02c", _NEIGHBOUR, "#9467bd")
+_MODEL_COLOURS = (COMPUTED, "#2ca02c", NEIGHBOUR, "#9467bd")
 
 _CROSS_HEADER = ["case", "source", "fitted model", "fitted parameters (+- std)", "RMS / peak [%]",
                  "peak force: source, fit [N]", "dissipated energy: source, fit [N mm]", "energy ratio fit / source [-]",
@@ -85,16 +86,16 @@ def curves_figure(panels, *, control_label: str = "CMOD [mm]"):
         One panel per entry, side by side.
     """
     panels = list(panels)
-    fig = _new_figure(5.0 * len(panels), 4.0)
+    fig = new_figure(5.0 * len(panels), 4.0)
     axes = np.atleast_1d(fig.subplots(1, len(panels), squeeze=False)[0])
     for ax, panel in zip(axes, panels):
         if panel.std is not None:
-            ax.fill_between(panel.control, panel.y - 2 * panel.std, panel.y + 2 * panel.std, color=_MEASURED,
+            ax.fill_between(panel.control, panel.y - 2 * panel.std, panel.y + 2 * panel.std, color=MEASURED,
                             alpha=0.2, lw=0, label=f"{panel.data_label} +/- 2 std")
         if panel.source is not None:
             label, control, force = panel.source
             ax.plot(control, force, "-", color="k", lw=1.0, label=label)
-        ax.plot(panel.control, panel.y, "o", color=_MEASURED, ms=3.5, label=panel.data_label)
+        ax.plot(panel.control, panel.y, "o", color=MEASURED, ms=3.5, label=panel.data_label)
         for fit, colour in zip(panel.fits, _MODEL_COLOURS):
             ax.plot(fit.control, fit.force, "--", color=colour, lw=1.6,
                     label=f"{fit.label} (RMS {100 * fit.rms_relative:.1f} %)")
@@ -157,9 +158,9 @@ def _fit_details(fit, control) -> str:
     from fracid.report import figures
 
     result = fit.identification
-    final_stage = _stage_sections(result, figures, limit=1)  # the stage that gave the estimate
-    sections = [_parameter_section(result), _fit_section(result, control, figures), *final_stage, _runs_section(result)]
-    return (f"<details><summary>{_e(fit.label)} ({_e(fit.model_key)}): identification details</summary>\n"
+    final_stage = stage_sections(result, figures, limit=1)  # the stage that gave the estimate
+    sections = [parameter_section(result), fit_section(result, control, figures), *final_stage, runs_section(result)]
+    return (f"<details><summary>{esc(fit.label)} ({esc(fit.model_key)}): identification details</summary>\n"
             + "\n".join(sections) + "\n</details>")
 
 
@@ -189,35 +190,35 @@ def write_cross_model_report(path, *, crosses=(), comparisons=(), title="fracid:
     crosses, comparisons = list(crosses), list(comparisons)
     panels = ([CurvePanel.of_cross(case, cross) for case, cross in crosses]
               + [CurvePanel.of_comparison(label, comparison) for label, comparison in comparisons])
-    body = [f"<h1>{_e(title)}</h1>", f'<p class="meta">Generated {_e(generated_now())} by fracid.</p>']
+    body = [f"<h1>{esc(title)}</h1>", f'<p class="meta">Generated {esc(generated_now())} by fracid.</p>']
     if intro:
-        body.append(f"<p>{_e(intro)}</p>")
+        body.append(f"<p>{esc(intro)}</p>")
     if panels:
-        body.append(_image(to_png(curves_figure(panels)), "fitted curves",
+        body.append(html_image(to_png(curves_figure(panels)), "fitted curves",
                            "Data (points), the source curves of the cross-calibrations (black) and the runs of the "
                            "fitted models at their estimates (dashed)."))
     if crosses:
         header, rows = cross_rows(crosses)
         body.append("<h2>Cross-calibration: model B fitted to a curve of model A</h2>")
-        body.append(_table(header, rows, text_columns=(0, 1, 2, 3)))
+        body.append(html_table(header, rows, text_columns=(0, 1, 2, 3)))
         body.append("<p>RMS: root mean square of the force residual at the data points over the source's peak force. "
                     "Dissipated energy: external work minus elastic energy of the runs to the last data point.</p>")
     for label, comparison in comparisons:
         header, rows = comparison_rows(comparison)
         peak = float(np.max(np.abs(comparison.data.y)))
-        body.append(f"<h2>{_e(label)}</h2>")
-        body.append(_table(header, rows, text_columns=(0, 1)))
+        body.append(f"<h2>{esc(label)}</h2>")
+        body.append(html_table(header, rows, text_columns=(0, 1)))
         body.append(f"<p>{comparison.data.y.size} data points from {comparison.data.control[0]:.4g} to "
                     f"{comparison.data.control[-1]:.4g} mm; measured peak {peak:.1f} N (the RMS is relative to it). "
                     "Dissipated energy of each model's run at its estimate to the last data point.</p>")
         for failed, reason in getattr(comparison, "failures", {}).items():
-            body.append(f"<p><strong>{_e(failed)}: not fitted.</strong> {_e(reason)}</p>")
+            body.append(f"<p><strong>{esc(failed)}: not fitted.</strong> {esc(reason)}</p>")
     body.append("<h2>Identification details</h2>")
     for case, cross in crosses:
-        body.append(f"<h3>{_e(case)}</h3>\n" + _fit_details(cross.fit, cross.data.control))
+        body.append(f"<h3>{esc(case)}</h3>\n" + _fit_details(cross.fit, cross.data.control))
     for label, comparison in comparisons:
-        body.append(f"<h3>{_e(label)}</h3>\n"
+        body.append(f"<h3>{esc(label)}</h3>\n"
                     + "\n".join(_fit_details(fit, comparison.data.control) for fit in comparison.fits))
     if notes:
-        body.append("<h2>Notes</h2>\n<ul class=\"notes\">" + "".join(f"<li>{_e(n)}</li>" for n in notes) + "</ul>")
+        body.append("<h2>Notes</h2>\n<ul class=\"notes\">" + "".join(f"<li>{esc(n)}</li>" for n in notes) + "</ul>")
     return write_document(path, title, body)

@@ -22,10 +22,10 @@ from matplotlib.patches import Patch
 from fracid.inverse.verdict import Z_90
 from fracid.tables import without_nan
 from fracid.report.figures import (
-    _COMPUTED,
-    _MEASURED,
-    _ellipse,
-    _new_figure,
+    COMPUTED,
+    MEASURED,
+    covariance_ellipse,
+    new_figure,
     block_panels,
     finish_block_panel,
     parameter_units,
@@ -39,7 +39,7 @@ __all__ = ["GAUSSIAN_90", "comparison_table", "corner_figure", "posterior_dict",
 GAUSSIAN_90 = Z_90
 
 _POSTERIOR = "#1f77b4"
-_GAUSSIAN = _COMPUTED
+_GAUSSIAN = COMPUTED
 _MEAN = "#ff7f0e"
 
 #: what each interval is, as the JSON and the page label them
@@ -136,7 +136,7 @@ def corner_figure(result, log_axes=None) -> Figure:
     intervals = result.credible_intervals(0.9)
 
     side = min(2.6, 10.0 / max(p, 1)) * p + 0.8
-    fig = _new_figure(6.4, 4.0) if p == 1 else _new_figure(side, side)
+    fig = new_figure(6.4, 4.0) if p == 1 else new_figure(side, side)
     axes = fig.subplots(p, p, squeeze=False)
     for i in range(p):
         for j in range(p):
@@ -190,7 +190,7 @@ def _pair(ax, xv, yv, weights, x_edges, y_edges, centre, cov, mean, log) -> None
     ax.pcolormesh(x_edges, y_edges, np.ma.masked_equal(counts.T, 0.0), cmap="Blues", shading="flat")
     if np.all(np.isfinite(centre)) and np.all(np.isfinite(cov)):
         for n_std, style in ((1.0, "-"), (2.0, "--")):
-            ring = _ellipse(centre, cov, n_std)
+            ring = covariance_ellipse(centre, cov, n_std)
             if log[0] or log[1]:  # points below zero have no place on a log axis
                 keep = ((ring[:, 0] > 0) | (not log[0])) & ((ring[:, 1] > 0) | (not log[1]))
                 ring = np.where(keep[:, None], ring, np.nan)
@@ -227,7 +227,7 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
         ax.plot(xs[order], median[part][order], "-", color=_POSTERIOR, lw=1.6, label="posterior median")
         if fit is not None and np.any(np.isfinite(fit[part])):
             ax.plot(xs[order], fit[part][order], "--", color=_GAUSSIAN, lw=1.4, label="Kalman filter fit")
-        ax.errorbar(xs, y_exp[part], yerr=std[part], fmt="o", color=_MEASURED, ms=3.5, capsize=2, lw=1,
+        ax.errorbar(xs, y_exp[part], yerr=std[part], fmt="o", color=MEASURED, ms=3.5, capsize=2, lw=1,
                     label="measured +- std", zorder=3)
         finish_block_panel(ax, name, control is not None)
     return fig
@@ -313,26 +313,26 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
 def comparison_table(result) -> str:
     """HTML table: per parameter, the Kalman filter's estimate, std and Gaussian 90 % interval beside the
     posterior's mean, std and 90 % credible interval."""
-    from fracid.report.html import _num, _table
+    from fracid.report.markup import html_table, num
 
     rows = []
     for name, entry in posterior_dict(result)["parameters"].items():
         kf, post = entry["kalman_filter"], entry["posterior"]
-        rows.append([name, entry["unit"], _num(kf["estimate"], 5), _num(kf["std"], 3),
-                     f"[{_num(kf['interval_90'][0], 5)}, {_num(kf['interval_90'][1], 5)}]",
-                     _num(post["mean"], 5), _num(post["std"], 3),
-                     f"[{_num(post['interval_90'][0], 5)}, {_num(post['interval_90'][1], 5)}]"])
-    return _table(["parameter", "unit", "Kalman filter estimate", "Kalman filter std",
+        rows.append([name, entry["unit"], num(kf["estimate"], 5), num(kf["std"], 3),
+                     f"[{num(kf['interval_90'][0], 5)}, {num(kf['interval_90'][1], 5)}]",
+                     num(post["mean"], 5), num(post["std"], 3),
+                     f"[{num(post['interval_90'][0], 5)}, {num(post['interval_90'][1], 5)}]"])
+    return html_table(["parameter", "unit", "Kalman filter estimate", "Kalman filter std",
                    "Kalman filter 90 % interval (estimate +- 1.645 std)", "posterior mean", "posterior std",
                    "posterior 90 % credible interval"], rows, text_columns=(0, 1))
 
 
 def statistics_table(result) -> str:
     """HTML table of the sampler's draws, rounds, effective sample size, failed runs and status."""
-    from fracid.report.html import _num, _table
+    from fracid.report.markup import html_table, num
 
-    return _table(["", ""], [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
-                             ["effective sample size (ESS)", _num(result.ess, 4)], ["failed runs", result.failed],
+    return html_table(["", ""], [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
+                             ["effective sample size (ESS)", num(result.ess, 4)], ["failed runs", result.failed],
                              ["status", result.status]], text_columns=(0, 1))
 
 
@@ -340,17 +340,17 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
     """A self-contained HTML page: the Kalman filter's Gaussian estimate beside the posterior per
     parameter, the sampler's statistics and rounds, the figures ``pngs`` (``corner`` and
     ``posterior_predictive`` PNG bytes) embedded and, collapsed, how the run was made (``provenance``)."""
-    from fracid.report.html import _e, _image, _num, _table, generated_now, provenance_section, write_document
+    from fracid.report.markup import esc, generated_now, html_image, html_table, num, provenance_section, write_document
 
     table, stats = comparison_table(result), statistics_table(result)
-    status = _e(result.status) if result.converged else f'<span class="warn">{_e(result.status)}</span>'
-    history = _table(["round", "draws", "failed", "ESS after the round", "proposal components"],
-                     [[h.get("round", k) + 1, h.get("draws", ""), h.get("failed", ""), _num(h.get("ess"), 4),
+    status = esc(result.status) if result.converged else f'<span class="warn">{esc(result.status)}</span>'
+    history = html_table(["round", "draws", "failed", "ESS after the round", "proposal components"],
+                     [[h.get("round", k) + 1, h.get("draws", ""), h.get("failed", ""), num(h.get("ess"), 4),
                        h.get("components", "")] for k, h in enumerate(result.history)])
     names = ", ".join(str(n) for n in result.names)
     body = [
-        f"<h1>{_e(title)}</h1>",
-        (f'<p class="meta">Generated {_e(generated_now())} by fracid. Parameters: {_e(names)}; '
+        f"<h1>{esc(title)}</h1>",
+        (f'<p class="meta">Generated {esc(generated_now())} by fracid. Parameters: {esc(names)}; '
          f"{np.size(result.y_exp)} measured values.</p>"),
         "<h2>Kalman filter and posterior</h2>",
         table,
@@ -360,11 +360,11 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
          f"its interval is the equal-tailed 90 % credible interval of the weighted draws. Status: {status}.</p>"),
         stats,
         "<h2>Figures</h2>",
-        _image(pngs["corner"], "corner plot",
+        html_image(pngs["corner"], "corner plot",
                "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and pair "
                "(below: 2D histogram), with the Kalman filter's Gaussian in red (normal curve; 1 and 2 std "
                "ellipses; x its estimate; orange +: the posterior mean)."),
-        _image(pngs["posterior_predictive"], "posterior predictive",
+        html_image(pngs["posterior_predictive"], "posterior predictive",
                "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without measurement "
                "noise), its median, and the Kalman filter's fit (dashed)."),
         "<h2>Rounds of the sampler</h2>",

@@ -15,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.report.figures import (_ESTIMATE, _MEASURED, _NEIGHBOUR, _new_figure, _parameter_axis, parameter_label,
+from fracid.report.figures import (ESTIMATE, MEASURED, NEIGHBOUR, new_figure, parameter_axis, parameter_label,
                                    parameter_units, sensitivity_figure, size_effect_figure, to_png)
-from fracid.report.html import _e, _image, _table, write_report
+from fracid.report.html import write_report
+from fracid.report.markup import esc, html_image, html_table
 from fracid.report.posterior import (comparison_table, corner_figure, predictive_figure, statistics_table,
                                      write_posterior)
 
@@ -31,7 +32,7 @@ def valley_figure(maps, multi_start=None, truth=None, names=None):
     when omitted, which only fits two parameters)."""
     if not maps:
         return None
-    fig = _new_figure(5.2 * len(maps), 4.4)
+    fig = new_figure(5.2 * len(maps), 4.4)
     axes = np.atleast_1d(fig.subplots(1, len(maps)))
     for ax, m in zip(axes, maps):
         reference = "f_estimate" if m.centred and m.f[0] <= m.f.min() else "f_min"
@@ -39,20 +40,20 @@ def valley_figure(maps, multi_start=None, truth=None, names=None):
         sc = ax.scatter(m.points[:, 0], m.points[:, 1], c=np.log10(excess + 1.0), cmap="viridis_r", s=25,
                         edgecolors="none")
         fig.colorbar(sc, ax=ax, label=f"log10(f - {reference} + 1) [-]")
-        ax.plot(m.points[m.valley, 0], m.points[m.valley, 1], "o", mfc="none", mec=_NEIGHBOUR, ms=10, mew=1.6,
+        ax.plot(m.points[m.valley, 0], m.points[m.valley, 1], "o", mfc="none", mec=NEIGHBOUR, ms=10, mew=1.6,
                 label=f"valley: f - {reference} <= {m.level:.3g} ({int(m.valley.sum())} points)")
         if m.centred:
-            ax.plot([m.points[0, 0]], [m.points[0, 1]], "D", color=_ESTIMATE, ms=8, mec="k", mew=0.6, label="estimate")
+            ax.plot([m.points[0, 0]], [m.points[0, 1]], "D", color=ESTIMATE, ms=8, mec="k", mew=0.6, label="estimate")
         i, j = (list(names).index(m.names[0]), list(names).index(m.names[1])) if names is not None else (0, 1)
         if multi_start is not None:
             for a, b in zip(multi_start.starts, multi_start.ends):
-                ax.annotate("", xy=(b[i], b[j]), xytext=(a[i], a[j]), arrowprops={"arrowstyle": "->", "color": _ESTIMATE})
-            ax.plot(multi_start.ends[:, i], multi_start.ends[:, j], "*", color=_ESTIMATE, ms=12, mec="k", mew=0.5,
+                ax.annotate("", xy=(b[i], b[j]), xytext=(a[i], a[j]), arrowprops={"arrowstyle": "->", "color": ESTIMATE})
+            ax.plot(multi_start.ends[:, i], multi_start.ends[:, j], "*", color=ESTIMATE, ms=12, mec="k", mew=0.5,
                     label="multi-start ends")
         if truth is not None:
             ax.plot([truth[i]], [truth[j]], "P", color="k", ms=10, label="truth")
-        _parameter_axis(ax, "x", m.points[:, 0])
-        _parameter_axis(ax, "y", m.points[:, 1])
+        parameter_axis(ax, "x", m.points[:, 0])
+        parameter_axis(ax, "y", m.points[:, 1])
         ax.set_xlabel(parameter_label(m.names[0]))
         ax.set_ylabel(parameter_label(m.names[1]))
         title = f"valley correlation {m.correlation:+.2f}" if np.isfinite(m.correlation) else "valley"
@@ -66,14 +67,14 @@ def stability_figure(stability, names, estimate=None, std=None):
     """Estimates of the noisy replicates per parameter, with the estimate and its +-2 std band."""
     ok = stability.ok
     p = len(names)
-    fig = _new_figure(3.2 * p, 3.4)
+    fig = new_figure(3.2 * p, 3.4)
     axes = np.atleast_1d(fig.subplots(1, p))
     for j, (ax, name) in enumerate(zip(axes, names)):
-        ax.plot(np.arange(1, ok.sum() + 1), stability.estimates[ok, j], "o", color=_MEASURED, label="replicates")
+        ax.plot(np.arange(1, ok.sum() + 1), stability.estimates[ok, j], "o", color=MEASURED, label="replicates")
         if estimate is not None:
-            ax.axhline(estimate[j], color=_ESTIMATE, label="estimate")
+            ax.axhline(estimate[j], color=ESTIMATE, label="estimate")
             if std is not None:
-                ax.axhspan(estimate[j] - 2 * std[j], estimate[j] + 2 * std[j], color=_ESTIMATE, alpha=0.12,
+                ax.axhspan(estimate[j] - 2 * std[j], estimate[j] + 2 * std[j], color=ESTIMATE, alpha=0.12,
                            label="+- 2 std")
         ax.set_xlabel("replicate")
         ax.set_ylabel(parameter_label(name))
@@ -88,12 +89,12 @@ def prediction_figure(predictions):
     shown = [p for p in predictions if p.status == "ok"]
     if not shown:
         return None
-    fig = _new_figure(4.6 * len(shown), 3.6)
+    fig = new_figure(4.6 * len(shown), 3.6)
     axes = np.atleast_1d(fig.subplots(1, len(shown)))
     for ax, p in zip(axes, shown):
-        ax.errorbar(p.control, p.y_exp, yerr=p.std_exp, fmt="o", ms=3, color=_MEASURED, label="measured")
-        ax.plot(p.control, p.y, "-", color=_ESTIMATE, label="predicted")
-        ax.fill_between(p.control, p.y - 2 * p.std, p.y + 2 * p.std, color=_ESTIMATE, alpha=0.15, label="+- 2 std")
+        ax.errorbar(p.control, p.y_exp, yerr=p.std_exp, fmt="o", ms=3, color=MEASURED, label="measured")
+        ax.plot(p.control, p.y, "-", color=ESTIMATE, label="predicted")
+        ax.fill_between(p.control, p.y - 2 * p.std, p.y + 2 * p.std, color=ESTIMATE, alpha=0.15, label="+- 2 std")
         ax.set_title(f"{p.name}: RMS {p.relative_rms:.1%}, chi2/point {p.chi2_per_point:.2f}", fontsize=9)
         ax.set_xlabel("control [mm]")
         ax.grid(alpha=0.3)
@@ -120,33 +121,33 @@ def _verdict_section(study) -> str:
     rows = [[v.name, v.status, f"{v.value:.5g}", f"{v.std:.3g}", f"{v.std / abs(v.value):.1%}", v.measure,
              f"{v.partner} ({v.correlation:+.3f})" if v.partner else "", f"{v.variance_removed:.0%}",
              "; ".join(v.remarks + tuple(f"would help: {s}" for s in v.suggestions))] for v in study.verdict.parameters]
-    table = _table(["parameter", "verdict", "estimate", "std", "std/|x|", "measure", "most correlated with",
+    table = html_table(["parameter", "verdict", "estimate", "std", "std/|x|", "measure", "most correlated with",
                     "prior variance removed", "remarks"], rows, text_columns=(0, 1, 5, 6, 8))
     if getattr(study, "posterior", None) is not None:
         table = ("<p>Measure: the posterior's equal-tailed 90 % credible interval (see Posterior below). Estimate: the "
                  "posterior mean; std: the interval's half-width / 1.645 (its standard deviation if the posterior were "
                  "normal); correlations: the weighted covariance of the draws.</p>" + table)
-    text = "<pre>" + _e(study.verdict.text(units)) + "</pre>"
-    runs = f"<p>{_e(study.runs_text())}</p>" if getattr(study, "runs", None) else ""
-    notes = "".join(f"<li>{_e(n)}</li>" for n in getattr(study, "notes", ()))
+    text = "<pre>" + esc(study.verdict.text(units)) + "</pre>"
+    runs = f"<p>{esc(study.runs_text())}</p>" if getattr(study, "runs", None) else ""
+    notes = "".join(f"<li>{esc(n)}</li>" for n in getattr(study, "notes", ()))
     return table + text + runs + (f'<ul class="notes">{notes}</ul>' if notes else "")
 
 
 def _posterior_section(post, pngs: dict) -> str:
     """The Kalman filter's Gaussian beside the sampled posterior, the sampler's statistics and its figures."""
     table, stats = comparison_table(post), statistics_table(post)
-    status = _e(post.status) if post.converged else f'<span class="warn">{_e(post.status)}</span>'
+    status = esc(post.status) if post.converged else f'<span class="warn">{esc(post.status)}</span>'
     text = ("<p>Adaptive importance sampling on the exact forward model (every draw one forward run, stored in "
             "runs.sqlite under the label \"posterior\"), started from the Kalman filter's Gaussian, prior uniform "
             "between the bounds of [identify.bounds] (log-uniform where log-scaled), with the [posterior] settings. "
             f"Status: {status}. The draws and their weights are in posterior.csv, the numbers in posterior.json; "
             '<a href="posterior.html">posterior.html</a> shows the sampler\'s rounds too.</p>')
-    figures = [_image(pngs["corner"], "corner plot",
+    figures = [html_image(pngs["corner"], "corner plot",
                       "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and "
                       "pair (below: 2D histogram), with the Kalman filter's Gaussian in red (normal curve; 1 and 2 "
                       "std ellipses; x its estimate; orange +: the posterior mean).")]
     if pngs.get("posterior_predictive") is not None:
-        figures.append(_image(pngs["posterior_predictive"], "posterior predictive",
+        figures.append(html_image(pngs["posterior_predictive"], "posterior predictive",
                               "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without "
                               "measurement noise), its median, and the Kalman filter's fit (dashed)."))
     return text + table + stats + "".join(figures)
@@ -185,13 +186,13 @@ def study_sections(study, figures: dict, posterior_figures: dict | None = None) 
     for name in [*captions, *(n for n in figures if n not in captions)]:  # a figure without a caption too
         fig = figures.get(name)
         if fig is not None:
-            sections.append((name.replace("_", " ").capitalize(), _image(to_png(fig), name, captions.get(name, ""))))
+            sections.append((name.replace("_", " ").capitalize(), html_image(to_png(fig), name, captions.get(name, ""))))
     if study.multi_start is not None:
         ms = study.multi_start
         rows = [[i + 1, *np.round(a, 6).tolist(), *np.round(b, 6).tolist(), f"{f:.4g}"]
                 for i, (a, b, f) in enumerate(zip(ms.starts, ms.ends, ms.f))]
         header = ["start"] + [f"start {n}" for n in study.names] + [f"end {n}" for n in study.names] + ["f at end"]
-        sections.append(("Multi-start check", _table(header, rows)))
+        sections.append(("Multi-start check", html_table(header, rows)))
     return sections
 
 
