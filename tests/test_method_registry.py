@@ -76,3 +76,19 @@ def test_the_default_method_is_still_knn_kalman(tmp_path, curve):
     proc = run_fracid(["identify", "cfg.toml", *OUT], tmp_path)
     check(proc, tmp_path, 0)
     assert json.loads((tmp_path / "out" / "result.json").read_text())["method"] == "knn-kalman"
+
+
+@pytest.mark.slow
+def test_fracid_study_runs_knn_gauss_newton_and_gives_a_verdict(tmp_path, curve):
+    _case(tmp_path, curve, identify='method = "knn-gauss-newton"',
+          tail="[identify.gauss-newton]\nmax_iterations = 10\n[study]\nstarts = 2\nreplicates = 2")
+    proc = run_fracid(["study", "cfg.toml", *OUT], tmp_path)
+    check(proc, tmp_path, 0)
+    study = json.loads((tmp_path / "out" / "study.json").read_text())
+    assert study["identification"]["method"] == "knn-gauss-newton"
+    assert set(study["runs"]) >= {"KNN", "Gauss-Newton", "multi-start", "stability"}
+    assert {v["name"] for v in study["verdict"]["parameters"]} == {"c", "beta"}
+    assert len(study["stability"]["estimates"]) == 2 and len(study["multi_start"]["ends"]) == 2
+    verdict = (tmp_path / "out" / "verdict.txt").read_text()
+    assert "Gauss-Newton: converged" in verdict
+    assert "<h2>Gauss-Newton</h2>" in (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
