@@ -36,16 +36,16 @@ def test_posterior_writes_draws_json_figures_and_page(run):
     assert table.shape[0] >= 40 and np.isclose(table[:, 2].sum(), 1.0, atol=1e-6)
     info = json.loads((out / "posterior.json").read_text())
     assert info["ess"] >= 30 and info["status"] == "converged"
-    assert np.shape(info["interval_90"]) == (2, 2) and np.shape(info["kalman_filter"]["interval_90"]) == (2, 2)
+    assert np.shape(info["interval_90"]) == (2, 2) and np.shape(info["gaussian"]["interval_90"]) == (2, 2)
     c = info["parameters"]["c"]
-    assert c["unit"] == "mm^2" and set(c) == {"unit", "kalman_filter", "posterior"}
-    kf = c["kalman_filter"]
+    assert c["unit"] == "mm^2" and set(c) == {"unit", "gaussian", "posterior"}
+    kf = c["gaussian"]
     assert np.allclose(kf["interval_90"], [kf["estimate"] - 1.645 * kf["std"], kf["estimate"] + 1.645 * kf["std"]],
                        rtol=1e-3)
     for name in ("corner", "posterior_predictive"):
         assert (out / "figures" / f"{name}.png").read_bytes()[:8] == PNG
     page = (out / "posterior.html").read_text()
-    assert "Kalman filter" in page and "importance sampling" in page and "90 % credible interval" in page
+    assert "Identification and posterior" in page and "importance sampling" in page and "90 % credible interval" in page
     assert page.count("data:image/png;base64,") == 2
     for written in ("result.json", "fit.csv", "report.html", "runs.sqlite"):  # what identify writes
         assert (out / written).exists()

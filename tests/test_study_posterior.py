@@ -45,7 +45,7 @@ def test_study_samples_the_posterior_and_its_verdict_names_the_measure(run):
     for name in ("corner", "posterior_predictive"):
         assert (out / "figures" / f"{name}.png").read_bytes()[:8] == PNG
     html = (out / "report.html").read_text()
-    assert "<h2>Posterior</h2>" in html and "Kalman filter 90 % interval" in html
+    assert "<h2>Posterior</h2>" in html and "Gaussian 90 % interval" in html
     assert "effective sample size (ESS)" in html and 'href="posterior.html"' in html
     assert 'alt="corner plot"' in html and 'alt="posterior predictive"' in html
     assert html.index("<h2>Verdict</h2>") < html.index("<h2>Posterior</h2>")

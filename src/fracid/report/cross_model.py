@@ -28,7 +28,7 @@ _CROSS_HEADER = ["case", "source", "fitted model", "fitted parameters (+- std)",
                  "peak force: source, fit [N]", "dissipated energy: source, fit [N mm]", "energy ratio fit / source [-]",
                  "forward runs"]
 _COMPARISON_HEADER = ["model", "fitted parameters (+- std)", "RMS / peak [%]", "peak force [N]",
-                      "dissipated energy [N mm]", "forward runs", "Kalman converged"]
+                      "dissipated energy [N mm]", "forward runs", "converged"]
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
 """The posterior of ``fracid posterior``: the sampler run from an identification, its figures (corner
-plot, posterior predictive band), its JSON, and a self-contained HTML page setting the Kalman filter's
+plot, posterior predictive band), its JSON, and a self-contained HTML page setting the identification's
 Gaussian beside the sampled posterior.
 
 The sampler itself is :func:`fracid.inverse.posterior.posterior`; here it is only started from an
@@ -43,7 +43,7 @@ _GAUSSIAN = COMPUTED
 _MEAN = "#ff7f0e"
 
 #: what each interval is, as the JSON and the page label them
-KALMAN_INTERVAL = "Kalman filter: Gaussian 90 % interval, estimate +- 1.645 std"
+GAUSSIAN_INTERVAL = "identification: Gaussian 90 % interval, estimate +- 1.645 std"
 POSTERIOR_INTERVAL = ("posterior: equal-tailed 90 % credible interval (weighted 5 % and 95 % quantiles of the "
                       "importance-weighted draws)")
 
@@ -107,7 +107,7 @@ def _scale(ax, axis: str, log: bool) -> None:
 
 
 def corner_figure(result, log_axes=None) -> Figure:
-    """Pairs of the weighted draws, with the Kalman filter's Gaussian over them.
+    """Pairs of the weighted draws, with the identification's Gaussian over them.
 
     Diagonal: the weighted histogram of each parameter (density), the normal curve of the Gaussian
     estimate (``estimate``, ``estimate_cov``) and the posterior's 90 % credible interval (dotted).
@@ -164,13 +164,13 @@ def corner_figure(result, log_axes=None) -> Figure:
             ax.grid(True, alpha=0.25)
     handles = [Patch(color=_POSTERIOR, alpha=0.5, label="posterior (weighted draws)"),
                Line2D([], [], color=_POSTERIOR, ls=":", label="posterior 90 % credible interval"),
-               Line2D([], [], color=_GAUSSIAN, label="Kalman filter Gaussian (1 and 2 std)"),
+               Line2D([], [], color=_GAUSSIAN, label="identification's Gaussian (1 and 2 std)"),
                Line2D([], [], color=_MEAN, marker="+", ls="", ms=9, mew=1.8, label="posterior mean"),
-               Line2D([], [], color=_GAUSSIAN, marker="x", ls="", ms=7, mew=1.8, label="Kalman filter estimate")]
+               Line2D([], [], color=_GAUSSIAN, marker="x", ls="", ms=7, mew=1.8, label="identification's estimate")]
     holder = axes[0, p - 1] if p > 1 else axes[0, 0]
     holder.legend(handles=handles if p > 1 else handles[:3], loc="upper right", fontsize="small",
                   framealpha=0.9 if p > 1 else 0.6)
-    fig.suptitle(f"posterior: {len(result.x)} draws, ESS {result.ess:.0f}; Kalman filter Gaussian in red",
+    fig.suptitle(f"posterior: {len(result.x)} draws, ESS {result.ess:.0f}; the identification's Gaussian in red",
                  fontsize="medium")
     return fig
 
@@ -202,7 +202,7 @@ def _pair(ax, xv, yv, weights, x_edges, y_edges, centre, cov, mean, log) -> None
 def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
     """Per data block: the measured points with +- 1 std error bars, the posterior 90 % band of the
     computed curve (:meth:`PosteriorResult.predictive_band`, without measurement noise), its median,
-    and the Kalman filter's fit when given.
+    and the identification's fit when given.
 
     Parameters
     ----------
@@ -212,7 +212,7 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
     blocks : sequence of (name, start, stop), optional
         Data blocks of y (``ExperimentalData.blocks``); one block without them.
     fit : array_like, optional
-        The values computed at the Kalman filter's estimate (``IdentificationResult.y_fit``).
+        The values computed at the identification's estimate (``MethodResult.y_fit``).
     """
     y_exp = np.asarray(result.y_exp, float)
     std = np.asarray(result.std_exp, float)
@@ -226,7 +226,7 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
                         label="posterior 90 % band of the computed curve")
         ax.plot(xs[order], median[part][order], "-", color=_POSTERIOR, lw=1.6, label="posterior median")
         if fit is not None and np.any(np.isfinite(fit[part])):
-            ax.plot(xs[order], fit[part][order], "--", color=_GAUSSIAN, lw=1.4, label="Kalman filter fit")
+            ax.plot(xs[order], fit[part][order], "--", color=_GAUSSIAN, lw=1.4, label="identification's fit")
         ax.errorbar(xs, y_exp[part], yerr=std[part], fmt="o", color=MEASURED, ms=3.5, capsize=2, lw=1,
                     label="measured +- std", zorder=3)
         finish_block_panel(ax, name, control is not None)
@@ -237,7 +237,7 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
 
 
 def posterior_dict(result) -> dict:
-    """:meth:`PosteriorResult.to_dict` with the Kalman filter's estimate, std and Gaussian 90 % interval,
+    """:meth:`PosteriorResult.to_dict` with the identification's estimate, std and Gaussian 90 % interval,
     and per parameter both estimates and both intervals, labelled."""
     out = result.to_dict()
     names = list(result.names)
@@ -246,11 +246,11 @@ def posterior_dict(result) -> dict:
     kf_interval = np.column_stack([estimate - GAUSSIAN_90 * kf_std, estimate + GAUSSIAN_90 * kf_std])
     intervals = np.asarray(out["interval_90"], float)
     out["interval_90_label"] = POSTERIOR_INTERVAL
-    out["kalman_filter"] = {"estimate": estimate.tolist(), "std": kf_std.tolist(), "interval_90": kf_interval.tolist(),
-                            "interval_90_label": KALMAN_INTERVAL}
+    out["gaussian"] = {"estimate": estimate.tolist(), "std": kf_std.tolist(), "interval_90": kf_interval.tolist(),
+                            "interval_90_label": GAUSSIAN_INTERVAL}
     out["parameters"] = {
         name: {"unit": result.units.get(name, ""),
-               "kalman_filter": {"estimate": float(estimate[j]), "std": float(kf_std[j]),
+               "gaussian": {"estimate": float(estimate[j]), "std": float(kf_std[j]),
                                  "interval_90": kf_interval[j].tolist()},
                "posterior": {"mean": float(out["mean"][j]), "std": float(out["std"][j]),
                              "interval_90": intervals[j].tolist()}}
@@ -273,7 +273,7 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     data : ExperimentalData, optional
         Its ``control`` and ``blocks`` lay out the predictive figure.
     fit : array_like, optional
-        The Kalman filter's fit, drawn in the predictive figure.
+        The identification's fit, drawn in the predictive figure.
     log_axes : sequence of bool, optional
         Log axes of the corner plot per parameter (``ParameterSpace.log``).
     title : str
@@ -311,19 +311,19 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
 
 
 def comparison_table(result) -> str:
-    """HTML table: per parameter, the Kalman filter's estimate, std and Gaussian 90 % interval beside the
+    """HTML table: per parameter, the identification's estimate, std and Gaussian 90 % interval beside the
     posterior's mean, std and 90 % credible interval."""
     from fracid.report.markup import html_table, num
 
     rows = []
     for name, entry in posterior_dict(result)["parameters"].items():
-        kf, post = entry["kalman_filter"], entry["posterior"]
+        kf, post = entry["gaussian"], entry["posterior"]
         rows.append([name, entry["unit"], num(kf["estimate"], 5), num(kf["std"], 3),
                      f"[{num(kf['interval_90'][0], 5)}, {num(kf['interval_90'][1], 5)}]",
                      num(post["mean"], 5), num(post["std"], 3),
                      f"[{num(post['interval_90'][0], 5)}, {num(post['interval_90'][1], 5)}]"])
-    return html_table(["parameter", "unit", "Kalman filter estimate", "Kalman filter std",
-                   "Kalman filter 90 % interval (estimate +- 1.645 std)", "posterior mean", "posterior std",
+    return html_table(["parameter", "unit", "estimate (identification)", "std (identification)",
+                   "Gaussian 90 % interval (estimate +- 1.645 std)", "posterior mean", "posterior std",
                    "posterior 90 % credible interval"], rows, text_columns=(0, 1))
 
 
@@ -337,7 +337,7 @@ def statistics_table(result) -> str:
 
 
 def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid posterior", provenance=None) -> Path:
-    """A self-contained HTML page: the Kalman filter's Gaussian estimate beside the posterior per
+    """A self-contained HTML page: the identification's Gaussian estimate beside the posterior per
     parameter, the sampler's statistics and rounds, the figures ``pngs`` (``corner`` and
     ``posterior_predictive`` PNG bytes) embedded and, collapsed, how the run was made (``provenance``)."""
     from fracid.report.markup import esc, generated_now, html_image, html_table, num, provenance_section, write_document
@@ -352,9 +352,9 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
         f"<h1>{esc(title)}</h1>",
         (f'<p class="meta">Generated {esc(generated_now())} by fracid. Parameters: {esc(names)}; '
          f"{np.size(result.y_exp)} measured values.</p>"),
-        "<h2>Kalman filter and posterior</h2>",
+        "<h2>Identification and posterior</h2>",
         table,
-        (f"<p>Kalman filter: the identification's Gaussian estimate; its interval is the Gaussian 90 % interval "
+        (f"<p>Identification: its Gaussian estimate; its interval is the Gaussian 90 % interval "
          f"estimate +- 1.645 std. Posterior: adaptive importance sampling on the exact forward model (every draw "
          f"one forward run), prior uniform between the bounds of [identify.bounds] (log-uniform where log-scaled); "
          f"its interval is the equal-tailed 90 % credible interval of the weighted draws. Status: {status}.</p>"),
@@ -362,11 +362,11 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
         "<h2>Figures</h2>",
         html_image(pngs["corner"], "corner plot",
                "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and pair "
-               "(below: 2D histogram), with the Kalman filter's Gaussian in red (normal curve; 1 and 2 std "
+               "(below: 2D histogram), with the identification's Gaussian in red (normal curve; 1 and 2 std "
                "ellipses; x its estimate; orange +: the posterior mean)."),
         html_image(pngs["posterior_predictive"], "posterior predictive",
                "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without measurement "
-               "noise), its median, and the Kalman filter's fit (dashed)."),
+               "noise), its median, and the identification's fit (dashed)."),
         "<h2>Rounds of the sampler</h2>",
         history,
         provenance_section(provenance),

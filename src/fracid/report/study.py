@@ -5,7 +5,7 @@ HTML report: the identification report of :func:`fracid.report.html.write_report
 study's sections (verdict, posterior, sensitivity, uniqueness, multi-start, stability, predictions, size
 effect). A study with a sampled posterior also gets the files of ``fracid posterior``
 (:func:`fracid.report.posterior.write_posterior`: posterior.csv, .json, .nc, .html and the corner and
-predictive figures), and its report a "Posterior" section: the Kalman filter's and the posterior's
+predictive figures), and its report a "Posterior" section: the identification's and the posterior's
 90 % intervals side by side, the sampler's statistics and those two figures.
 """
 
@@ -134,22 +134,22 @@ def _verdict_section(study) -> str:
 
 
 def _posterior_section(post, pngs: dict) -> str:
-    """The Kalman filter's Gaussian beside the sampled posterior, the sampler's statistics and its figures."""
+    """The identification's Gaussian beside the sampled posterior, the sampler's statistics and its figures."""
     table, stats = comparison_table(post), statistics_table(post)
     status = esc(post.status) if post.converged else f'<span class="warn">{esc(post.status)}</span>'
     text = ("<p>Adaptive importance sampling on the exact forward model (every draw one forward run, stored in "
-            "runs.sqlite under the label \"posterior\"), started from the Kalman filter's Gaussian, prior uniform "
+            "runs.sqlite under the label \"posterior\"), started from the identification's Gaussian, prior uniform "
             "between the bounds of [identify.bounds] (log-uniform where log-scaled), with the [posterior] settings. "
             f"Status: {status}. The draws and their weights are in posterior.csv, the numbers in posterior.json; "
             '<a href="posterior.html">posterior.html</a> shows the sampler\'s rounds too.</p>')
     figures = [html_image(pngs["corner"], "corner plot",
                       "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and "
-                      "pair (below: 2D histogram), with the Kalman filter's Gaussian in red (normal curve; 1 and 2 "
+                      "pair (below: 2D histogram), with the identification's Gaussian in red (normal curve; 1 and 2 "
                       "std ellipses; x its estimate; orange +: the posterior mean).")]
     if pngs.get("posterior_predictive") is not None:
         figures.append(html_image(pngs["posterior_predictive"], "posterior predictive",
                               "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without "
-                              "measurement noise), its median, and the Kalman filter's fit (dashed)."))
+                              "measurement noise), its median, and the identification's fit (dashed)."))
     return text + table + stats + "".join(figures)
 
 
@@ -177,7 +177,7 @@ def study_sections(study, figures: dict, posterior_figures: dict | None = None) 
         "sensitivity": "Normalised sensitivities along the load history and the share of each parameter's prior "
                        "(bounds) variance removed by the data up to each point.",
         "valley": "Objective over the population around the estimate (diamond); circled: the valley of sets the "
-                  "data cannot tell from the estimate (chi^2 95 % level); arrows: Kalman filters from distinct starting points.",
+                  "data cannot tell from the estimate (chi^2 95 % level); arrows: local fits from distinct starting points.",
         "stability": "Estimates from data with noise added (fixed seeds): the scatter against the estimate's +-2 std.",
         "predictions": "Data not used for calibration, predicted at the estimate (+-2 std propagated from its "
                        "covariance).",
