@@ -12,7 +12,7 @@ import pytest
 
 import fracid
 from _bar_study import write_bar_study
-from fracid import cli, cli_common
+from fracid import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = Path(__file__).with_name("configs")
@@ -54,7 +54,9 @@ def test_vtk_skipped_is_said_only_when_vtk_was_asked_for(tmp_path, capsys, monke
 
 @pytest.mark.parametrize("count, text", [(1, "1 run"), (2, "2 runs"), (0, "0 runs")])
 def test_plural(count, text):
-    assert cli_common.plural(count, "run") == text
+    from fracid.inverse.plans import plural
+
+    assert plural(count, "run") == text
 
 
 def test_identify_writes_result_fit_figures_and_report(bar_study, tmp_path):

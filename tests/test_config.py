@@ -4,7 +4,6 @@ No forward runs: loading, building data, operator, space and settings only.
 """
 
 import dataclasses
-import inspect
 import shutil
 from pathlib import Path
 
@@ -18,14 +17,14 @@ from fracid.config import (
     build_parameters,
     build_space,
     build_specimen,
-    identify_settings,
+    build_method,
     load_config,
     simulate_settings,
 )
 from fracid.data import gregoire2013_beam4_path
 from fracid.inverse.forward_operator import ForwardOperator
 from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import identify, identify_data
+from fracid.inverse.strategy import KnnSettings
 from fracid.fem.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
@@ -155,16 +154,12 @@ def test_valid_beam_config_loads_and_builds_everything(tmp_path):
     np.testing.assert_allclose(space.upper, [1.2e-4, 2000.0, 30.0])
     assert space.log == (False, True, False)
 
-    settings = identify_settings(cfg)
-    assert {k: settings[k] for k in ("n", "method", "seed", "k", "max_iterations", "tol")} == {
-        "n": 64, "method": "sobol", "seed": 0, "k": 5, "max_iterations": 10, "tol": 0.01}
-    groups = settings["groups"]
-    assert len(groups) == 4
+    method = build_method(cfg)
+    assert method.knn == KnnSettings(n=64, method="sobol", seed=0, k=5)
+    assert (method.kalman.max_iterations, method.kalman.tol, method.kalman.restart) == (10, 0.01, "linearize")
+    groups = method.kalman.groups
+    assert len(groups) == 4  # DEFAULT_GROUPS consecutive steps
     np.testing.assert_array_equal(np.concatenate(groups), np.arange(40))
-    # every setting is a keyword that identify_data forwards to identify
-    accepted = set(inspect.signature(identify).parameters)
-    assert set(settings) <= accepted
-    assert "settings" in inspect.signature(identify_data).parameters
 
     assert cfg.output.directory == tmp_path / "results"
     assert cfg.output.vtk_steps == ()
@@ -253,9 +248,9 @@ knn = { method = "grid", n = 5, k = 5 }
     assert [o.quantity for o in operator.observations] == ["force", "damaged_zone_width"]
     assert [o.control for o in operator.observations] == ["end_displacement"] * 2
     assert operator.n_outputs == 8
-    settings = identify_settings(cfg)
-    assert settings["method"] == "grid"  # default grouping: DEFAULT_KALMAN_GROUPS = 4 consecutive steps
-    assert [g.tolist() for g in settings["groups"]] == [[0, 1], [2, 3], [4, 5], [6, 7]]
+    method = build_method(cfg)
+    assert method.knn.method == "grid"  # default grouping: DEFAULT_GROUPS = 4 consecutive steps
+    assert [g.tolist() for g in method.kalman.groups] == [[0, 1], [2, 3], [4, 5], [6, 7]]
 
 
 def test_specimen_maps_match_the_specimens():
@@ -271,13 +266,9 @@ def test_specimen_maps_match_the_specimens():
     assert set(problem.functionals) == set(_SPECIMENS["bar"][0])
 
 
-def test_restart_is_forwarded_when_identify_takes_it(tmp_path):
+def test_restart_is_a_setting_of_the_built_method(tmp_path):
     cfg = load_config(write(tmp_path, variant('restart = "linearize"', 'restart = "prior-mean"')))
-    if "restart" in inspect.signature(identify).parameters:
-        assert identify_settings(cfg)["restart"] == "prior-mean"
-    else:
-        with pytest.raises(ConfigError, match=r"identify.kalman.restart = 'prior-mean'"):
-            identify_settings(cfg)
+    assert build_method(cfg).kalman.restart == "prior-mean"
 
 
 def test_single_curve_with_relative_std(tmp_path):
@@ -724,9 +715,6 @@ LIMITS = [
     pytest.param(variant("n = 64\nmethod = \"sobol\"", "n = 100\nmethod = \"grid\""), "identify",
                  ["identify.knn.n", "100", "1,000,000 points (n**p = 100**3", "limit of 100,000"],
                  id="grid-population"),
-    pytest.param(variant("n_points = 40", "n_points = 50000"), "identify",
-                 ["experiments[0].n_points", "50000", "n_y = 50,000", "n_y^2 x 8 bytes = 18.6 GiB", "at most 5,000"],
-                 id="n_points"),
     pytest.param(BAR_SIMULATE.replace("n_elements = 120", "n_elements = 100000000"), "simulate",
                  ["specimen.n_elements", "100000000", "373 GiB", "at most 200,000 elements"], id="bar-elements"),
     pytest.param(variant("h_fine = 2.0", "h_fine = 0.01"), "identify",
@@ -755,16 +743,13 @@ def test_limits_and_formats_are_named(tmp_path, text, purpose, words):
     test_bad_config_is_named(tmp_path, text, purpose, words)
 
 
-def test_data_values_are_limited_over_the_calibration_blocks(tmp_path):
+def test_data_values_are_not_capped_over_the_calibration_blocks(tmp_path):
+    """No cap on n_y (the data covariance is not an n x n matrix): each block and the sum are accepted;
+    a prediction block is not stacked with the calibration blocks."""
     block = BEAM[BEAM.index("[[experiments]]"):BEAM.index("[identify]")]
     two = variant("n_points = 40", "n_points = 3000", BEAM.replace("[identify]", block + "[identify]", 1))
-    assert load_config(write(tmp_path, two)).n_y == 3040  # each block and the sum within the limit
-    with pytest.raises(ConfigError) as info:
-        load_config(write(tmp_path, two.replace("n_points = 40", "n_points = 2001")))
-    message = str(info.value)
-    assert "experiments = [3000, 2001]" in message and "add up to n_y = 5,001" in message
-    assert "at most 5,000" in message
-    # a prediction block is not stacked with them: only its own size counts
+    assert load_config(write(tmp_path, two)).n_y == 3040
+    assert load_config(write(tmp_path, two.replace("n_points = 40", "n_points = 50000"))).n_y == 53000
     predicted = two.replace("n_points = 40", 'n_points = 2001\nrole = "prediction"')
     assert load_config(write(tmp_path, predicted)).n_y == 3000
 

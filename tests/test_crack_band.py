@@ -6,12 +6,15 @@ import pytest
 from fracid.fem.assembly import SparsePattern
 from fracid.fem.cohesive import CohesiveParameters, hordijk_stress
 from fracid.fem.crack_band import band_damage, crack_band_stress, principal_tension, snap_back_limit
+from fracid.fem.laws import HordijkLaw
+from fracid.fem.tsl import ScaledLaw
 from fracid.models import CrackBandModel
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.strip import TensionStrip
 
 PARAMS = CohesiveParameters(E=37000.0, nu=0.2, ft=3.0, Gf=0.1)
 LAW = PARAMS.law()[1:]
+LOCAL = ScaledLaw(HordijkLaw(), PARAMS)  # the law at PARAMS, no strength factor
 
 
 def _voigt_rotation(angle):
@@ -39,13 +42,13 @@ def test_principal_tension_is_the_major_eigenpair_and_its_derivative():
 def test_band_stress_in_uniaxial_tension_is_hordijk_traction_of_the_opening():
     h = 5.0
     kappa = np.linspace(1.01, 40.0, 200) * PARAMS.ft / PARAMS.E
-    omega, d_omega = band_damage(kappa, h, PARAMS.E, PARAMS.ft, *LAW)
+    omega, d_omega = band_damage(kappa, h, PARAMS.E, LOCAL)
     w = h * omega * kappa
     np.testing.assert_allclose((1 - omega) * PARAMS.E * kappa, hordijk_stress(w, PARAMS.ft, *LAW), atol=1e-9)
     d = 1e-9
-    fd = (band_damage(kappa + d, h, PARAMS.E, PARAMS.ft, *LAW)[0] - band_damage(kappa - d, h, PARAMS.E, PARAMS.ft, *LAW)[0]) / (2 * d)
+    fd = (band_damage(kappa + d, h, PARAMS.E, LOCAL)[0] - band_damage(kappa - d, h, PARAMS.E, LOCAL)[0]) / (2 * d)
     np.testing.assert_allclose(d_omega, fd, rtol=1e-5, atol=1e-6)
-    assert np.all(band_damage(0.99 * PARAMS.ft / PARAMS.E, h, PARAMS.E, PARAMS.ft, *LAW)[0] == 0.0)
+    assert np.all(band_damage(0.99 * PARAMS.ft / PARAMS.E, h, PARAMS.E, LOCAL)[0] == 0.0)
 
 
 def test_material_tangent_matches_finite_differences_and_the_law_rotates_with_the_stress():
@@ -53,10 +56,10 @@ def test_material_tangent_matches_finite_differences_and_the_law_rotates_with_th
     s = rng.normal(scale=1e-4, size=(8, 9, 3)) + np.array([1.5e-4, 0.0, 0.0])
     kappa_old = np.repeat(rng.uniform(0.0, 3e-4, size=(8, 1)), 9, axis=1)  # loading, unloading, uncracked ...
     weights = rng.uniform(0.5, 1.5, size=(8, 9))
-    E, ft = np.full((8, 9), PARAMS.E), np.full((8, 9), PARAMS.ft)
+    E = np.full((8, 9), PARAMS.E)
 
     def stress(s):
-        return crack_band_stress(s, kappa_old, weights, 5.0, E, PARAMS.nu, ft, LAW)
+        return crack_band_stress(s, kappa_old, weights, 5.0, E, PARAMS.nu, LOCAL)
 
     sigma, dsigma, (a, b), kappa, omega = stress(s)
     assert np.any((kappa > kappa_old) & (omega > 0)) and np.any((kappa == kappa_old) & (omega > 0))
@@ -77,7 +80,10 @@ def test_material_tangent_matches_finite_differences_and_the_law_rotates_with_th
 
 def test_band_wider_than_the_snap_back_limit_is_refused():
     brittle = PARAMS.replace(Gf=0.002)
-    limit = snap_back_limit(brittle.E, brittle.ft, *brittle.law()[1:])
+    limit = snap_back_limit(brittle.E, HordijkLaw(), brittle)
+    x = np.linspace(0.0, 1.0, 100001)[:-1]  # the steepest slope of the law, sampled finely
+    steepest = np.max(np.abs(np.diff(hordijk_stress(x * brittle.wc, brittle.ft, *brittle.law()[1:])))) / (x[1] * brittle.wc)
+    assert limit == pytest.approx(brittle.E / steepest, rel=1e-4)
     with pytest.raises(ValueError, match="snap-back limit"):
         CrackBandModel().build(TensionStrip(n_elements=3, length=3 * 1.2 * limit / (1 - 0.04), height=10.0), brittle)
 

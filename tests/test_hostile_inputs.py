@@ -78,7 +78,6 @@ CASES = {
     "bar-n_elements-1e8": case(2, ["specimen.n_elements", "memory", "200,000"], config={"n_elements": "100_000_000"}),
     "beam-h_fine-0.001": case(2, ["specimen.h_fine", "unknowns", "memory"], csv=None, args=("simulate", "cfg.toml"),
                               config='[specimen]\ntype = "notched-beam"\nh_fine = 0.001\n'),
-    "n_points-50000": case(2, ["experiments[0].n_points", "covariance"], config={"n_points": "50000"}),
     "groups-above-n_y": case(2, ["identify.kalman.groups", "n_y = 12"], config={"groups": "13"}),
     "k-above-n": case(2, ["identify.knn.k", "population size 8"], config={"k": "9"}),
     # ---- the data file

@@ -94,8 +94,13 @@ def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path
 
 def test_default_method_settings_belong_to_the_default_method(problem):
     op, data = problem
-    with pytest.raises(ValueError, match="n, groups: settings of the default method"):
+    with pytest.raises(TypeError, match="unknown setting.s. groups, n: the method 'least-squares' has no settings"):
         identify(op, data.y, data.covariance, SPACE, method=LeastSquares(), n=8, groups="all")
+    with pytest.raises(TypeError, match="unknown setting.s. population of the method 'knn-gauss-newton'; known: k, "
+                                        "knn, max_iterations, n, seed, tol"):
+        identify(op, data.y, data.covariance, SPACE, method="knn-gauss-newton", population=8)
+    with pytest.raises(ValueError, match="method = 'simplex': not a registered inverse method"):
+        identify(op, data.y, data.covariance, SPACE, method="simplex")
 
 
 def test_default_method_passed_explicitly(problem):
@@ -125,7 +130,7 @@ def test_study_settings_group_the_options_and_replace_by_name():
     assert (settings.starts, settings.replicates, settings.prior) == (0, 5, "bounds")
     assert settings.identification == KnnKalman(settings.knn, settings.kalman)
     assert StudySettings().replace(knn=KnnSettings(n=8), k=2).knn == KnnSettings(n=8, k=2)
-    with pytest.raises(TypeError, match="unknown study setting"):
+    with pytest.raises(TypeError, match="unknown setting.s. population .*or a study setting: method, noise_seed"):
         StudySettings().replace(population=16)
     with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
         StudySettings(prior="flat")

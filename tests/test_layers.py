@@ -9,9 +9,9 @@ import fracid
 
 # floor of each top-level unit of the package: a module may import its own floor and those below
 FLOORS = {
-    "fem": 0,
+    "fem": 0, "field_error": 0,
     "specimens": 1,
-    "models": 2, "forward": 2, "data": 2, "store": 2, "tables": 2, "parallel": 2, "progress": 2, "provenance": 2,
+    "models": 2, "model_protocol": 2, "forward": 2, "data": 2, "store": 2, "tables": 2, "parallel": 2, "progress": 2, "provenance": 2,
     "inverse": 3,
     "report": 4,
     "config": 5,

@@ -27,7 +27,7 @@ def test_the_table_of_pairs(kind):
         if not runs_on(model, specimen):
             with pytest.raises(TypeError, match="does not run on"):
                 model.simulate(specimen, model.parameters(), target=0.01)
-    assert set(SPECIMENS.values()) <= {type(s) for s in specimens}
+    assert {cls for cls in SPECIMENS.values() if cls.default_instance() is not None} <= {type(s) for s in specimens}
 
 
 def test_cohesive_crack_and_crack_band_on_the_dogbone():

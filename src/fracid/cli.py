@@ -1,13 +1,15 @@
 """The ``fracid`` command: a thin layer over the Python API.
 
     fracid simulate CONFIG    forward analysis: curve (CSV), plot (PNG), fields (VTK)
-    fracid identify CONFIG    KNN + Kalman filter: result (JSON), fitted curves (CSV), figures, HTML report
+    fracid identify CONFIG    the inverse method of [identify] method: result (JSON), fitted curves (CSV), figures,
+                              HTML report
     fracid posterior CONFIG   identify, then weighted samples of the parameters given the data (adaptive
                               importance sampling on the exact model): CSV, JSON, figures, HTML page
-    fracid study CONFIG       the whole strategy: KNN, sensitivity, uniqueness, Kalman filter, multi-start,
-                              stability, prediction of held-out data, size effect; a verdict per parameter
-    fracid uniqueness CONFIG  KNN, objective maps and valley, Kalman filter, multi-start (no replicates)
-    fracid stability CONFIG   KNN, Kalman filter, identification on noisy replicates (no multi-start)
+    fracid study CONFIG       the whole strategy through the method's stages: search, sensitivity, uniqueness,
+                              refinement, multi-start, stability, prediction of held-out data, size effect;
+                              a verdict per parameter
+    fracid uniqueness CONFIG  search, objective maps and valley, refinement, multi-start (no replicates)
+    fracid stability CONFIG   search, refinement, identification on noisy replicates (no multi-start)
     fracid sensitivity CONFIG normalised sensitivities and information along the load history at the
                               configured parameter values
     fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
@@ -32,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli_common import (command_executor, demo_config_path, load, out_dir, plural, progress_choice, provenance,
+from fracid.cli_common import (command_executor, demo_config_path, load, out_dir, progress_choice, provenance,
                                say, warn, working_in, wrote)
 from fracid.progress import progress_lines
 
@@ -51,7 +53,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"fracid {version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("simulate", "forward analysis of the configured specimen"),
-                       ("identify", "identify parameters from measured data (KNN + Kalman filter)"),
+                       ("identify", "identify parameters from measured data ([identify] method)"),
                        ("posterior", "identify, then sample the parameters given the data on the exact model"),
                        ("study", "identification with uniqueness, stability and prediction checks, and a verdict"),
                        ("uniqueness", "the study's uniqueness stages only: objective maps, valley, multi-start"),
@@ -116,27 +118,22 @@ def _identify_job(args, config_path):
     """The configuration and what the identification is built of: data, operator, space, settings."""
     from types import SimpleNamespace
 
-    from fracid.config import build_data, build_operator, build_space, identify_settings
+    from fracid.config import build_data, build_method, build_operator, build_space
 
     cfg = load(args, config_path, "identify")
     data = build_data(cfg)
     return SimpleNamespace(cfg=cfg, data=data, operator=build_operator(cfg, data), space=build_space(cfg),
-                           settings=identify_settings(cfg))
+                           method=build_method(cfg))  # [identify] method, from fracid.inverse.methods.METHODS
 
 
 def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
-    from fracid.config import build_method
     from fracid.inverse.strategy import identify_data
 
-    method = build_method(job.cfg)  # [identify] method, from fracid.inverse.methods.METHODS
-    if job.cfg.identify.method == "knn-kalman":
-        say(args, _stage_costs(job.settings, job.data.n_y, len(job.space.names), job.operator))
-    else:
-        say(args, f"KNN: {job.settings['n']} forward runs, then {method.name} (at most "
-                  f"{method.max_iterations} linearisations; [identify.gauss-newton] max_iterations).")
+    for line in _stage_plans(job.method, job.operator, job.data.n_y, len(job.space.names)):
+        say(args, line)
     start = time.perf_counter()
-    result = identify_data(job.operator, job.data, job.space, method=method, executor=executor, store=store,
+    result = identify_data(job.operator, job.data, job.space, method=job.method, executor=executor, store=store,
                            progress=progress_choice(args), retry_failed=args.retry_failed)
     result.runs["wall_seconds"] = time.perf_counter() - start
     result.provenance = provenance(args, job.cfg, job.operator, job.space, store)
@@ -218,15 +215,13 @@ def run_posterior_command(args) -> int:
     return 0
 
 
-def _stage_costs(settings, n_y, p, operator=None) -> str:
-    """What the KNN and Kalman stages will cost, said before the work starts."""
-    from fracid.cli_check import kalman_cost
-
-    cost = kalman_cost(operator, settings, n_y, p)
-    return (f"KNN: {settings['n']} forward runs. Kalman filter: {cost['steps']} steps per pass "
-            f"({plural(cost['per_step'], 'run')} per step: {cost['how']}); the first pass costs about "
-            f"{cost['first']:.0f} full-curve runs, each later one {cost['later']}, at most {cost['passes']} passes, then "
-            f"{cost['final']} at the estimate ([identify.kalman] groups, max_iterations).")
+def _stage_plans(method, operator, n_y: int, p: int) -> list[str]:
+    """What the method's stages will cost (its ``plan``, :class:`~fracid.inverse.plans.StagePlan`), said before
+    the work starts; its stages' names for a method that has no plan."""
+    plan = getattr(method, "plan", None)  # an optional capability of an inverse method
+    if plan is None:
+        return [f"{method.name}: stages {', '.join(dict(getattr(method, 'stages', {}) or {}).values()) or method.name}"]
+    return [stage.line() for stage in plan(operator, n_y, p)]
 
 
 def _write_figures(directory: Path, result, control) -> None:

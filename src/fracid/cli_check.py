@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli_common import load, plural, warn
+from fracid.cli_common import load, warn
 
 #: one forward run slower than this [s] is warned about
 SLOW_RUN = 30.0
@@ -32,62 +32,33 @@ def add_parser(sub, common) -> None:
     p.add_argument("--no-time", action="store_true", help="do not time a forward run (no time estimate)")
 
 
-def kalman_cost(operator, settings, n_y, p) -> dict:
-    """The Kalman stage's cost: ``steps`` per pass, ``per_step`` runs per step (1 when the model
-    differentiates its runs exactly, :func:`fracid.inverse.sensitivity.exact_sensitivity`; else the run
-    and 2 per parameter, central differences), ``first`` (the first pass in full-curve runs: step t runs
-    up to observation t/steps of the curve), ``later`` (runs of each later pass: one linearisation,
-    :func:`fracid.inverse.kalman.kalman_filter`), ``passes`` at most, ``final`` (the run at the estimate)
-    and ``how`` (the words for ``per_step``). Backtracking over failed or worse points adds runs."""
-    from fracid.inverse.sensitivity import DirectDifferentiation, exact_sensitivity
-
-    groups = settings.get("groups")
-    steps = n_y if groups is None else len(groups)
-    exact = isinstance(exact_sensitivity(operator)[1], DirectDifferentiation)
-    per_step = 1 if exact else 2 * p + 1
-    how = ("the run with its exact sensitivities" if exact else
-           "the run and 2 per parameter: central differences")
-    return {"steps": steps, "per_step": per_step, "first": per_step * (steps + 1) / 2, "later": per_step,
-            "passes": settings["max_iterations"], "final": per_step, "how": how}
-
-
-def _mesh_sizes(description) -> tuple:
-    """(smallest, largest) element side [mm]: corner to corner (2D), element length (bar)."""
-    cells = description.cells
-    if cells.shape[1] == 2:  # a bar: vertex i is node 2 i
-        lengths = np.abs(np.diff(description.nodes[2 * cells][..., 0], axis=1))
-    else:
-        corners = description.nodes[cells[:, :(3 if cells.shape[1] == 6 else 4)]]
-        lengths = np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=-1)
-    return float(lengths.min()), float(lengths.max())
-
-
 def mesh_key(cfg) -> str:
-    """The key that sets the mesh's size: ``specimen.h_fine``, ``specimen.n_elements`` or the mesh file."""
+    """The key that sets the mesh's size, as the specimen declares it (its
+    :meth:`~fracid.specimens.protocol.Specimen.resolution`): ``specimen.h_fine = 1``, ``specimen.n_elements
+    = 200``, ``specimen.file (the mesh)``."""
     from fracid.config import build_specimen
 
-    specimen = build_specimen(cfg)
-    for name in ("h_fine", "n_elements"):
-        if hasattr(specimen, name):
-            return f"specimen.{name} = {getattr(specimen, name):g}"
-    return "specimen.file (the mesh)"
+    field = build_specimen(cfg).resolution()
+    if field.field is None:
+        return "[specimen] (its mesh)"
+    if isinstance(field.value, (int, float)):
+        return f"specimen.{field.field} = {field.value:g}"
+    return f"specimen.{field.field} (the mesh)"
 
 
 def specimen_lines(cfg, model, params) -> list:
     """The specimen, its control and its mesh: nodes, elements, unknowns (of this model), element sizes."""
     from fracid.config import build_specimen
+    from fracid.specimens.protocol import element_sides
 
     specimen = build_specimen(cfg)
     description = specimen.describe()
-    unknowns = getattr(model.build(description, params), "n_free", None)
-    smallest, largest = _mesh_sizes(description)
-    options = dict(cfg.specimen.options)
-    options = (f"file {options['path']}" if cfg.specimen.type == "mesh" else
-               ", ".join(f"{k} = {v}" for k, v in options.items()) or "defaults")
+    unknowns = model.build(description, params).n_free
+    smallest, largest = element_sides(description)
+    options = specimen.options_text(dict(cfg.specimen.options))
     return [f"specimen: {cfg.specimen.type} ({type(specimen).__name__}; {options}), control {cfg.specimen.control}",
             f"mesh: {len(description.nodes):,} nodes, {len(description.cells):,} elements, "
-            f"{'?' if unknowns is None else f'{unknowns:,}'} unknowns; element sides {smallest:.3g} to {largest:.3g} mm "
-            f"({mesh_key(cfg)})"]
+            f"{unknowns:,} unknowns; element sides {smallest:.3g} to {largest:.3g} mm ({mesh_key(cfg)})"]
 
 
 def model_lines(cfg, params) -> list:
@@ -116,25 +87,16 @@ def identify_lines(cfg) -> list:
     return [f"identified: {bounds}; the others fixed at [model.parameters]"]
 
 
-def identify_plan(cfg, operator, settings, n_y) -> dict:
-    """Forward runs of the identification's stages: ``knn`` runs (side by side), Kalman ``kalman`` runs
-    at most and ``kalman_full`` full-curve equivalents (one after another), and the cost dict."""
-    p = len(cfg.identify.parameters)
-    cost = kalman_cost(operator, settings, n_y, p)
-    knn = cfg.identify.knn.population(p)
-    later = (cost["passes"] - 1) * cost["later"] + cost["final"]
-    return {"knn": knn, "kalman": cost["steps"] * cost["per_step"] + later, "kalman_full": cost["first"] + later,
-            "cost": cost}
+def identify_plan(method, operator, n_y: int, p: int) -> list:
+    """The stages of the configured inverse method and their forward runs (its ``plan``:
+    :class:`~fracid.inverse.plans.StagePlan` per stage; empty for a method without one)."""
+    plan = getattr(method, "plan", None)  # an optional capability of an inverse method
+    return [] if plan is None else list(plan(operator, n_y, p))
 
 
-def plan_lines(cfg, plan) -> list:
+def plan_lines(cfg, method, plan) -> list:
     """The stages of the identification and their forward runs; what ``fracid posterior`` adds."""
-    cost, knn = plan["cost"], cfg.identify.knn
-    lines = [f"stage KNN: {plan['knn']} forward runs side by side ({knn.method}, k = {knn.k}; [identify.knn] n)",
-             f"stage Kalman filter: {cost['steps']} steps per pass, {plural(cost['per_step'], 'run')} per step "
-             f"({cost['how']}), at most {cost['passes']} passes and a run at the estimate: at most "
-             f"{plural(plan['kalman'], 'run')} one after another without backtracking, "
-             f"about {plan['kalman_full']:.0f} full-curve runs ([identify.kalman] groups, max_iterations)"]
+    lines = [stage.line() for stage in plan] or [f"stages of {method.name}: no plan of their forward runs"]
     post = cfg.posterior
     lines.append(f"fracid posterior adds at most {post.samples_per_round * post.max_rounds} runs "
                  f"([posterior] samples_per_round x max_rounds)")
@@ -166,20 +128,27 @@ def time_lines(cfg, seconds, plan, workers) -> list:
     if seconds > SLOW_RUN:
         warn(f"one forward run takes {seconds:.0f} s (over {SLOW_RUN:.0f} s): the mesh makes it so "
              f"({mesh_key(cfg)}); a coarser mesh runs faster, if it still resolves the process zone")
-    if plan is None:
+    if not plan:
         return lines
-    knn_s = math.ceil(plan["knn"] / workers) * seconds
-    kalman_s = plan["kalman_full"] * seconds * (SENSITIVITY_COST if plan["cost"]["per_step"] == 1 else 1.0)
-    total = knn_s + kalman_s
-    lines.append(f"estimate for fracid identify on {workers} worker(s): KNN {_duration(knn_s)}, Kalman filter at most "
-                 f"{_duration(kalman_s)}: at most {_duration(total)}")
+    times = [(stage, _stage_seconds(stage, seconds, workers)) for stage in plan]
+    total = sum(t for _, t in times)
+    parts = ", ".join(f"{stage.label} {'at most ' if not stage.side_by_side else ''}{_duration(t)}" for stage, t in times)
+    lines.append(f"estimate for fracid identify on {workers} worker(s): {parts}: at most {_duration(total)}")
     if total > SLOW_PLAN:
-        key = (f"[identify.knn] n = {cfg.identify.knn.n}" if knn_s >= kalman_s else
-               "[identify.kalman] groups and max_iterations")
+        slowest = max(times, key=lambda pair: pair[1])[0]
         warn(f"the identification may take {_duration(total)} (over {_duration(SLOW_PLAN)}) on {workers} worker(s): "
-             f"mostly because of {key}, with each run taking {seconds:.1f} s ({mesh_key(cfg)}); --workers or a "
-             "Dask cluster (--scheduler) shares the KNN stage")
+             f"mostly because of {slowest.keys or slowest.label}, with each run taking {seconds:.1f} s "
+             f"({mesh_key(cfg)}); --workers or a Dask cluster (--scheduler) shares the stages whose runs are side "
+             "by side")
     return lines
+
+
+def _stage_seconds(stage, seconds: float, workers: int) -> float:
+    """Wall time of a stage's runs: side by side on the workers, or one after another (a run with exact
+    sensitivities costs :data:`SENSITIVITY_COST` plain runs)."""
+    if stage.side_by_side:
+        return math.ceil(stage.runs / workers) * seconds
+    return stage.full_runs * seconds * (SENSITIVITY_COST if stage.exact else 1.0)
 
 
 def _duration(seconds: float) -> str:
@@ -192,8 +161,7 @@ def _duration(seconds: float) -> str:
 
 def run_check(args) -> int:
     """``fracid check``: print the plan of the configuration; exit 2 (with the message) if it is invalid."""
-    from fracid.config import build_data, build_model, build_operator, build_parameters, build_specimen
-    from fracid.config import identify_settings
+    from fracid.config import build_data, build_method, build_model, build_operator, build_parameters, build_specimen
     from fracid.parallel import available_cores
 
     cfg = load(args, args.config, "simulate")  # [[experiments]] and [identify] validated when present
@@ -205,8 +173,9 @@ def run_check(args) -> int:
     if purpose == "identify":
         data = build_data(cfg)
         operator = build_operator(cfg, data)
-        plan = identify_plan(cfg, operator, identify_settings(cfg), data.n_y)
-        lines += data_lines(data) + identify_lines(cfg) + plan_lines(cfg, plan)
+        method = build_method(cfg)
+        plan = identify_plan(method, operator, data.n_y, len(cfg.identify.parameters))
+        lines += data_lines(data) + identify_lines(cfg) + plan_lines(cfg, method, plan)
     else:
         lines.append("plan: fracid simulate, one forward run (no [[experiments]] and [identify]: nothing to identify)")
     print("\n".join(lines), flush=True)

@@ -1,6 +1,6 @@
 """The plumbing every ``fracid`` command shares: loading the configuration, the output directory and its
 claim, the directory's lock and run store, the executor of ``--workers`` / ``--scheduler``, the progress
-choice, the provenance record and the messages (``say``, ``warn``, ``wrote``, ``plural``).
+choice, the provenance record and the messages (``say``, ``warn``, ``wrote``).
 
 :mod:`fracid.cli` (the parser, the dispatch and simulate / identify / posterior / demo),
 :mod:`fracid.cli_studies`, :mod:`fracid.cli_init` and :mod:`fracid.cli_check` import from here, so none of
@@ -40,11 +40,6 @@ def wrote(args, out, names) -> None:
 def warn(text) -> None:
     """A warning on stderr, even with ``--quiet``."""
     print(f"fracid: warning: {text}", file=sys.stderr, flush=True)
-
-
-def plural(count, noun) -> str:
-    """``"1 run"``, ``"2 runs"``."""
-    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def load(args, path, purpose):

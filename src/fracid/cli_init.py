@@ -99,15 +99,18 @@ def description(cls) -> list:
 
 
 def runnable_pairs() -> list:
-    """The (specimen type, model type) pairs ``fracid init`` writes: every built-in specimen of
-    :data:`fracid.specimens.SPECIMENS` with every model of :data:`fracid.models.MODEL_TYPES` that
-    runs on its default instance (:func:`fracid.models.runs_on`)."""
+    """The (specimen type, model type) pairs ``fracid init`` writes: every specimen of
+    :data:`fracid.specimens.SPECIMENS` that has a default instance (not the mesh, which needs its file)
+    with every model of :data:`fracid.models.MODEL_TYPES` that runs on it (:func:`fracid.models.runs_on`)."""
     from fracid.models import MODEL_TYPES, runs_on
     from fracid.specimens import SPECIMENS
 
     pairs = []
     for kind, cls in SPECIMENS.items():
-        description = cls().describe()
+        specimen = cls.default_instance()
+        if specimen is None:
+            continue
+        description = specimen.describe()
         pairs += [(kind, name) for name, make in MODEL_TYPES.items() if runs_on(make(), description)]
     return pairs
 
@@ -169,9 +172,10 @@ def _specimen_lines(kind: str, given: dict) -> list:
 
     cls = SPECIMENS[kind]
     docs = numpydoc_parameters(cls)
+    controls = cls.default_instance().control_names
     lines = ["[specimen]"] + [line for paragraph in description(cls) for line in _comments(paragraph) + ["#"]] + [
         _line("type", kind, " | ".join(SPECIMENS)),
-        _line("control", cls.controls[0], "one of " + ", ".join(cls.controls))]
+        _line("control", controls[0], "one of " + ", ".join(controls))]
     for field in dataclasses.fields(cls):
         kind_text, meaning = docs.get(field.name, (str(field.type), ""))
         value = given.get(field.name, field.default)

@@ -43,7 +43,12 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
         if exp.role == "calibration":
             calibrated.add(D)
     base = next(iter(specimens.values()), None) or build_specimen(cfg)
-    size_field = "size" if hasattr(base, "size") else "depth" if hasattr(base, "depth") else "length"
+    size_field = base.size_field
+    if size_field is None:
+        from fracid.exits import UsageError
+
+        raise UsageError(f"the specimen {type(base).__name__} declares no size_field: a size-effect series cannot "
+                         "scale it")
     for D in sizes or ():
         try:
             specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
@@ -71,8 +76,6 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0, "posterior": None},
 def _study_settings(cfg, command):
     """The :class:`~fracid.inverse.study.StudySettings` of ``[study]`` with the configured inverse method; a
     method that cannot run the study's stages is the configuration's error (exit 2)."""
-    from dataclasses import fields
-
     from fracid.config import ConfigError, build_method, study_settings
     from fracid.inverse.methods import StudyMethod
     from fracid.inverse.study import StudySettings
@@ -83,9 +86,7 @@ def _study_settings(cfg, command):
                           "inverse method (a search over a population, a refinement, a local fit from a point: "
                           "fracid.inverse.methods.StudyMethod), which this method does not declare; use it with "
                           "`fracid identify`")
-    checks = {f.name for f in fields(StudySettings)} - {"method"}  # [study]'s; the method's own are in it
-    given = {name: value for name, value in study_settings(cfg).items() if name in checks}
-    return StudySettings(method=method).replace(**{**given, **_STUDY_PARTS[command]})
+    return StudySettings(method=method).replace(**{**study_settings(cfg), **_STUDY_PARTS[command]})
 
 
 def run_study_command(args) -> int:

@@ -8,7 +8,8 @@ from fracid.fem.path_following import PathResult
 def _specimen_names() -> str:
     from fracid.specimens import SPECIMENS
 
-    return ", ".join(f"{kind!r} -> {cls.__module__}.{cls.__name__}()" for kind, cls in SPECIMENS.items())
+    return ", ".join(f"{kind!r} -> {cls.__module__}.{cls.__name__}()" for kind, cls in SPECIMENS.items()
+                     if cls.default_instance() is not None)
 
 
 def check_specimen(specimen, model=None) -> None:

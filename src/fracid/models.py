@@ -1,17 +1,34 @@
-"""The forward models the inverse code sees: one small interface, so a new model touches no inverse code.
+"""The forward models the inverse code sees: one small written contract, :class:`ForwardModel`, so a
+new model touches no inverse code.
 
-A forward model is any object with
+A forward model declares
 
 ``key`` : str
-    Names the model (and its variant) in run-store keys: runs of different models never share a key.
+    Names the model (and its variant, its law) in run-store keys: runs of different models never share a key.
 ``parameters`` : type
     Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods and
     ``replace(**changes)`` on instances, returning a validated copy (ValueError for bad values).
 ``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints,
-damage_threshold, observables)``
+damage_threshold, observables, sensitivities)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
     :class:`~fracid.fem.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
+``runs_on(specimen)`` / ``why_not(specimen)``
+    Whether it runs on a specimen, and why not (None when it does).
+``differentiable`` : tuple of str
+    The parameters whose exact sensitivities a run computes (``simulate(..., sensitivities=names)``).
+``differentiates_observers`` : bool
+    Whether its observers (zone widths) have such derivatives too.
+``observer_names`` : tuple of str
+    Observers of its own beyond the specimen's observables (e.g. ``crack_length``).
+``regularization`` : str or None
+    The damage formulation ("gradient", "local", "integral"); None for the crack models.
+``scales(params)`` / ``default_target(specimen, params)``
+    Its characteristic strain (and opening), and the specimen's default final control value [mm].
+
+A model of a few lines (``key``, ``parameters``, ``simulate``) inherits the rest from
+:class:`ModelDefaults`, or is completed by :func:`declared` (both of :mod:`fracid.model_protocol`,
+importable from here).
 
 The models below build their problem from the specimen's
 :class:`~fracid.specimens.description.Description` (``specimen.describe()``): a formulation (gradient,
@@ -23,7 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar, Protocol
+from typing import ClassVar
 
 import numpy as np
 
@@ -31,30 +48,17 @@ from fracid.fem.crack_band_problem import CrackBandProblem, element_extent
 from fracid.fem.cohesive_problem import CohesiveCrackProblem, crack_edges
 from fracid.fem.fpz import zone_width_observer
 from fracid.fem.laws import DamageLaw, HordijkLaw
+from fracid.fem.probes import probe_matrix
+from fracid.fem.tsl import differentiable as gives_derivatives
 from fracid.fem.path_following import ConvergenceError, PathResult, StepOptions, follow_path
 from fracid.fem.problem import FORMULATIONS
+from fracid.model_protocol import ForwardModel, ModelDefaults, declared, runs_on
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
-__all__ = ["IMPLAUSIBLE_FACTOR", "MODEL_TYPES", "USUAL_RANGES", "CohesiveCrackModel", "ConvergenceError",
-           "CrackBandModel", "DamageModel", "ForwardModel", "PathResult", "StepOptions", "implausible", "known_units",
-           "model_from_type", "parameter_units", "runs_on", "usual_range_text"]
-
-
-class ForwardModel(Protocol):
-    key: str
-    parameters: type
-
-    def simulate(self, specimen, params, **options): ...
-
-
-def runs_on(model, specimen) -> bool:
-    """Whether ``model`` can run on ``specimen`` (an instance or its class); models without a
-    ``runs_on`` method run on every specimen."""
-    check = getattr(model, "runs_on", None)
-    if check is None:
-        return True
-    return check(specimen() if isinstance(specimen, type) else specimen)  # a class: its default instance
+__all__ = ["IMPLAUSIBLE_FACTOR", "probe_matrix", "MODEL_TYPES", "USUAL_RANGES", "CohesiveCrackModel", "ConvergenceError",
+           "CrackBandModel", "DamageModel", "ForwardModel", "ModelDefaults", "PathResult", "StepOptions", "declared",
+           "implausible", "known_units", "model_from_type", "parameter_units", "runs_on", "usual_range_text"]
 
 
 def _description(specimen):
@@ -69,17 +73,13 @@ def select_observers(observers: dict, names=None) -> dict:
     return {name: fn for name, fn in observers.items() if name in set(names)}
 
 
-class _PathFollowing:
+class _PathFollowing(ModelDefaults):
     """``simulate`` of the models below: build the problem, follow the path with the specimen's
     default control, target and steps."""
 
     def scales(self, params) -> dict:
         """Characteristic strain (and opening) a specimen sizes its default control with."""
         return self.law.scales(params)
-
-    def default_target(self, specimen, params) -> float:
-        """The specimen's default final control value for this model with ``params`` [mm]."""
-        return specimen.default_target(self.scales(params))
 
     def simulate(self, specimen, params, *, control=None, target=None, stop_force_fraction=0.1, steps=None,
                  damage_threshold=0.0, observables=None, **options):
@@ -96,14 +96,6 @@ class _PathFollowing:
                            stop_force_fraction=stop_force_fraction,
                            observers=select_observers(observers, observables), **options)
 
-    def runs_on(self, specimen) -> bool:
-        return self.why_not(specimen) is None
-
-    @property
-    def differentiable(self) -> tuple:
-        """Parameters whose derivatives a run computes by direct differentiation (``simulate(...,
-        sensitivities=names)``; see :mod:`fracid.fem.ddm`): those its problem class declares."""
-        return tuple(getattr(self._problem_class, "differentiable", ()))
 
 
 @dataclass(frozen=True)
@@ -141,9 +133,6 @@ class DamageModel(_PathFollowing):
             return "its imperfection is a reduced tensile strength, which a damage law does not read"
         return None
 
-    @property
-    def _problem_class(self):
-        return FORMULATIONS[self.regularization]
 
     @property
     def differentiable(self) -> tuple:
@@ -169,7 +158,8 @@ class DamageModel(_PathFollowing):
 
 
 class _CrackModel(_PathFollowing):
-    """The models of one crack with Hordijk's law: plane stress, where the specimen says the crack runs."""
+    """The models of one crack with a traction-separation law (:class:`~fracid.fem.tsl.TractionSeparationLaw`,
+    Hordijk's by default): plane stress, where the specimen says the crack runs."""
 
     #: observers whose values the runs do not differentiate (a count of cracked points: a staircase)
     observer_names: ClassVar[tuple] = ("crack_length",)
@@ -177,6 +167,11 @@ class _CrackModel(_PathFollowing):
     @property
     def parameters(self) -> type:
         return self.law.parameters
+
+    @property
+    def differentiable(self) -> tuple:
+        """Every parameter of the law if the law gives its parameter derivatives, else none."""
+        return tuple(self.parameters.names()) if gives_derivatives(self.law) else ()
 
     def why_not(self, specimen):
         d = _description(specimen)
@@ -192,7 +187,7 @@ class _CrackModel(_PathFollowing):
 
 @dataclass(frozen=True)
 class CohesiveCrackModel(_CrackModel):
-    """Discrete cohesive crack with Hordijk's law along the specimen's crack path (a symmetry line of
+    """Discrete cohesive crack with a traction-separation law (Hordijk's by default) along the specimen's crack path (a symmetry line of
     the model), elastic bulk (docs/theory.md, section 5). The faces are tied by a penalty
     ``penalty_factor * E / h`` [MPa/mm] (h the finest element size along the path) until the traction
     reaches ft. Observable: ``crack_length`` [mm], the length of the path whose faces have separated.
@@ -200,14 +195,17 @@ class CohesiveCrackModel(_CrackModel):
 
     penalty_factor: float = 1000.0
     law: HordijkLaw = HordijkLaw()
-    key: ClassVar[str] = "cohesive-crack-hordijk"
+
+    @property
+    def key(self) -> str:
+        """``cohesive-crack-<law>``: runs of different traction-separation laws never share a key."""
+        return f"cohesive-crack-{self.law.name}"
 
     def _path_problem(self, crack):
         if crack.nodes is None or not crack.mirrored:
             return "the specimen has no crack path on a symmetry line"
         return None
 
-    _problem_class = CohesiveCrackProblem
 
     def build(self, specimen, params):
         d = _description(specimen)
@@ -225,7 +223,7 @@ class CohesiveCrackModel(_CrackModel):
 
 @dataclass(frozen=True)
 class CrackBandModel(_CrackModel):
-    """Smeared crack band: a rotating crack with Hordijk's law scaled by the band width
+    """Smeared crack band: a rotating crack with a traction-separation law (Hordijk's by default) scaled by the band width
     (docs/theory.md, section 5). Same parameters as the cohesive crack, so the two are directly
     comparable. The band is confined to the elements along the specimen's crack path (in a half
     model a band elsewhere would be mirrored into two cracks), or free where the specimen has no path.
@@ -239,9 +237,9 @@ class CrackBandModel(_CrackModel):
 
     @property
     def key(self) -> str:
-        return "crack-band-hordijk" + ("" if self.band_width is None else f"-band-{self.band_width:g}")
+        """``crack-band-<law>[-band-<width>]``: runs of different laws or band widths never share a key."""
+        return f"crack-band-{self.law.name}" + ("" if self.band_width is None else f"-band-{self.band_width:g}")
 
-    _problem_class = CrackBandProblem
 
     def build(self, specimen, params):
         d = _description(specimen)

@@ -9,15 +9,15 @@ one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
 resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
-:func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`identify_settings`, :func:`simulate_settings`,
+:func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`simulate_settings`,
 :func:`posterior_settings`)
 are pure functions of the validated :class:`Config`.
 
 Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
 
 Limits: a configuration beyond what a workstation holds is refused with the estimate and the limit
-(:data:`MAX_POPULATION` KNN points, :data:`MAX_BAR_ELEMENTS` bar elements, :data:`MAX_UNKNOWNS`
-unknowns of a 2D mesh counted from the geometry, :data:`MAX_DATA_VALUES` data values).
+(:data:`MAX_POPULATION` KNN points, :data:`MAX_BAR_ELEMENTS` bar elements and :data:`MAX_UNKNOWNS`
+unknowns of a 2D mesh counted from the geometry).
 
 Warnings: valid settings that are probably not meant (``relative_std`` above 1, process-zone
 elements larger than the internal length l = sqrt(2 c)) are returned in ``Config.warnings``.
@@ -31,12 +31,12 @@ dataclasses), :mod:`~fracid.config.checker` (TOML reading and value checks),
 
 Example
 -------
->>> from fracid.config import load_config, build_data, build_operator, build_space, identify_settings
+>>> from fracid.config import load_config, build_data, build_operator, build_space, build_method
 >>> from fracid.inverse.strategy import identify_data
 >>> cfg = load_config("study.toml")                                   # doctest: +SKIP
 >>> data = build_data(cfg)                                            # doctest: +SKIP
 >>> result = identify_data(build_operator(cfg, data), data, build_space(cfg),
-...                        **identify_settings(cfg))                  # doctest: +SKIP
+...                        method=build_method(cfg))                  # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -52,7 +52,6 @@ from fracid.config.builders import (
     build_parameters,
     build_space,
     build_specimen,
-    identify_settings,
     posterior_settings,
     simulate_settings,
     study_settings,
@@ -63,9 +62,7 @@ from fracid.config.registry import _SPECIMENS, _specimen_class  # noqa: F401
 from fracid.config.schema import (
     BAR_BYTES_PER_ELEMENT,
     BYTES_PER_UNKNOWN,
-    DEFAULT_KALMAN_GROUPS,
     MAX_BAR_ELEMENTS,
-    MAX_DATA_VALUES,
     MAX_POPULATION,
     MAX_UNKNOWNS,
     Config,
@@ -100,7 +97,6 @@ __all__ = [
     "build_space",
     "build_method",
     "build_specimen",
-    "identify_settings",
     "load_config",
     "simulate_settings",
     "build_held_out",
@@ -113,9 +109,7 @@ __all__ = [
     "BAR_BYTES_PER_ELEMENT",
     "BYTES_PER_UNKNOWN",
     "CONTROL_SCALE_LIMIT",
-    "DEFAULT_KALMAN_GROUPS",
     "MAX_BAR_ELEMENTS",
-    "MAX_DATA_VALUES",
     "MAX_POPULATION",
     "MAX_UNKNOWNS",
 ]

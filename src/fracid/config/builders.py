@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import contextlib
 
-import inspect
 
 import numpy as np
 
 from fracid.config.checker import _show
 from fracid.config.registry import _model_of, _specimen_class
-from fracid.config.schema import DEFAULT_KALMAN_GROUPS, Config, ConfigError, ExperimentConfig
+from fracid.config.schema import Config, ConfigError, ExperimentConfig
 
 
 def _require(cfg: Config, section: str):
@@ -36,8 +35,9 @@ def build_parameters(cfg: Config):
 
 
 def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
-    """The specimen object (NotchedBeam, DogBone or BarWithWeakZone) with the fields given; with an
-    experiment, its ``specimen`` overrides applied (e.g. the size of one specimen of a series)."""
+    """The specimen object of ``[specimen] type`` (a class of :data:`fracid.specimens.SPECIMENS`) with the
+    fields given; with an experiment, its ``specimen`` overrides applied (e.g. the size of one specimen of
+    a series)."""
     options = dict(cfg.specimen.options)
     if experiment is not None:
         options.update(dict(experiment.specimen))
@@ -94,8 +94,6 @@ def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> No
     """Refuse data whose control reaches far beyond, or stops far short of, the control at which the
     specimen has long failed: blamed on ``control_unit`` unless a bound or a parameter value explains it."""
     specimen, model = build_specimen(cfg, exp), build_model(cfg)
-    if not hasattr(model, "default_target"):
-        return
     params = build_parameters(cfg)
     candidates = {"[model.parameters]": params}
     if cfg.identify is not None:
@@ -211,12 +209,13 @@ def build_held_out(cfg: Config) -> list:
 
 
 def study_settings(cfg: Config) -> dict:
-    """Keyword arguments of :func:`fracid.inverse.study.run_study` from ``[study]`` and ``[identify]``;
-    ``posterior`` is the :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``,
-    None otherwise."""
+    """The checks of ``[study]`` as keyword arguments of :meth:`fracid.inverse.study.StudySettings.replace`
+    (``starts``, ``replicates``, ``noise_seed``, ``tolerance``, ``prior``; ``posterior``: the
+    :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``, None otherwise). The
+    inverse method is :func:`build_method`'s: ``StudySettings(method=build_method(cfg)).replace(**study_settings(cfg))``."""
     study = cfg.study
-    return {**identify_settings(cfg), "starts": study.starts, "replicates": study.replicates,
-            "noise_seed": study.seed, "tolerance": study.tolerance, "prior": study.prior,
+    return {"starts": study.starts, "replicates": study.replicates, "noise_seed": study.seed,
+            "tolerance": study.tolerance, "prior": study.prior,
             "posterior": posterior_settings(cfg) if study.posterior else None}
 
 
@@ -235,49 +234,24 @@ def build_space(cfg: Config):
                           log=tuple(name in identify.log for name in identify.parameters))
 
 
-def identify_settings(cfg: Config) -> dict:
-    """Keyword arguments of :func:`fracid.inverse.strategy.identify_data` (and ``identify``).
-
-    ``n``, ``method``, ``seed``, ``k``, ``groups`` (``groups`` consecutive index arrays covering
-    the n_y observations; :data:`DEFAULT_KALMAN_GROUPS` when not given), ``max_iterations``,
-    ``tol``, ``max_starts`` and ``restart`` (only when ``identify`` accepts it; a non-default restart it cannot take raises ConfigError). Execution
-    (executor, store, progress) is not configuration: add it at the call.
-    """
-    from fracid.inverse.strategy import identify
-
-    settings = _require(cfg, "identify")
-    knn, kalman = settings.knn, settings.kalman
-    count = kalman.groups if kalman.groups is not None else min(DEFAULT_KALMAN_GROUPS, cfg.n_y)
-    groups = [np.asarray(g) for g in np.array_split(np.arange(cfg.n_y), count)]
-    out = {"n": knn.n, "method": knn.method, "seed": knn.seed, "k": knn.k, "groups": groups,
-           "max_iterations": kalman.max_iterations, "tol": kalman.tol, "max_starts": kalman.max_starts}
-    if "restart" in inspect.signature(identify).parameters:
-        out["restart"] = kalman.restart
-    elif kalman.restart != "linearize":
-        raise ConfigError(f"{cfg.path}: identify.kalman.restart = {kalman.restart!r}: this version of "
-                          "fracid.inverse.strategy.identify cannot forward it; only 'linearize' (the default) is available")
-    return out
-
-
 def build_method(cfg: Config):
-    """The configured inverse method (``[identify] method``, a key of
-    :data:`fracid.inverse.methods.METHODS`) with the settings of its stages: for ``"knn-kalman"``
-    ``[identify.knn]`` and ``[identify.kalman]`` (as :func:`identify_settings`), for
-    ``"knn-gauss-newton"`` ``[identify.knn]`` and ``[identify.gauss-newton]``. Give it to
-    :func:`fracid.inverse.strategy.identify_data` as ``method=`` (no other settings)."""
-    from fracid.inverse.methods import METHODS
-    from fracid.inverse.strategy import KalmanSettings, KnnSettings
+    """The configured inverse method: the class that ``[identify] method`` names in
+    :data:`fracid.inverse.methods.METHODS`, built by its ``from_config(identify, n_y)`` from the validated
+    ``[identify]`` (the sections of its settings; a method's own ``[identify.<name>]`` table is in
+    ``identify.methods``). Give it to :func:`fracid.inverse.strategy.identify_data` as ``method=``.
+
+    Raises
+    ------
+    ConfigError
+        When the method refuses its settings (checked already when the configuration was loaded).
+    """
+    from fracid.config.identify import method_from_config
 
     identify = _require(cfg, "identify")
-    settings = identify_settings(cfg)
-    knn = KnnSettings(n=settings["n"], method=settings["method"], seed=settings["seed"], k=settings["k"])
-    cls = METHODS[identify.method]
-    if identify.method == "knn-gauss-newton":
-        gn = identify.gauss_newton
-        return cls(knn=knn, max_iterations=gn.max_iterations, tol=gn.tol)
-    kalman = KalmanSettings(groups=settings["groups"], max_iterations=settings["max_iterations"], tol=settings["tol"],
-                            restart=settings.get("restart", "linearize"), max_starts=settings["max_starts"])
-    return cls(knn=knn, kalman=kalman)
+    try:
+        return method_from_config(identify, cfg.n_y)
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"{cfg.path}: identify.{identify.method}: {err}") from None
 
 
 def simulate_settings(cfg: Config) -> dict:

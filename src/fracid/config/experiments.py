@@ -1,13 +1,14 @@
 """Validation of the ``[[experiments]]`` blocks: keys, units, the data file's header and columns
-(read with the block's delimiter and decimal mark) and the size of the data."""
+(read with the block's delimiter and decimal mark). The number of data values is not capped: the
+covariance of the data is not held as an n x n matrix."""
 
 from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
 
-from fracid.config.checker import _bytes, _Checker
-from fracid.config.registry import _specimen_class, _specimen_observables
+from fracid.config.checker import _Checker
+from fracid.config.registry import _section_reader, _specimen_class, _specimen_observables
 from fracid.config.schema import (
     _CONTROL_UNITS,
     _DECIMALS,
@@ -18,18 +19,11 @@ from fracid.config.schema import (
     _KINDS,
     _LOCAL_UNITS,
     _ROLES,
-    MAX_DATA_VALUES,
     ExperimentConfig,
     SpecimenConfig,
 )
 from fracid.config.sections import _check_specimen, _check_specimen_size, _specimen_options
 from fracid.data.experimental import SAMPLINGS
-
-
-def _data_limit_text(n_y: int, what: str) -> str:
-    return (f"{what} n_y = {n_y:,} data values, whose covariance takes n_y^2 x 8 bytes = {_bytes(8.0 * n_y * n_y)}; "
-            f"at most {MAX_DATA_VALUES:,} are allowed ({_bytes(8.0 * MAX_DATA_VALUES**2)}), and 40 to 100 points "
-            "describe a curve: lower n_points")
 
 
 def _csv_table(ck: _Checker, key: str, value, path: Path, delimiter: str, decimal: str, columns):
@@ -90,8 +84,6 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
             ck.fail(f"{prefix}.{name}", raw[name], f"not used by kind {kind!r}, which takes "
                     + ", ".join(_KIND_KEYS[kind]))
     n_points = ck.integer(f"{prefix}.n_points", required("n_points"), "must be an integer >= 3", lambda v: v >= 3)
-    if n_points > MAX_DATA_VALUES:
-        ck.fail(f"{prefix}.n_points", n_points, _data_limit_text(n_points, "this block alone has"))
     sampling = ck.choice(f"{prefix}.sampling", raw.get("sampling", SAMPLINGS[0]), SAMPLINGS)
 
     delimiter = raw.get("delimiter", ",")
@@ -156,11 +148,12 @@ def _experiment(ck: _Checker, i: int, raw, base: Path, specimen: SpecimenConfig)
     default_name = "global" if quantity == "force" else quantity
     name = ck.string(f"{prefix}.name", raw.get("name", default_name), "must be a non-empty string")
     overrides = ()
-    if "specimen" in raw and specimen.type == "mesh":
-        ck.fail(f"{prefix}.specimen", raw["specimen"], "a mesh specimen takes no per-experiment overrides yet; "
-                "run the experiments of different meshes from configurations of their own")
+    cls = _specimen_class(specimen.type)
+    if "specimen" in raw and _section_reader(cls) is not None:
+        ck.fail(f"{prefix}.specimen", raw["specimen"], f"a {specimen.type} specimen (read by its own [specimen] "
+                "section) takes no per-experiment overrides yet; run the experiments of different specimens from "
+                "configurations of their own")
     if "specimen" in raw:
-        cls = _specimen_class(specimen.type)
         fields = [f.name for f in dataclasses.fields(cls)]
         given = _specimen_options(ck, f"{prefix}.specimen", ck.table(f"{prefix}.specimen", raw["specimen"], fields), cls)
         _check_specimen(ck, f"{prefix}.specimen", specimen.type, cls, {**dict(specimen.options), **given}, given)

@@ -1,6 +1,7 @@
 """Validation of the ``[identify]`` section: identified parameters, their bounds and log flags,
-the inverse method, ``[identify.knn]`` (with the population limit), ``[identify.kalman]`` and
-``[identify.gauss-newton]``."""
+the inverse method and the sections of the registered methods' settings: ``[identify.knn]`` (with the
+population limit), ``[identify.kalman]``, ``[identify.gauss-newton]`` and a registered method's own
+``[identify.<name>]`` table, checked by the method's ``from_config`` (:func:`method_from_config`)."""
 
 from __future__ import annotations
 
@@ -45,8 +46,25 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         if needed:
             ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
         return None
-    ck.table("identify", raw, _IDENTIFY_KEYS)
+    from fracid.inverse.methods import METHODS
+
+    ck.table("identify", raw, (*_IDENTIFY_KEYS, *(name for name in METHODS if name not in _IDENTIFY_KEYS)))
     cls = _model_of(model.type).parameters
+    names = _identified(ck, raw, cls, model)
+    inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
+    lower, upper, log = _bounds(ck, raw, cls, names)
+    identify = IdentifyConfig(parameters=names, lower=lower, upper=upper, log=log, knn=_knn(ck, raw, names, n_y),
+                              kalman=_kalman(ck, raw, n_y), method=inverse,
+                              gauss_newton=_gauss_newton(ck, raw, inverse), methods=_method_tables(ck, raw, inverse))
+    try:
+        method_from_config(identify, n_y)
+    except (TypeError, ValueError) as err:
+        ck.fail(f"identify.{inverse}", raw.get(inverse, inverse), str(err))
+    return identify
+
+
+def _identified(ck: _Checker, raw, cls, model: ModelConfig) -> tuple:
+    """``identify.parameters``: a non-empty list of distinct parameters of the model's class."""
     names_all = cls.names()
     if "parameters" not in raw:
         ck.missing("identify.parameters", "a list of model parameters among " + ", ".join(names_all))
@@ -60,29 +78,17 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
     duplicates = sorted({v for v in value if value.count(v) > 1})
     if duplicates:
         ck.fail("identify.parameters", value, f"duplicate parameter {', '.join(map(repr, duplicates))}; list each once")
-    names = tuple(value)
-    from fracid.inverse.methods import METHODS
+    return tuple(value)
 
-    inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
 
+def _bounds(ck: _Checker, raw, cls, names: tuple) -> tuple[tuple, tuple, tuple]:
+    """``[identify.bounds]``: (lower, upper, log) of the identified parameters."""
     if "bounds" not in raw:
         ck.missing("identify.bounds", "a table with [lower, upper] for " + ", ".join(names))
     bounds = ck.table("identify.bounds", raw["bounds"], (*names, "log"))
     lower, upper = [], []
     for name in names:
-        key = f"identify.bounds.{name}"
-        unit = cls.units().get(name, "-")
-        allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(cls, name)} [{unit}]"
-        if name not in bounds:
-            ck.missing(key, f"[lower, upper] bounds of the identified parameter {name} [{unit}]")
-        pair = bounds[name]
-        lo, hi = ck.pair(key, pair, allowed)
-        if not lo < hi:
-            ck.fail(key, pair, f"lower = {lo:g} must be below upper = {hi:g} ({allowed})")
-        for which, v in (("lower", lo), ("upper", hi)):
-            if not _valid_parameter(cls, name, v):
-                ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(cls, name)} [{unit}]")
-        _check_plausible(ck, key, pair, name, (lo, hi), cls.units())
+        lo, hi = _bound_pair(ck, bounds, cls, name)
         lower.append(lo)
         upper.append(hi)
     log = ()
@@ -96,7 +102,28 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
             if not lo > 0:
                 ck.fail("identify.bounds.log", bounds["log"],
                         f"log scale for {name!r} needs a lower bound > 0, but identify.bounds.{name} has lower = {lo:g}")
+    return tuple(lower), tuple(upper), log
 
+
+def _bound_pair(ck: _Checker, bounds: dict, cls, name: str) -> tuple[float, float]:
+    key = f"identify.bounds.{name}"
+    unit = cls.units().get(name, "-")
+    allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(cls, name)} [{unit}]"
+    if name not in bounds:
+        ck.missing(key, f"[lower, upper] bounds of the identified parameter {name} [{unit}]")
+    pair = bounds[name]
+    lo, hi = ck.pair(key, pair, allowed)
+    if not lo < hi:
+        ck.fail(key, pair, f"lower = {lo:g} must be below upper = {hi:g} ({allowed})")
+    for which, v in (("lower", lo), ("upper", hi)):
+        if not _valid_parameter(cls, name, v):
+            ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(cls, name)} [{unit}]")
+    _check_plausible(ck, key, pair, name, (lo, hi), cls.units())
+    return lo, hi
+
+
+def _knn(ck: _Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
+    """``[identify.knn]``, with the population limit."""
     raw_knn = ck.table("identify.knn", raw.get("knn", {}), _KNN_KEYS)
     n = ck.integer("identify.knn.n", raw_knn.get("n", 64), "must be an integer >= 2", lambda v: v >= 2)
     method = ck.choice("identify.knn.method", raw_knn.get("method", "sobol"), _METHODS)
@@ -111,12 +138,14 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
                                      f"each), and the points and their outputs alone take {values:,} x 8 bytes = "
                                      f"{_bytes(8.0 * values)} (p = {len(names)} parameters + n_y = {n_y or 0} outputs "
                                      "per point); a few hundred points are enough to start the Kalman filter")
-    k_value = raw_knn.get("k", 5)
-    k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), k_value,
+    k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), raw_knn.get("k", 5),
                    f"must be an integer with 1 <= k <= the population size {population} ({how}, method {method!r})",
                    lambda v: 1 <= v <= population)
-    knn = dataclasses.replace(knn, k=k)
+    return dataclasses.replace(knn, k=k)
 
+
+def _kalman(ck: _Checker, raw, n_y: int | None) -> KalmanConfig:
+    """``[identify.kalman]``."""
     raw_kf = ck.table("identify.kalman", raw.get("kalman", {}), _KALMAN_KEYS)
     groups = None
     if "groups" in raw_kf:
@@ -125,7 +154,7 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
                    if top else "must be an integer >= 1")
         groups = ck.integer("identify.kalman.groups", raw_kf["groups"], allowed,
                             lambda v: v >= 1 and (top is None or v <= top))
-    kalman = KalmanConfig(
+    return KalmanConfig(
         groups=groups,
         max_iterations=ck.integer("identify.kalman.max_iterations", raw_kf.get("max_iterations", 10),
                                   "must be an integer >= 1", lambda v: v >= 1),
@@ -135,15 +164,53 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         max_starts=ck.integer("identify.kalman.max_starts", raw_kf.get("max_starts", 3),
                               "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1),
     )
+
+
+def _gauss_newton(ck: _Checker, raw, inverse: str) -> GaussNewtonConfig:
+    """``[identify.gauss-newton]``."""
     raw_gn = ck.table("identify.gauss-newton", raw.get("gauss-newton", {}), _GAUSS_NEWTON_KEYS)
-    gauss_newton = GaussNewtonConfig(
+    if raw_gn and inverse != "knn-gauss-newton":
+        ck.warn(f"[identify.gauss-newton] is given but identify.method = {inverse!r}: its settings are not used "
+                "(set method = \"knn-gauss-newton\" to use them)")
+    return GaussNewtonConfig(
         max_iterations=ck.integer("identify.gauss-newton.max_iterations", raw_gn.get("max_iterations", 20),
                                   "must be an integer >= 1 (linearisations at most)", lambda v: v >= 1),
         tol=ck.number("identify.gauss-newton.tol", raw_gn.get("tol", 0.01),
                       "must be a number > 0 [standard deviations]", lambda v: v > 0),
     )
-    if raw_gn and inverse != "knn-gauss-newton":
-        ck.warn(f"[identify.gauss-newton] is given but identify.method = {inverse!r}: its settings are not used "
-                "(set method = \"knn-gauss-newton\" to use them)")
-    return IdentifyConfig(parameters=names, lower=tuple(lower), upper=tuple(upper), log=log, knn=knn, kalman=kalman,
-                          method=inverse, gauss_newton=gauss_newton)
+
+
+def _method_tables(ck: _Checker, raw, inverse: str) -> dict:
+    """The registered methods' own tables ``[identify.<name>]``, as read (the method's ``from_config``
+    checks its own); a warning for one of a method not chosen."""
+    from fracid.inverse.methods import METHODS
+
+    methods = {}
+    for name in (name for name in METHODS if name in raw):
+        if not isinstance(raw[name], dict):
+            ck.fail(f"identify.{name}", raw[name], f"must be a table (section) of the settings of the method {name!r}")
+        methods[name] = dict(raw[name])
+        if name != inverse:
+            ck.warn(f"[identify.{name}] is given but identify.method = {inverse!r}: its settings are not used "
+                    f"(set method = \"{name}\" to use them)")
+    return methods
+
+
+def method_from_config(identify: IdentifyConfig, n_y: int | None):
+    """The inverse method of a validated ``[identify]``: ``METHODS[identify.method].from_config(identify,
+    n_y)``; a method class without ``from_config`` is built with its defaults (and takes no table).
+
+    Raises
+    ------
+    ValueError, TypeError
+        The method's refusal of its settings (the message names the setting and what is allowed).
+    """
+    from fracid.inverse.methods import METHODS
+
+    cls = METHODS[identify.method]
+    from_config = getattr(cls, "from_config", None)  # an optional hook of the method
+    if from_config is not None:
+        return from_config(identify, n_y)
+    if identify.methods.get(identify.method):
+        raise ValueError(f"the method {identify.method!r} takes no settings from the configuration")
+    return cls()

@@ -4,24 +4,21 @@ internal length)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, _Checker, _read_toml
-from fracid.config.experiments import _data_limit_text, _experiments
+from fracid.config.experiments import _experiments
 from fracid.config.identify import _identify
-from fracid.config.mesh_section import c_range, check_mesh_units
+from fracid.config.mesh_section import c_range
 from fracid.config.posterior import _posterior
-from fracid.config.registry import _model_of, _specimen_class
+from fracid.config.registry import _model_of, _section_reader, _specimen_class
 from fracid.config.schema import (
     _PURPOSES,
     _TOP_KEYS,
-    MAX_BAR_ELEMENTS,
-    MAX_DATA_VALUES,
     Config,
     ConfigError,
     ModelConfig,
@@ -35,6 +32,7 @@ from fracid.config.sections import (
     _simulate,
     _specimen,
     _study,
+    _value_text,
 )
 
 
@@ -72,15 +70,14 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
     if experiments and not n_y and purpose == "identify":
         ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
-    if n_y and n_y > MAX_DATA_VALUES:
-        ck.fail("experiments", [e.n_points for e in experiments if e.role == "calibration"],
-                _data_limit_text(n_y, "the n_points of the calibration blocks add up to"))
     identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
     output = _output(ck, raw.get("output"), base)
     simulate = _simulate(ck, raw.get("simulate"))
     study = _study(ck, raw.get("study"))
     posterior = _posterior(ck, raw.get("posterior"))
-    check_mesh_units(ck, model, specimen, identify)
+    section = _section_reader(_specimen_class(specimen.type))
+    if section is not None:  # the checks of a specimen's own section (a mesh's units against l)
+        section.check(ck, model, specimen, identify)
     _mesh_warnings(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
                   identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,
@@ -106,8 +103,9 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
     gradient or integral damage model (the smallest c: the given one, or the lower bound when c is
     identified): the damage band, a few l wide, is then not resolved and the results depend on the mesh.
 
-    Element size: ``h_fine`` for the notched beam and the dog-bone (8-node elements in the refined
-    band), ``length / n_elements`` for the bar.
+    The element size, the key that sets it and the advice are the specimen's
+    (:meth:`~fracid.specimens.protocol.Specimen.resolution`): ``h_fine`` of the notched beam, ``length /
+    n_elements`` of the bar, the smallest element side of a mesh file.
     """
     if model.regularization not in ("gradient", "integral"):
         return
@@ -117,33 +115,17 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
     variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))
                  for e in experiments if e.specimen]
     cls = _specimen_class(specimen.type)
+    fields = {f.name for f in dataclasses.fields(cls)}
     for prefix, options, given in variants:
-        built = cls(**options)
-        if specimen.type == "mesh":
-            h = _smallest_side(built.describe())
-            size = f"specimen.file = {built.path!r}: its smallest element side, {h:.3g} mm,"
-            advice = "refine the mesh where the crack runs to sides <= l/2"
-        elif specimen.type == "bar":
-            h = built.length / built.n_elements
-            key, default = _field_key(prefix, "n_elements", options, given)
-            size = f"{key} = {built.n_elements}{default}: the element size length / n_elements = {h:.3g} mm"
-            needed = 2.0 * built.length / length
-            advice = (f"use n_elements >= {math.ceil(needed)} (h <= l/2)" if needed <= MAX_BAR_ELEMENTS else
-                      f"that needs {needed:.3g} elements, beyond the limit {MAX_BAR_ELEMENTS}: is c in mm^2?")
-        else:
-            h = built.h_fine
-            key, default = _field_key(prefix, "h_fine", options, given)
-            size = f"{key} = {h:g}{default}: the element size h_fine = {h:g} mm"
-            advice = "use h_fine <= l/2"
-        if h > length:
-            ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
-                    f"the damage band is not resolved and the results depend on the mesh; {advice}")
-
-
-def _smallest_side(description) -> float:
-    """The shortest element side of a plane mesh [mm] (corner to corner)."""
-    corners = description.nodes[description.cells[:, :(3 if description.cells.shape[1] == 6 else 4)]]
-    return float(np.min(np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=-1)))
+        resolution = cls(**options).resolution(length)
+        if resolution.h <= length:
+            continue
+        size = f"specimen ({specimen.type}): {resolution.text}"
+        if resolution.field is not None:
+            key, default = _field_key(prefix, resolution.field, options, given)
+            size = f"{key} = {_value_text(resolution.value)}{default if resolution.field in fields else ''}: {resolution.text}"
+        ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
+                f"the damage band is not resolved and the results depend on the mesh; {resolution.advice}")
 
 
 def _model_parameters(model: ModelConfig):

@@ -29,9 +29,9 @@ import numpy as np
 
 from fracid.config import schema
 from fracid.config.checker import ConfigError, _bytes, _Checker
+from fracid.config.registry import SpecimenSection
 from fracid.config.schema import SpecimenConfig
 
-MESH_TYPE = "mesh"
 _KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
          "crack", "regions")
 _COMPONENT = "must be 'x' or 'y'"
@@ -41,8 +41,9 @@ _COARSEST = 100.0
 _METRES = 5.0
 
 
-def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
-    """The validated ``[specimen]`` of a mesh: the file is read and every group named is checked."""
+def mesh_specimen(ck: _Checker, raw: dict, base: Path, kind: str = "mesh") -> SpecimenConfig:
+    """The validated ``[specimen]`` of a mesh (registered as ``kind``): the file is read and every group
+    named is checked."""
     ck.table("specimen", raw, _KEYS)
     for key in ("file", "thickness", "supports", "loads", "controls"):
         if key not in raw:
@@ -64,7 +65,7 @@ def mesh_specimen(ck: _Checker, raw: dict, base: Path) -> SpecimenConfig:
     names = tuple(name for name, _ in options["controls"])
     control = ck.choice("specimen.control", raw.get("control", names[0]), names)
     _check_mesh(ck, options)
-    return SpecimenConfig(type=MESH_TYPE, control=control, options=tuple(options.items()))
+    return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
 
 
 _ALLOWED = {
@@ -205,7 +206,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
     model : ModelConfig
         The validated ``[model]``.
     specimen : SpecimenConfig
-        The validated ``[specimen]``; nothing is checked unless its type is "mesh".
+        The validated ``[specimen]`` of a mesh (:data:`SECTION`).
     identify : IdentifyConfig or None
         The validated ``[identify]``, if any.
 
@@ -214,10 +215,10 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
     ConfigError
         Naming the file, the mesh's extent in its units and in mm, ``specimen.scale``, c and l.
     """
-    if specimen.type != MESH_TYPE or model.regularization not in ("gradient", "integral"):
+    if model.regularization not in ("gradient", "integral"):
         return
-    from fracid.config.loading import _smallest_side
     from fracid.specimens.mesh import MeshSpecimen
+    from fracid.specimens.protocol import element_sides
 
     built = MeshSpecimen(**dict(specimen.options))
     description = built.describe()
@@ -232,7 +233,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
                 if extent.max() < _METRES else "check specimen.scale (mm per mesh unit) and that c is in mm^2")
         raise ConfigError(f"{ck.path}: {size}, smaller than the internal length l = sqrt(2 c) = {length:.3g} mm "
                           f"(with {small_where}): {hint}")
-    length, side = math.sqrt(2.0 * large), _smallest_side(description)
+    length, side = math.sqrt(2.0 * large), element_sides(description)[0]
     if side > _COARSEST * length:
         hint = ("is the mesh drawn in mm? then leave scale out (1, the default)" if built.scale > 1 else
                 "scale = 0.001 for a mesh drawn in micrometres")
@@ -252,3 +253,7 @@ def c_range(model, identify) -> tuple:
         values += [(identify.lower[i], f"the lower bound c = {identify.lower[i]:g} mm^2 of identify.bounds.c"),
                    (identify.upper[i], f"the upper bound c = {identify.upper[i]:g} mm^2 of identify.bounds.c")]
     return min(values), max(values)
+
+
+#: the ``[specimen]`` section of :class:`~fracid.specimens.mesh.MeshSpecimen` (its ``config_section``)
+SECTION = SpecimenSection(read=mesh_specimen, check=check_mesh_units)

@@ -1,13 +1,36 @@
 """The model and specimen types a configuration may name.
 
-The model types are read from :data:`fracid.models.MODEL_TYPES` at each call, the specimen types and
-their controls and observables from :data:`fracid.specimens.SPECIMENS`: a model or specimen registered
-there needs no change here.
+The model types are read from :data:`fracid.models.MODEL_TYPES` at each call, the specimen types from
+:data:`fracid.specimens.SPECIMENS` (each a :class:`~fracid.specimens.protocol.Specimen`, asked for its
+controls, observables, limits and its ``[specimen]`` section): a model or specimen registered there,
+from a test file too, needs no change here.
 """
 
 from __future__ import annotations
 
+import importlib
+from dataclasses import dataclass
+from typing import Callable
+
 from fracid.specimens import SPECIMENS
+
+
+@dataclass(frozen=True)
+class SpecimenSection:
+    """The reader of a ``[specimen]`` section that is not the specimen's dataclass fields (a specimen
+    class names it in its ``config_section``).
+
+    Parameters
+    ----------
+    read : callable (checker, raw table, base directory, type name) -> SpecimenConfig
+        Validates the section (every key, the files it names) and returns it.
+    check : callable (checker, ModelConfig, SpecimenConfig, IdentifyConfig or None) -> None
+        The checks joining the section with the model and the identification (e.g. the mesh's units
+        against the internal length), raising ConfigError.
+    """
+
+    read: Callable
+    check: Callable
 
 
 def _model_types() -> tuple:
@@ -23,20 +46,41 @@ def _model_of(kind: str):
     return model_from_type(kind)
 
 
+def _specimen_types() -> tuple:
+    """The ``[specimen] type`` names: those of :data:`fracid.specimens.SPECIMENS` at the time of the call."""
+    return tuple(SPECIMENS)
+
+
 def _specimen_class(kind: str):
-    if kind == "mesh":  # the user's own (fracid.config.mesh_section), not a built-in geometry
-        from fracid.specimens.mesh import MeshSpecimen
+    """The specimen class registered as ``kind`` in :data:`fracid.specimens.SPECIMENS`."""
+    try:
+        return SPECIMENS[kind]
+    except KeyError:
+        raise ValueError(f"specimen type = {kind!r}; choose one of {', '.join(map(repr, SPECIMENS))}") from None
 
-        return MeshSpecimen
-    return SPECIMENS[kind]
+
+def _section_reader(cls) -> SpecimenSection | None:
+    """The :class:`SpecimenSection` of a specimen class that declares one (its ``config_section``,
+    ``"module:name"``), or None when its dataclass fields are the section's keys."""
+    where = cls.config_section
+    if where is None:
+        return None
+    module, _, name = where.partition(":")
+    return getattr(importlib.import_module(module), name)
 
 
-#: specimen type -> (controls, the first being the default; local observables [mm])
-_SPECIMENS = {kind: (cls.controls, cls.observables) for kind, cls in SPECIMENS.items()}
+def _build(specimen):
+    """The specimen object of a validated ``[specimen]`` (a :class:`~fracid.config.schema.SpecimenConfig`)."""
+    return _specimen_class(specimen.type)(**dict(specimen.options))
 
 
 def _specimen_observables(specimen) -> tuple:
-    """The local observables of a validated ``[specimen]`` (a mesh's depend on its crack line)."""
-    if specimen.type == "mesh":
-        return _specimen_class("mesh")(**dict(specimen.options)).observables
-    return _SPECIMENS[specimen.type][1]
+    """The local observables of a validated ``[specimen]``, asked of the specimen (a mesh's depend on its crack line)."""
+    return tuple(_build(specimen).observables)
+
+
+#: specimen type -> (control names, the first the default; local observables [mm]) of the default instances
+#: registered at import (not the mesh, which has none); the configuration asks the specimen itself, this map
+#: is kept for the tests that import it
+_SPECIMENS = {kind: (tuple(instance.control_names), tuple(instance.observables)) for kind, cls in SPECIMENS.items()
+              if (instance := cls.default_instance()) is not None}

@@ -27,7 +27,9 @@ present they are always validated. Every other key is optional unless marked *re
     eta = 10.0                          # -, eta >= 1
 
     [specimen]                          # required
-    type = "notched-beam"               # required: "notched-beam" | "dogbone" | "bar"
+    type = "notched-beam"               # required: a key of fracid.specimens.SPECIMENS: "notched-beam" |
+                                        #   "dogbone" | "bar" | "wedge-splitting" | "strip" | "mesh" (its
+                                        #   own keys: fracid.config.mesh_section) | specimens added later
     control = "cmod"                    # the specimen's default if omitted:
                                         #   notched-beam: "cmod" (default) | "deflection"
                                         #   dogbone:      "elongation" (default) | "platen_displacement"
@@ -149,11 +151,17 @@ present they are always validated. Every other key is optional unless marked *re
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from fracid.config.registry import _model_of
 from fracid.inverse.posterior import PosteriorSettings
+from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
+    BAR_BYTES_PER_ELEMENT,
+    BYTES_PER_UNKNOWN,
+    MAX_BAR_ELEMENTS,
+    MAX_UNKNOWNS,
+)
 
 
 class ConfigError(ValueError):
@@ -195,10 +203,6 @@ _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 _STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
 _POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
 _ROLES = ("calibration", "prediction")
-#: Kalman steps per pass when [identify.kalman] groups is not given. A step costs one run (with exact
-#: sensitivities) up to its last observation, so one observation per step would cost a 30-point curve about
-#: 15 full-run equivalents per pass; with linearised restarts the later passes use one run each.
-DEFAULT_KALMAN_GROUPS = 4
 
 
 # ------------------------------------------------------------------------------ size limits
@@ -209,25 +213,8 @@ DEFAULT_KALMAN_GROUPS = 4
 #: minutes each), so 1e5 is already days of computing; n = 1e9 allocated 23.5 GB before the first run
 MAX_POPULATION = 100_000
 
-#: largest number of bar elements: about 4 kB each in a forward run (measured), so 2e5 elements
-#: take about 1 GB; 1e8 elements hung the machine
-MAX_BAR_ELEMENTS = 200_000
-
-#: measured memory of a forward run of the bar per element [bytes]
-BAR_BYTES_PER_ELEMENT = 4_000
-
-#: largest number of unknowns (2 displacements per node + 1 nonlocal strain per vertex) of a 2D
-#: mesh: about 6 kB each in a forward run (measured, before the sparse factorisation's own
-#: memory), so 2e6 unknowns take about 12 GB, and every step factorises the matrix again
-MAX_UNKNOWNS = 2_000_000
-
-#: measured memory of a forward run of the 2D specimens per unknown [bytes]
-BYTES_PER_UNKNOWN = 6_000
-
-#: largest number of data values n_y (the n_points of the calibration blocks together, and of each
-#: prediction block): the covariance C_exp is a dense n_y x n_y matrix of 8-byte numbers (5000 ->
-#: 191 MiB, 50000 -> 18.6 GiB) factorised by every Kalman step; 40 to 100 points describe a curve
-MAX_DATA_VALUES = 5_000
+# The limits of a forward run's memory (MAX_BAR_ELEMENTS, BAR_BYTES_PER_ELEMENT, MAX_UNKNOWNS,
+# BYTES_PER_UNKNOWN) are the specimens' (fracid.specimens.protocol), imported above and re-exported.
 
 
 # ------------------------------------------------------------------------------ validated config
@@ -244,7 +231,7 @@ class ModelConfig:
     def regularization(self) -> str | None:
         """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
         (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
-        return getattr(_model_of(self.type), "regularization", None)
+        return _model_of(self.type).regularization
 
 
 @dataclass(frozen=True)
@@ -349,7 +336,7 @@ class GaussNewtonConfig:
 @dataclass(frozen=True)
 class IdentifyConfig:
     """``[identify]``: identified parameters, their bounds and log flags, the inverse method (a key of
-    :data:`fracid.inverse.methods.METHODS`) and the settings of its stages (KNN, Kalman, Gauss-Newton)."""
+    :data:`fracid.inverse.methods.METHODS`) and the sections of the registered methods' settings."""
 
     parameters: tuple
     lower: tuple
@@ -359,6 +346,9 @@ class IdentifyConfig:
     kalman: KalmanConfig = KalmanConfig()
     method: str = DEFAULT_INVERSE_METHOD
     gauss_newton: GaussNewtonConfig = GaussNewtonConfig()
+    #: a registered method's own table ``[identify.<name>]`` by method name, as read (its ``from_config``
+    #: checks it)
+    methods: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -13,17 +13,12 @@ import re
 from pathlib import Path
 
 from fracid.config.checker import _bytes, _Checker, _show
-from fracid.config.mesh_section import MESH_TYPE, mesh_specimen
-from fracid.config.registry import _SPECIMENS, _model_of, _model_types, _specimen_class
+from fracid.config.registry import _model_of, _model_types, _section_reader, _specimen_class, _specimen_types
 from fracid.config.schema import (
     _MODEL_KEYS,
     _OUTPUT_KEYS,
     _SIMULATE_KEYS,
     _STUDY_KEYS,
-    BAR_BYTES_PER_ELEMENT,
-    BYTES_PER_UNKNOWN,
-    MAX_BAR_ELEMENTS,
-    MAX_UNKNOWNS,
     ConfigError,
     ModelConfig,
     OutputConfig,
@@ -85,17 +80,20 @@ def _model(ck: _Checker, raw) -> ModelConfig:
 
 
 def _check_model_runs_on(ck: _Checker, model: ModelConfig, specimen) -> None:
+    """Refuse a model that does not run on the specimen, with its reason and the specimen types it runs on."""
     from fracid.models import runs_on
 
-    if specimen.type == MESH_TYPE:
-        built = _specimen_class(specimen.type)(**dict(specimen.options))
-        if not runs_on(_model_of(model.type), built):
-            ck.fail("model.type", model.type, f"does not run on this mesh specimen: {_model_of(model.type).why_not(built)}")
+    made = _model_of(model.type)
+    built = _specimen_class(specimen.type)(**dict(specimen.options))
+    if runs_on(made, built):
         return
-    if not runs_on(_model_of(model.type), _specimen_class(specimen.type)):
-        fits = [kind for kind in _SPECIMENS if runs_on(_model_of(model.type), _specimen_class(kind))]
-        ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it; it runs on "
-                + (", ".join(repr(k) for k in fits) or "no built-in specimen"))
+    fits = []
+    for kind in _specimen_types():
+        instance = _specimen_class(kind).default_instance()
+        if instance is not None and runs_on(made, instance):
+            fits.append(repr(kind))
+    ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it ({made.why_not(built)}); "
+            "it runs on " + (", ".join(fits) or "no built-in specimen"))
 
 
 def _field_kind(field: dataclasses.Field) -> str:
@@ -103,18 +101,18 @@ def _field_kind(field: dataclasses.Field) -> str:
     return text.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
 
 
-def _specimen_error_key(message: str, fields, given) -> str | None:
-    """The specimen field a validation message is about: the first named one the user gave, else the first named."""
-    found = []
-    for name in fields:
-        match = re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", message)
-        if match:
-            found.append((match.start(), name))
-    found.sort()
-    for _, name in found:
-        if name in given:
-            return name
-    return found[0][1] if found else None
+def _specimen_error_key(err: Exception, fields, given) -> str | None:
+    """The specimen field an error of its validation is about: of the fields the error names (its
+    ``names``, a :class:`~fracid.field_error.FieldError`), the first the user gave, else the first.
+    An error without ``names`` (a specimen class of another package) is searched for field names."""
+    names = getattr(err, "names", None)
+    if names is None:  # fallback: the field names in the message, in their order there
+        message = str(err)
+        found = sorted((match.start(), name) for name in fields
+                       if (match := re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", message)))
+        names = [name for _, name in found]
+    names = [name for name in names if name in fields]
+    return next((name for name in names if name in given), names[0] if names else None)
 
 
 def _specimen_options(ck: _Checker, prefix: str, raw: dict, cls) -> dict:
@@ -140,13 +138,20 @@ def _check_specimen(ck: _Checker, prefix: str, kind: str, cls, options: dict, gi
         cls(**options)
     except (TypeError, ValueError) as err:
         fields = {f.name: f for f in dataclasses.fields(cls)}
-        name = _specimen_error_key(str(err), fields, options)
+        name = _specimen_error_key(err, fields, options)
         if name is None:
             raise ConfigError(f"{ck.path}: {prefix} ({kind}) is invalid: {err}") from None
         value = options.get(name, getattr(cls, name, None))
         where = f"{prefix}.{name}" if name in given else f"specimen.{name}"
         default = "" if name in options else " (default)"
         raise ConfigError(f"{ck.path}: {where} = {_show(value)}{default}: {err}") from None
+
+
+def _value_text(value) -> str:
+    """A specimen field's value in a message: a float as ``%g`` (2, 0.01), anything else as TOML shows it."""
+    if isinstance(value, float):
+        return f"{value:g}"
+    return _show(value)
 
 
 def _field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, str]:
@@ -156,37 +161,28 @@ def _field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str,
 
 
 def _check_specimen_size(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
-    """Refuse a mesh beyond :data:`MAX_BAR_ELEMENTS` or :data:`MAX_UNKNOWNS`, estimated from the
-    geometry without building it (the specimen is valid: :func:`_check_specimen` ran first)."""
-    specimen = cls(**options)
-    if kind == "bar":
-        n = specimen.n_elements
-        if n > MAX_BAR_ELEMENTS:
-            key, default = _field_key(prefix, "n_elements", options, given)
-            raise ConfigError(
-                f"{ck.path}: {key} = {n}{default}: a forward run of {n:,} bar elements needs about "
-                f"{_bytes(n * BAR_BYTES_PER_ELEMENT)} of memory ({BAR_BYTES_PER_ELEMENT:,} bytes per element, "
-                f"measured); at most {MAX_BAR_ELEMENTS:,} elements are allowed, and a few elements per internal length "
-                "l = sqrt(2 c) are enough")
+    """Refuse a problem beyond the specimen's limit (bar elements, unknowns of a plane mesh), estimated by
+    the specimen from its geometry without building the mesh (the specimen is valid: :func:`_check_specimen`
+    ran first)."""
+    size = cls(**options).size_estimate()
+    if not size.too_large:
         return
-    elements, nodes, vertices = specimen.mesh_size()
-    unknowns = 2 * nodes + vertices
-    if unknowns > MAX_UNKNOWNS:
-        key, default = _field_key(prefix, "h_fine", options, given)
-        if prefix != "specimen" and "h_fine" not in given:  # the experiment's overrides make the mesh too large
-            default += f" with {prefix} = {{" + ", ".join(f"{k} = {_show(v)}" for k, v in given.items()) + "}"
-        shape = ", ".join(f"{name} = {value:g}" for name, value in options.items()
-                          if isinstance(value, float) and name != "h_fine")
-        raise ConfigError(
-            f"{ck.path}: {key} = {specimen.h_fine:g}{default}: the mesh of this {kind} would have about {elements:,} "
-            f"elements and {unknowns:,} unknowns (estimated from the geometry{': ' + shape if shape else ''}), "
-            f"needing about {_bytes(unknowns * BYTES_PER_UNKNOWN)} of memory in a forward run "
-            f"({BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most {MAX_UNKNOWNS:,} unknowns are allowed: "
-            "use a larger h_fine (a few elements per internal length l = sqrt(2 c) are enough)")
+    key, default = _field_key(prefix, size.field or "type", options, given)
+    if prefix != "specimen" and size.field not in given:  # the experiment's overrides make the problem too large
+        default += f" with {prefix} = {{" + ", ".join(f"{k} = {_show(v)}" for k, v in given.items()) + "}"
+    shape = ", ".join(f"{name} = {value:g}" for name, value in options.items()
+                      if isinstance(value, float) and name != size.field)
+    raise ConfigError(
+        f"{ck.path}: {key} = {_value_text(size.value)}{default}: the mesh of this {kind} would have {size.summary} "
+        f"(estimated from the geometry{': ' + shape if shape else ''}), needing about {_bytes(size.memory)} of "
+        f"memory in a forward run ({size.bytes_per:,} bytes per {size.unit}, measured); at most {size.limit:,} "
+        f"{size.unit}s are allowed: {size.advice}")
 
 
 def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
-    types = (*_SPECIMENS, MESH_TYPE)
+    """The validated ``[specimen]``: its type among :data:`fracid.specimens.SPECIMENS`, read by the
+    specimen's own section reader if it declares one (a mesh file), else by its dataclass fields."""
+    types = _specimen_types()
     if raw is None:
         ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in types))
     if not isinstance(raw, dict):
@@ -194,15 +190,16 @@ def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
     if "type" not in raw:
         ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in types))
     kind = ck.choice("specimen.type", raw["type"], types)
-    if kind == MESH_TYPE:
-        return mesh_specimen(ck, raw, base if base is not None else ck.path.parent)
     cls = _specimen_class(kind)
+    reader = _section_reader(cls)
+    if reader is not None:
+        return reader.read(ck, raw, base if base is not None else ck.path.parent, kind)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     ck.table("specimen", raw, ("type", "control", *fields))
-    controls, _ = _SPECIMENS[kind]
-    control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
     options = _specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
     _check_specimen(ck, "specimen", kind, cls, options, options)
+    controls = cls(**options).control_names
+    control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
     _check_specimen_size(ck, "specimen", kind, cls, options, options)
     return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
 

@@ -16,6 +16,15 @@ from fracid.data.curves import (
     read_curve_csv,
     require_positive_force,
 )
+from fracid.data.covariance_matrix import (
+    Block,
+    Covariance,
+    Dense,
+    Diagonal,
+    LowRankPlusDiagonal,
+    as_covariance,
+    block_diagonal,
+)
 from fracid.data.dataset import ExperimentalData, stack
 from fracid.data.experimental import (
     from_envelope,
@@ -28,11 +37,18 @@ from fracid.data.experimental import (
 from fracid.data.sampling import SAMPLINGS, decimate, sample_points
 
 __all__ = [
+    "Block",
+    "Covariance",
     "Curve",
     "DataError",
     "DataTypeError",
+    "Dense",
+    "Diagonal",
     "ExperimentalData",
+    "LowRankPlusDiagonal",
     "SAMPLINGS",
+    "as_covariance",
+    "block_diagonal",
     "curve_from_arrays",
     "decimate",
     "from_envelope",

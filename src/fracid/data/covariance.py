@@ -16,6 +16,7 @@ import re
 import numpy as np
 
 from fracid.data.arguments import real_number
+from fracid.data.covariance_matrix import Diagonal
 from fracid.data.dataset import ExperimentalData
 from fracid.data.errors import DataError
 
@@ -85,5 +86,5 @@ def diagonal_data(points, y, s, name: str, notes: list[str]) -> ExperimentalData
             "use std_floor > 0 or give the standard deviation explicitly"
         )
     return ExperimentalData(
-        control=points, y=y, covariance=np.diag(s**2), blocks=((str(name), 0, len(y)),), notes=tuple(notes)
+        control=points, y=y, covariance=Diagonal(s**2), blocks=((str(name), 0, len(y)),), notes=tuple(notes)
     )

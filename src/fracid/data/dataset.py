@@ -12,8 +12,8 @@ import operator
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.linalg
 
+from fracid.data.covariance_matrix import Covariance, as_covariance, block_diagonal
 from fracid.data.errors import DataError
 
 
@@ -27,8 +27,11 @@ class ExperimentalData:
         Control value [mm] at which each entry of ``y`` is taken.
     y : array_like, shape (n_y,)
         Measured values: forces [N] (global blocks) or local quantities (e.g. width [mm]).
-    covariance : array_like, shape (n_y, n_y)
-        Covariance C_exp [N^2, or the local unit squared], symmetric positive definite.
+    covariance : array_like, shape (n_y, n_y), or Covariance
+        Covariance C_exp [N^2, or the local unit squared], symmetric positive definite; kept as a
+        :class:`~fracid.data.covariance_matrix.Covariance` (a :class:`~fracid.data.covariance_matrix.Diagonal`
+        when diagonal, so that n_y may be large). It reads as an (n_y, n_y) array while n_y is small
+        (``np.asarray(data.covariance)``, ``data.covariance.shape``, ``data.covariance[s, s]``).
     blocks : tuple of (str, int, int)
         (name, start, stop) of each stacked block: ``y[start:stop]``; contiguous, covering all of
         ``y``, names unique.
@@ -44,32 +47,24 @@ class ExperimentalData:
 
     control: np.ndarray
     y: np.ndarray
-    covariance: np.ndarray
+    covariance: Covariance
     blocks: tuple[tuple[str, int, int], ...]
     notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         control = np.array(self.control, dtype=float)
         y = np.array(self.y, dtype=float)
-        cov = np.array(self.covariance, dtype=float)
         if y.ndim != 1 or y.size == 0:
             raise DataError(f"y must be a non-empty one-dimensional array, got shape {y.shape}")
         n = y.size
         if control.shape != (n,):
             raise DataError(f"control must have shape ({n},) like y, got {control.shape}")
-        if cov.shape != (n, n):
-            raise DataError(f"covariance must have shape ({n}, {n}), got {cov.shape}")
-        for what, array in (("control", control), ("y", y), ("covariance", cov)):
+        for what, array in (("control", control), ("y", y)):
             if not np.all(np.isfinite(array)):
                 raise DataError(f"{what} holds non-finite values")
-        if not np.allclose(cov, cov.T, rtol=0.0, atol=1e-12 * float(np.max(np.abs(cov)))):
-            raise DataError("covariance is not symmetric")
-        try:
-            np.linalg.cholesky(cov)
-        except np.linalg.LinAlgError:
-            raise DataError("covariance is not positive definite (a zero or negative variance?)") from None
+        cov = _check_covariance(self.covariance, n)
         blocks = _check_blocks(self.blocks, n)
-        for array in (control, y, cov):
+        for array in (control, y):
             array.setflags(write=False)
         object.__setattr__(self, "control", control)
         object.__setattr__(self, "y", y)
@@ -85,7 +80,7 @@ class ExperimentalData:
     @property
     def std(self) -> np.ndarray:
         """Standard deviation of each entry, sqrt(diag(covariance)) [N or the local unit]."""
-        return np.sqrt(np.diag(self.covariance))
+        return self.covariance.std()
 
     def weighted(self, weights: dict) -> "ExperimentalData":
         """The data with block weights p_b: f = sum_b p_b f_b (docs/theory.md, section 3.3, e.g. p1 global, p2 local).
@@ -107,7 +102,7 @@ class ExperimentalData:
                 raise DataError(f"weight of block {name!r} = {p!r}: it must be a number > 0")
             scale[self.block(name)] = 1.0 / np.sqrt(p)
         notes = [f"block {name!r} weighted p = {p:g} (covariance divided by p)" for name, p in weights.items() if p != 1]
-        return replace(self, covariance=self.covariance * np.outer(scale, scale), notes=self.notes + tuple(notes))
+        return replace(self, covariance=self.covariance.scaled(scale), notes=self.notes + tuple(notes))
 
     def block(self, name: str) -> slice:
         """Slice of ``y`` holding the block ``name``."""
@@ -115,6 +110,23 @@ class ExperimentalData:
             if block_name == name:
                 return slice(start, stop)
         raise KeyError(f"no block {name!r}; blocks: {', '.join(b[0] for b in self.blocks)}")
+
+
+def _check_covariance(covariance, n: int) -> Covariance:
+    """``covariance`` as a :class:`~fracid.data.covariance_matrix.Covariance` of n values (Diagonal when it is
+    diagonal); DataError if it is not an (n, n) array or a covariance of n values, not finite, not symmetric
+    or not positive definite."""
+    if not isinstance(covariance, Covariance):
+        try:
+            covariance = np.asarray(covariance, dtype=float)
+        except (TypeError, ValueError):
+            raise DataError(f"covariance is a {type(covariance).__name__}, not an array of numbers") from None
+        if covariance.shape != (n, n):
+            raise DataError(f"covariance must have shape ({n}, {n}), got {covariance.shape}")
+    try:
+        return as_covariance(covariance, n, name="covariance")
+    except ValueError as err:
+        raise DataError(str(err)) from None
 
 
 def _check_blocks(blocks, n: int) -> tuple[tuple[str, int, int], ...]:
@@ -185,7 +197,7 @@ def stack(*datasets: ExperimentalData) -> ExperimentalData:
     return ExperimentalData(
         control=np.concatenate([d.control for d in datasets]),
         y=np.concatenate([d.y for d in datasets]),
-        covariance=scipy.linalg.block_diag(*[d.covariance for d in datasets]),
+        covariance=block_diagonal([d.covariance for d in datasets]),
         blocks=tuple(blocks),
         notes=tuple(notes),
     )

@@ -264,8 +264,8 @@ def read_table(path: str, delimiter: str = ",", decimal: str = ".", columns: Seq
     try:
         rows = list(iter_rows(lines[start:], delimiter, first_line=start + 1))
     except csv.Error as error:
-        unclosed = "; a quote '\"' that is not closed makes the rest of the file one cell" if "limit" in str(error) \
-            else ""
+        odd_quotes = sum(line.count('"') for line in lines[start:]) % 2  # the file says it, not the error's text
+        unclosed = "; a quote '\"' that is not closed makes the rest of the file one cell" if odd_quotes else ""
         raise DataError(f"{path}: not a readable CSV file ({error}){unclosed}") from None
     _check_line_breaks(path, rows)
     kinds = _row_kinds(rows, decimal)

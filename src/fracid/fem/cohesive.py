@@ -24,8 +24,8 @@ from typing import ClassVar
 import numpy as np
 from scipy.special import gammainc
 
-from fracid.fem.damage import update_history
 from fracid.fem.ranges import ParameterRange, ParameterSet
+from fracid.fem.tsl import secant_unloading
 
 
 _R = ParameterRange
@@ -68,8 +68,9 @@ def normalised_area(x, c1, c2):
     return _incomplete_moment(0, c2, x) + c1**3 * _incomplete_moment(3, c2, x) - tail * x**2 / 2.0
 
 
-def _normalised_law(x, c1, c2):
-    """f(x) = sigma / ft and df/dx of the Hordijk law, without the cut-offs outside [0, 1)."""
+def hordijk_shape(x, c1, c2):
+    """f(x) = sigma / ft and df/dx of the Hordijk law at normalised openings x = w / wc [-], without
+    the cut-offs outside [0, 1)."""
     decay = np.exp(-c2 * x)
     tail = (1.0 + c1**3) * np.exp(-c2)
     cubic = 1.0 + (c1 * x) ** 3
@@ -78,13 +79,22 @@ def _normalised_law(x, c1, c2):
     return f, df
 
 
-def _softening(w, ft, wc, c1, c2):
-    """Stress and tangent of the Hordijk law, both zero outside the softening range 0 <= w < wc."""
+def hordijk_shape_derivatives(x, c1, c2) -> dict:
+    """d f / d c1 and d f / d c2 of :func:`hordijk_shape` at fixed x [-]:
+    3 c1^2 (x^3 exp(-c2 x) - x exp(-c2)) and x ((1 + c1^3) exp(-c2) - (1 + (c1 x)^3) exp(-c2 x))."""
+    decay, tail = np.exp(-c2 * x), np.exp(-c2)
+    return {"c1": 3.0 * c1**2 * (x**3 * decay - x * tail),
+            "c2": -x * (1.0 + (c1 * x) ** 3) * decay + x * (1.0 + c1**3) * tail}
+
+
+def hordijk_envelope(w, ft, wc, c1, c2):
+    """Stress [MPa] and tangent [MPa/mm] of the Hordijk law, both zero outside the softening range
+    0 <= w < wc (see :func:`hordijk_stress` and :func:`hordijk_tangent`)."""
     w = np.asarray(w, dtype=float)
     active = (w >= 0.0) & (w < wc)
     # evaluate at a harmless x where inactive so that no overflow or nan leaks through np.where
     x = np.where(active, w / wc, 0.0)
-    f, df = _normalised_law(x, c1, c2)
+    f, df = hordijk_shape(x, c1, c2)
     return np.where(active, ft * f, 0.0), np.where(active, ft / wc * df, 0.0)
 
 
@@ -112,7 +122,7 @@ def hordijk_stress(w, ft, wc, c1, c2):
     ndarray
         Traction sigma [MPa], broadcast over the arguments.
     """
-    return _softening(w, ft, wc, c1, c2)[0]
+    return hordijk_envelope(w, ft, wc, c1, c2)[0]
 
 
 def hordijk_tangent(w, ft, wc, c1, c2):
@@ -133,92 +143,12 @@ def hordijk_tangent(w, ft, wc, c1, c2):
     ndarray
         Tangent stiffness [MPa/mm].
     """
-    return _softening(w, ft, wc, c1, c2)[1]
-
-
-def hordijk_parameter_derivatives(w, ft, wc, c1, c2, params) -> dict:
-    """Derivatives of :func:`hordijk_stress` at fixed opening w with respect to the law's parameters
-    ft, Gf, c1 and c2 of ``params`` (a :class:`CohesiveParameters`), including their effect through
-    the critical opening wc = Gf / (ft I(c1, c2)).
-
-    The law's arguments ``ft`` and ``wc`` may be those of ``params`` scaled by a factor a (ft a,
-    wc / a: a strength imperfection at equal fracture energy); they move with the parameters in
-    proportion (:meth:`CohesiveParameters.argument_rates`).
-
-    Parameters
-    ----------
-    w : array_like
-        Opening [mm].
-    ft, wc, c1, c2 : array_like
-        The law's arguments, as in :func:`hordijk_stress`.
-    params : CohesiveParameters
-
-    Returns
-    -------
-    dict {"ft", "Gf", "c1", "c2": ndarray}
-        d sigma / d name [MPa per unit parameter], zero where the traction is cut to 0 (w < 0,
-        w >= wc). At w = wc the law has a kink and the derivative with respect to wc jumps: the
-        value of the cut-off side (0) is returned there, the one-sided derivative of opening
-        the point further.
-    """
-    w = np.asarray(w, dtype=float)
-    active = (w >= 0.0) & (w < wc)
-    x = np.where(active, w / wc, 0.0)
-    f, df = _normalised_law(x, c1, c2)
-    decay, tail = np.exp(-c2 * x), np.exp(-c2)
-    partial = {  # with respect to the arguments, wc held
-        "ft": f,
-        "wc": -ft * df * x / wc,
-        "c1": ft * 3.0 * c1**2 * (x**3 * decay - x * tail),
-        "c2": ft * (-x * (1.0 + (c1 * x) ** 3) * decay + x * (1.0 + c1**3) * tail),
-    }
-    out = {}
-    for name, (ft_rate, wc_rate, c1_rate, c2_rate) in params.argument_rates().items():
-        value = (partial["ft"] * ft * ft_rate + partial["wc"] * wc * wc_rate + partial["c1"] * c1_rate
-                 + partial["c2"] * c2_rate)
-        out[name] = np.where(active, value, 0.0)
-    return out
-
-
-def cohesive_traction_parameter_derivatives(w, w_max, ft, wc, c1, c2, params):
-    """Derivatives of the traction of :func:`cohesive_traction` at fixed opening w and fixed
-    history w_max: with respect to the parameters, and with respect to w_max.
-
-    Loading (w >= w_max): the envelope's, :func:`hordijk_parameter_derivatives` at w, and no
-    dependence on w_max. Unloading (0 <= w < w_max): sigma = hordijk_stress(w_max) w / w_max, so
-    d sigma / d x = d hordijk_stress(w_max) / d x  w / w_max and
-    d sigma / d w_max = w (w_max sigma_H'(w_max) - sigma_H(w_max)) / w_max^2. Closed (w < 0): zeros.
-
-    Parameters
-    ----------
-    w, w_max, ft, wc, c1, c2
-        As in :func:`cohesive_traction`.
-    params : CohesiveParameters
-        Whose ft, Gf, c1, c2 the arguments derive from (see :func:`hordijk_parameter_derivatives`).
-
-    Returns
-    -------
-    rates : dict {"ft", "Gf", "c1", "c2": ndarray}
-        d sigma / d name at fixed w and w_max [MPa per unit parameter].
-    d_sigma_d_w_max : ndarray
-        [MPa/mm], nonzero at unloading points only.
-    """
-    w = np.asarray(w, dtype=float)
-    w_max = np.asarray(w_max, dtype=float)
-    loading = w >= w_max
-    unloading = ~loading & (w >= 0.0)
-    reached = np.where(unloading, w_max, 1.0)  # w < w_max implies w_max > 0
-    envelope = hordijk_parameter_derivatives(w, ft, wc, c1, c2, params)
-    at_max = hordijk_parameter_derivatives(reached, ft, wc, c1, c2, params)
-    ratio = np.where(unloading, w / reached, 0.0)
-    rates = {name: np.where(loading, envelope[name], at_max[name] * ratio) for name in envelope}
-    stress, slope = _softening(reached, ft, wc, c1, c2)
-    d_w_max = np.where(unloading, w * (reached * slope - stress) / reached**2, 0.0)
-    return rates, d_w_max
+    return hordijk_envelope(w, ft, wc, c1, c2)[1]
 
 
 def cohesive_traction(w, w_max, ft, wc, c1, c2):
-    """Traction, consistent tangent and history update of the Hordijk law with secant unloading.
+    """Traction, consistent tangent and history update of the Hordijk law with secant unloading
+    (:func:`~fracid.fem.tsl.secant_unloading` on :func:`hordijk_envelope`).
 
     Loading (w >= w_max, neutral loading included, as in
     :func:`fracid.fem.damage.update_history`): the point follows the envelope,
@@ -246,18 +176,7 @@ def cohesive_traction(w, w_max, ft, wc, c1, c2):
     w_max_new : ndarray
         Updated history max(w_max, w) [mm].
     """
-    w = np.asarray(w, dtype=float)
-    w_max = np.asarray(w_max, dtype=float)
-    w_max_new, loading = update_history(w_max, w)
-    envelope, envelope_slope = _softening(w, ft, wc, c1, c2)
-    # w < w_max implies w_max > 0 for admissible histories; the guard keeps the division finite
-    # at points that are not unloading
-    reached = np.where(loading, 1.0, np.maximum(w_max, np.finfo(float).tiny))
-    secant = hordijk_stress(reached, ft, wc, c1, c2) / reached
-    opened = w >= 0.0
-    sigma = np.where(loading, envelope, np.where(opened, secant * w, 0.0))
-    dsigma = np.where(loading, envelope_slope, np.where(opened, secant, 0.0))
-    return sigma, dsigma, w_max_new
+    return secant_unloading(w, w_max, lambda v: hordijk_envelope(v, ft, wc, c1, c2))
 
 
 def dissipated_energy_density(w_max, ft, wc, c1, c2):
@@ -357,19 +276,7 @@ class CohesiveParameters(ParameterSet):
         return (3.0 * c1**2 * (moment(3) - 0.5 * tail),
                 0.5 * (1.0 + c1**3) * tail - moment(1) - c1**3 * moment(4))
 
-    def argument_rates(self) -> dict:
-        """How the law's arguments (ft, wc, c1, c2) move with each law parameter:
-        {name: (d ln ft / d name, d ln wc / d name, d c1 / d name, d c2 / d name)} for ft, Gf, c1, c2
-        (relative for ft and wc, so that they also hold for arguments scaled by a constant factor)."""
-        area = self.area_factor
-        d_c1, d_c2 = self.area_factor_derivatives()
-        return {
-            "ft": (1.0 / self.ft, -1.0 / self.ft, 0.0, 0.0),
-            "Gf": (0.0, 1.0 / self.Gf, 0.0, 0.0),
-            "c1": (0.0, -d_c1 / area, 1.0, 0.0),
-            "c2": (0.0, -d_c2 / area, 0.0, 1.0),
-        }
-
     def law(self) -> tuple[float, float, float, float]:
-        """(ft, wc, c1, c2), the trailing arguments of the law functions of this module."""
+        """(ft, wc, c1, c2), the trailing arguments of the Hordijk functions of this module (the crack
+        formulations do not use it: they ask their law object, :class:`~fracid.fem.laws.HordijkLaw`)."""
         return self.ft, self.wc, self.c1, self.c2

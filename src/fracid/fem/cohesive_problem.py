@@ -1,10 +1,11 @@
-"""A discrete cohesive crack along a symmetry line: elastic bulk plus Hordijk tractions on the crack.
+"""A discrete cohesive crack along a symmetry line: elastic bulk plus a traction-separation law on the crack.
 
 The crack of a symmetric half model lies on its symmetry line (the ligament of a notched beam, the
 mid-height section of a dog-bone). Its opening is twice the normal displacement of the nodes on
 that line. Before cracking the crack faces are tied
-by a stiff penalty (sigma = k w up to ft, at w0 = ft / k); beyond, the traction follows Hordijk's law
-of the opening in excess of w0 (secant unloading, :func:`~fracid.fem.cohesive.cohesive_traction`);
+by a stiff penalty (sigma = k w up to ft, at w0 = ft / k); beyond, the traction follows the law
+(:class:`~fracid.fem.tsl.TractionSeparationLaw`, Hordijk's by default) of the opening in excess of w0
+(secant unloading, :func:`~fracid.fem.tsl.secant_unloading`);
 closure (w < 0) is resisted by the same penalty. The crack edges' nodal forces and tangents are
 added to the element arrays of the bulk elements that own the edges, so the problem keeps the
 element structure (one sparse pattern) the nonlinear solver expects.
@@ -16,10 +17,11 @@ import numpy as np
 
 from fracid.fem import damage_sensitivity as ds
 from fracid.fem.assembly import assemble_vector
-from fracid.fem.cohesive import cohesive_traction, cohesive_traction_parameter_derivatives
+from fracid.fem.cohesive import hordijk_envelope
 from fracid.fem.elements import gauss_line, line_quadratic
 from fracid.fem.level_sets import superlevel_length
 from fracid.fem.problem import ElasticProblem
+from fracid.fem.tsl import differentiable, secant_unloading, secant_unloading_parameter_derivatives
 
 _GAUSS = 3
 
@@ -58,30 +60,48 @@ def crack_edges(nodes, cells, u_dofs, path_nodes, normal: int):
     return np.array(owners), np.array(slots), np.array(positions), np.array(sides)
 
 
-def crack_traction(w, w_max, ft, wc, c1, c2, penalty):
-    """Traction [MPa], its derivative [MPa/mm] and the new history for openings w [mm].
+def penalty_crack_traction(w, w_max, w0, penalty, envelope):
+    """Traction [MPa], its derivative [MPa/mm] and the new history for openings w [mm] of a crack whose
+    faces are tied by a penalty until they separate at w0 [mm].
 
-    Penalty branch sigma = penalty * w while uncracked (w_max <= w0 = ft / penalty) or closed (w < 0);
-    Hordijk's law of w - w0 after cracking (0 traction between 0 and w0 once cracked).
+    Penalty branch sigma = penalty * w while uncracked (w_max <= w0 and w <= w0) or closed (w < 0);
+    beyond, the law's ``envelope`` of w - w0 with secant unloading
+    (:func:`~fracid.fem.tsl.secant_unloading`; 0 traction between 0 and w0 once cracked).
     """
-    w0 = ft / penalty
     cracked = (w_max > w0) | (w > w0)
-    s, dsdw, s_max = cohesive_traction(np.maximum(w - w0, 0.0), np.maximum(w_max - w0, 0.0), ft, wc, c1, c2)
+    s, dsdw, _ = secant_unloading(np.maximum(w - w0, 0.0), np.maximum(w_max - w0, 0.0), envelope)
     open_side = np.where(w > w0, dsdw, 0.0)
     sigma = np.where(w < 0, penalty * w, np.where(cracked, np.where(w > w0, s, 0.0), penalty * w))
     tangent = np.where(w < 0, penalty, np.where(cracked, open_side, penalty))
     return sigma, tangent, np.maximum(w_max, w)
 
 
-def crack_traction_parameter_derivatives(w, w_max, params, penalty, penalty_rates):
-    """Derivatives of the traction of :func:`crack_traction` at fixed opening w and history w_max.
+def law_crack_traction(law, params, w, w_max, penalty):
+    """:func:`penalty_crack_traction` of a traction-separation law ``law`` with parameters ``params``
+    (w0 = ft / penalty, ft = ``law.strength(params)``)."""
+    return penalty_crack_traction(w, w_max, law.strength(params) / penalty, penalty,
+                                  lambda v: law.traction(v, params))
+
+
+def crack_traction(w, w_max, ft, wc, c1, c2, penalty):
+    """:func:`penalty_crack_traction` of Hordijk's law with arguments (ft, wc, c1, c2), w0 = ft / penalty.
+
+    Kept for callers that pass Hordijk's arguments (tests); the formulation uses its law object
+    (:func:`law_crack_traction`)."""
+    return penalty_crack_traction(w, w_max, ft / penalty, penalty, lambda v: hordijk_envelope(v, ft, wc, c1, c2))
+
+
+def crack_traction_parameter_derivatives(law, w, w_max, params, penalty, penalty_rates):
+    """Derivatives of the traction of :func:`law_crack_traction` at fixed opening w and history w_max.
 
     Parameters
     ----------
+    law : TractionSeparationLaw
+        With ``parameter_derivatives``.
     w, w_max : ndarray
         Openings and largest openings reached before the step [mm].
-    params : CohesiveParameters
-        The law's parameters (ft, wc, c1, c2 from ``params.law()``).
+    params : ParameterSet
+        The law's parameters (and E, nu of the bulk).
     penalty : float
         [MPa/mm].
     penalty_rates : dict {name: float}
@@ -89,25 +109,29 @@ def crack_traction_parameter_derivatives(w, w_max, params, penalty, penalty_rate
 
     Returns
     -------
-    rates : dict {"E", "nu", "ft", "Gf", "c1", "c2": ndarray}
-        d sigma / d name at fixed w and w_max [MPa per unit parameter]. The penalty branch moves with
-        the penalty; the cracked branch, Hordijk's law of w - w0 (w0 = ft / penalty), with the law's
-        parameters and with w0.
+    rates : dict {name: ndarray}
+        d sigma / d name at fixed w and w_max for every parameter of ``params`` [MPa per unit
+        parameter]. The penalty branch moves with the penalty; the cracked branch, the law of w - w0
+        (w0 = ft / penalty), with the law's parameters and with w0 (ft's derivatives are the
+        traction's at w = 0).
     d_sigma_d_w_max : ndarray
         [MPa/mm], nonzero where a cracked point unloads (secant branch).
     """
-    ft, wc, c1, c2 = params.law()
-    w0 = ft / penalty
+    w0 = law.strength(params) / penalty
+    strength_rates = law.parameter_derivatives(np.zeros(1), params)
     cracked = (w_max > w0) | (w > w0)
     penalty_branch = (w < 0) | ~cracked
     open_side = cracked & (w > w0)
     e, m = np.maximum(w - w0, 0.0), np.maximum(w_max - w0, 0.0)
-    law_rates, d_m = cohesive_traction_parameter_derivatives(e, m, ft, wc, c1, c2, params)
-    _, d_e, _ = cohesive_traction(e, m, ft, wc, c1, c2)
+    envelope = lambda v: law.traction(v, params)  # noqa: E731
+    law_rates, d_m = secant_unloading_parameter_derivatives(e, m, envelope,
+                                                            lambda v: law.parameter_derivatives(v, params))
+    _, d_e, _ = secant_unloading(e, m, envelope)
     rates = {}
     for name in params.names():
         d_penalty = penalty_rates.get(name, 0.0)
-        d_w0 = ((1.0 if name == "ft" else 0.0) - w0 * d_penalty) / penalty
+        d_ft = float(strength_rates[name][0]) if name in strength_rates else 0.0
+        d_w0 = (d_ft - w0 * d_penalty) / penalty
         # both e = w - w0 and m = w_max - w0 move by -w0' (m only matters where the point unloads)
         cracked_rate = law_rates.get(name, 0.0) - (d_e + d_m) * d_w0
         rates[name] = np.where(penalty_branch, d_penalty * w, np.where(open_side, cracked_rate, 0.0))
@@ -120,8 +144,10 @@ class CohesiveCrackProblem(ElasticProblem):
     Parameters
     ----------
     disc : MixedDiscretization
-    law : HordijkLaw
-    params : CohesiveParameters
+    law : TractionSeparationLaw
+        E.g. :class:`~fracid.fem.laws.HordijkLaw`.
+    params : ParameterSet
+        E, nu of the bulk and the law's parameters (``law.parameters``).
     conditions : Conditions
         Without a symmetry condition on the crack path's normal dofs.
     edges : tuple
@@ -137,13 +163,15 @@ class CohesiveCrackProblem(ElasticProblem):
         derivative with respect to E moves it too (:meth:`differentiate`); False holds it fixed.
     """
 
-    #: parameters :meth:`differentiate` differentiates with respect to (all of CohesiveParameters)
+    #: parameters :meth:`differentiate` differentiates with respect to with Hordijk's law (all of
+    #: CohesiveParameters); an instance's are all of its ``params`` if its law gives parameter derivatives
     differentiable = ("E", "nu", "ft", "Gf", "c1", "c2")
 
     def __init__(self, disc, law, params, conditions, edges, thickness, penalty, *, stiffness_factor=1.0,
                  penalty_follows_E=True):
         super().__init__(disc, params, conditions, stiffness_factor=stiffness_factor)
         self.law, self.penalty = law, float(penalty)
+        self.differentiable = tuple(params.names()) if differentiable(law) else ()
         self.penalty_rates = {"E": self.penalty / params.E} if penalty_follows_E else {}
         self.owners, self.slots, positions, self.sides = edges
         s, weights = gauss_line(_GAUSS)
@@ -162,10 +190,10 @@ class CohesiveCrackProblem(ElasticProblem):
         return 2.0 * u_n @ self.N.T  # (n_edges, n_g)
 
     def onset_ratio(self, w_max):
-        return float(w_max.max()) * self.penalty / self.params.ft
+        return float(w_max.max()) * self.penalty / self.law.strength(self.params)
 
     def _traction(self, w, w_max_old):
-        return crack_traction(w, w_max_old, *self.params.law(), self.penalty)
+        return law_crack_traction(self.law, self.params, w, w_max_old, self.penalty)
 
     def evaluate(self, q, w_max_old):
         residual, arrays, references = super().evaluate(q, None)
@@ -187,7 +215,7 @@ class CohesiveCrackProblem(ElasticProblem):
         """Length of the crack path where the faces have separated (opening beyond w0) [mm]."""
         order = np.argsort(self.y.ravel())
         y, w = self.y.ravel()[order], w_max.ravel()[order]
-        return superlevel_length(y, w, self.params.ft / self.penalty, y[0], y[-1])
+        return superlevel_length(y, w, self.law.strength(self.params) / self.penalty, y[0], y[-1])
 
     def fields(self, q, w_max, omega):
         out = super().fields(q, np.zeros(self.disc.weights.shape), omega)
@@ -228,9 +256,9 @@ class CohesiveCrackProblem(ElasticProblem):
 
         Non-differentiable points, where the one-sided derivative of the branch the point is on is
         used: the crack tip, where a point's opening crosses w0 (the traction's parameter derivatives
-        jump from the penalty branch to Hordijk's law, e.g. d sigma / d ft from 0 to
-        1 - sigma_H'(0) / penalty); the opening w - w0 = wc where the law's traction reaches zero (the
-        derivative with respect to wc jumps to 0); and w = w_max (loading or unloading). A point
+        jump from the penalty branch to the law, e.g. d sigma / d ft from 0 to
+        1 - sigma'(0) / penalty); the opening w - w0 = wc where the law's traction reaches zero (the
+        derivative with respect to wc jumps to 0), a kink of the law (the bilinear law's w1); and w = w_max (loading or unloading). A point
         exactly on such a kink at a recorded step is rare; across steps the derivative stays
         one-sided per step (the path's derivative is then that of the branches the points are on).
         """
@@ -242,7 +270,7 @@ class CohesiveCrackProblem(ElasticProblem):
         bulk = ds.equilibrium_pseudo_load(self.disc, self.params, self.const, ue, no_damage, no_damage_rate, names)
         w = self.openings(q)
         sigma, tangent, _ = self._traction(w, w_max_old)
-        rates, d_w_max = crack_traction_parameter_derivatives(w, w_max_old, self.params, self.penalty,
+        rates, d_w_max = crack_traction_parameter_derivatives(self.law, w, w_max_old, self.params, self.penalty,
                                                               self.penalty_rates)
         loading = w >= w_max_old
         explicit = ds.stacked(rates, names, w.shape) + d_w_max[..., None] * w_max_old_rate

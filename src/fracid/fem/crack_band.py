@@ -1,4 +1,5 @@
-"""Smeared crack band with Hordijk softening: a rotating crack in plane stress (docs/theory.md, section 5.3).
+"""Smeared crack band with a traction-separation law (Hordijk's by default): a rotating crack in plane
+stress (docs/theory.md, section 5.3).
 
 **Choice: rotating crack.** The crack normal follows the major principal direction of the
 (effective) stress, which is that of the strain for an isotropic bulk: the crack is coaxial. A fixed
@@ -17,21 +18,22 @@ strain e_c n (x) n (n the major direction) takes the stress normal to the crack 
 so a crack transmits no Poisson stress across the band and a closed crack (lambda_1 <= 0) carries
 compression. The history kappa is the largest lambda_1 reached (Rankine, in strain units). In
 uniaxial tension the crack strain is e_c = (1 - nu^2) omega kappa, and omega(kappa) is set so that
-the stress follows Hordijk's law of the crack opening w = h e_c, h the crack band width:
+the stress follows the traction-separation law sigma_L (:class:`~fracid.fem.tsl.TractionSeparationLaw`,
+e.g. Hordijk's) of the crack opening w = h e_c, h the crack band width:
 
-    E (kappa - w / h') = sigma_H(w),   h' = (1 - nu^2) h,
+    E (kappa - w / h') = sigma_L(w),   h' = (1 - nu^2) h,
 
 the stress of the band equal to the cohesive traction of its crack. The energy dissipated per unit
 band volume is then Gf / h, per unit crack area Gf, whatever the element size. The equation has one
-root in w when the band is narrower than the snap-back limit h' < E / max|d sigma_H / dw|
-(:func:`snap_back_limit`); wider elements are refused.
+root in w when the band is narrower than the snap-back limit h' < E / max|d sigma_L / dw|
+(:func:`snap_back_limit`); wider elements are refused. The law enters through a
+:class:`~fracid.fem.tsl.ScaledLaw` (the law at the parameters, with the elements' strength factors).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from fracid.fem.cohesive import _normalised_law, hordijk_parameter_derivatives, hordijk_stress, hordijk_tangent
 from fracid.fem.damage import update_history
 
 
@@ -101,19 +103,18 @@ def crack_direction_stress_nu_derivative(s):
     return np.where((lam > 0.0)[..., None], lam[..., None] * np.array([1.0, 1.0, 0.0]) - F1, 0.0)
 
 
-def snap_back_limit(E, ft, wc, c1, c2, samples: int = 2001) -> float:
+def snap_back_limit(E, law, params) -> float:
     """Widest crack band [mm] for which the band's stress-strain law has no snap-back:
-    h_max = E / max_w |d sigma_H / dw| (the softening slope of the band, -1 / (1/E - h / |sigma_H'|),
-    must stay negative)."""
-    x = np.linspace(0.0, 1.0, samples)
-    steepest = np.max(np.abs(_normalised_law(x, c1, c2)[1])) * ft / wc
-    return float(E / steepest)
+    h_max = E / max_w |d sigma / dw| (the softening slope of the band, -1 / (1/E - h / |sigma'|),
+    must stay negative), with E [MPa] and the steepest slope of ``law`` at ``params``
+    (``law.steepest_slope(params)`` [MPa/mm])."""
+    return float(E / law.steepest_slope(params))
 
 
-def band_damage(kappa, band_width, E, ft, wc, c1, c2, tol=1e-13, max_iterations=60):
+def band_damage(kappa, band_width, E, law, tol=1e-13, max_iterations=60):
     """Damage omega(kappa) of the crack band and d omega / d kappa.
 
-    Solves E (kappa - w / h) = sigma_H(w) for the opening w in [0, h kappa] by Newton steps kept in
+    Solves E (kappa - w / h) = sigma(w) for the opening w in [0, h kappa] by Newton steps kept in
     a shrinking bracket (bisection when a step leaves it), all points at once; omega = w / (h kappa).
 
     Parameters
@@ -122,50 +123,50 @@ def band_damage(kappa, band_width, E, ft, wc, c1, c2, tol=1e-13, max_iterations=
         Largest major principal effective stress / E reached [-].
     band_width : ndarray
         Crack band width h at each point [mm], below :func:`snap_back_limit`.
-    E, ft : float or ndarray
-        Young's modulus [MPa] and tensile strength [MPa] at each point.
-    wc, c1, c2 : float
-        Hordijk's critical opening [mm] and shape constants [-].
+    E : float or ndarray
+        Young's modulus [MPa] at each point.
+    law : ScaledLaw
+        The traction-separation law at its parameters, point by point (:class:`~fracid.fem.tsl.ScaledLaw`):
+        ``traction(w)``, ``strength()`` [MPa] and ``opening_scale()`` [mm] (the tolerance's unit).
 
     Returns
     -------
     omega, d_omega : ndarray
         Damage [-] (0 below kappa_0 = ft / E) and its derivative.
     """
-    kappa, h, E, ft = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (kappa, band_width, E, ft)))
+    kappa, h, E, ft, scale = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (
+        kappa, band_width, E, law.strength(), law.opening_scale())))
     cracked = kappa > ft / E
     k = np.where(cracked, kappa, ft / E)
     lo, hi = np.zeros_like(k), h * k
     w = np.zeros_like(k)
     for _ in range(max_iterations):
-        g = E * (k - w / h) - hordijk_stress(w, ft, wc, c1, c2)
-        slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)  # < 0 below the snap-back limit
+        sigma, tangent = law.traction(w)
+        g = E * (k - w / h) - sigma
+        slope = -E / h - tangent  # < 0 below the snap-back limit
         lo, hi = np.where(g > 0.0, w, lo), np.where(g > 0.0, hi, w)
         step = np.where(cracked, -g / slope, 0.0)
         trial = w + step
         w = np.where((trial >= lo) & (trial <= hi), trial, 0.5 * (lo + hi))
-        if np.all(np.abs(step) <= tol * wc):
+        if np.all(np.abs(step) <= tol * scale):
             break
-    slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)
+    slope = -E / h - law.traction(w)[1]
     dw = -E / slope
     omega = np.where(cracked, w / (h * k), 0.0)
     d_omega = np.where(cracked, dw / (h * k) - w / (h * k * k), 0.0)
     return omega, d_omega
 
 
-def band_damage_parameter_derivatives(kappa, band_width, E, ft, wc, c1, c2, params):
+def band_damage_parameter_derivatives(kappa, band_width, E, law):
     """Derivatives of the damage of :func:`band_damage` at fixed kappa, for the direct differentiation.
 
-    From the band's equation g = E (kappa - w / h) - sigma_H(w) = 0 at fixed kappa:
-    dw = -(dg/dx) / (dg/dw) with dg/dw = -E / h - sigma_H'(w), and omega = w / (h kappa).
+    From the band's equation g = E (kappa - w / h) - sigma(w) = 0 at fixed kappa:
+    dw = -(dg/dx) / (dg/dw) with dg/dw = -E / h - sigma'(w), and omega = w / (h kappa).
 
     Parameters
     ----------
-    kappa, band_width, E, ft, wc, c1, c2
-        As in :func:`band_damage` (``ft`` and ``wc`` may be scaled from those of ``params`` by a
-        strength factor, see :func:`~fracid.fem.cohesive.hordijk_parameter_derivatives`).
-    params : CohesiveParameters
-        Whose ft, Gf, c1, c2 the law's arguments derive from.
+    kappa, band_width, E, law
+        As in :func:`band_damage` (``law.parameter_derivatives(w)`` gives d sigma / d x at fixed w).
 
     Returns
     -------
@@ -173,23 +174,22 @@ def band_damage_parameter_derivatives(kappa, band_width, E, ft, wc, c1, c2, para
         d omega / d E [1/MPa] and d omega / d h [1/mm] with respect to the arguments E and h (the
         caller chains them to the parameters: E = params.E times a stiffness factor, h the width
         times 1 - nu^2).
-    law : dict {"ft", "Gf", "c1", "c2": ndarray}
-        d omega / d name [per unit parameter].
+    law : dict {name: ndarray}
+        d omega / d name [per unit parameter] for the law's parameters.
     All zero where the band has not cracked (kappa <= ft / E). At the onset kappa = ft / E, where
     omega leaves zero with a kink, the uncracked side's (zero) derivative is returned.
     """
-    omega, _ = band_damage(kappa, band_width, E, ft, wc, c1, c2)
-    kappa, h, E, ft = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (kappa, band_width, E, ft)))
+    omega, _ = band_damage(kappa, band_width, E, law)
+    kappa, h, E, ft = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (kappa, band_width, E, law.strength())))
     cracked = kappa > ft / E
     k = np.where(cracked, kappa, 1.0)
     w = omega * h * k
-    slope = -E / h - hordijk_tangent(w, ft, wc, c1, c2)  # dg / dw < 0
+    slope = -E / h - law.traction(w)[1]  # dg / dw < 0
     per_opening = np.where(cracked, 1.0 / (h * k), 0.0)  # d omega / d w at fixed h, kappa
     arguments = {"E": per_opening * (-(k - w / h) / slope),
                  "band_width": per_opening * (-E * w / (h * h * slope)) - np.where(cracked, w / (h * h * k), 0.0)}
-    law = {name: per_opening * rate / slope
-           for name, rate in hordijk_parameter_derivatives(w, ft, wc, c1, c2, params).items()}
-    return arguments, law
+    rates = {name: per_opening * rate / slope for name, rate in law.parameter_derivatives(w).items()}
+    return arguments, rates
 
 
 def element_mean(values, weights):
@@ -198,7 +198,7 @@ def element_mean(values, weights):
     return np.broadcast_to((np.sum(values * weights, axis=1) / np.sum(weights, axis=1))[:, None], weights.shape)
 
 
-def crack_band_stress(s, kappa_old, weights, band_width, E, nu, ft, law, crackable=1.0):
+def crack_band_stress(s, kappa_old, weights, band_width, E, nu, law, crackable=1.0):
     """Stress, material tangent and history of the rotating crack band at all points.
 
     Each element cracks as one band: its history kappa is the largest weighted mean over its points
@@ -217,12 +217,13 @@ def crack_band_stress(s, kappa_old, weights, band_width, E, nu, ft, law, crackab
         Integration weights [mm^3].
     band_width : ndarray, shape (n_el, 1) or (n_el, n_q)
         [mm].
-    E, ft : ndarray, shape (n_el, n_q)
-        Young's modulus [MPa] and tensile strength [MPa] (element means are used).
+    E : ndarray, shape (n_el, n_q)
+        Young's modulus [MPa] (element means are used).
     nu : float
         Poisson's ratio [-].
-    law : tuple
-        (wc, c1, c2) of Hordijk's law; wc [mm] may vary over the elements.
+    law : ScaledLaw
+        The traction-separation law at its parameters, its factors equal at the points of an element
+        (:func:`element_mean`).
     crackable : float or ndarray, shape (n_el, n_q)
         1 where a crack may form, 0 where the material stays elastic.
 
@@ -241,9 +242,8 @@ def crack_band_stress(s, kappa_old, weights, band_width, E, nu, ft, law, crackab
     share = weights / np.sum(weights, axis=1, keepdims=True)
     kappa, loading = update_history(kappa_old, element_mean(lam, weights))
     h = (1.0 - nu * nu) * np.broadcast_to(band_width, weights.shape)
-    wc, c1, c2 = law
     mean = lambda v: element_mean(v, weights)  # noqa: E731
-    omega, d_omega = (mean(crackable) * v for v in band_damage(kappa, h, mean(E), mean(ft), mean(wc), c1, c2))
+    omega, d_omega = (mean(crackable) * v for v in band_damage(kappa, h, mean(E), law))
     sigma = E[..., None] * (s - omega[..., None] * F)
     dsigma = E[..., None, None] * (np.eye(3) - omega[..., None, None] * dF)
     coupling = (E[..., None] * F, (d_omega * loading * share)[..., None] * dlam)

@@ -1,4 +1,5 @@
-"""A plane-stress problem whose material is the rotating crack band of :mod:`fracid.fem.crack_band`."""
+"""A plane-stress problem whose material is the rotating crack band of :mod:`fracid.fem.crack_band`, with
+any traction-separation law (:class:`~fracid.fem.tsl.TractionSeparationLaw`)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from fracid.fem.crack_band import (band_damage, band_damage_parameter_derivative
 from fracid.fem.damage import update_history
 from fracid.fem.forms import ElementArrays, _btdb
 from fracid.fem.problem import ContinuumProblem
+from fracid.fem.tsl import ScaledLaw, differentiable
 
 
 def element_extent(nodes, cells, direction) -> np.ndarray:
@@ -22,7 +24,7 @@ def element_extent(nodes, cells, direction) -> np.ndarray:
 
 
 class CrackBandProblem(ContinuumProblem):
-    """Smeared crack band (rotating crack, Hordijk softening) on a plane-stress discretisation.
+    """Smeared crack band (rotating crack, a traction-separation law) on a plane-stress discretisation.
 
     Displacement unknowns only (:class:`~fracid.fem.problem.ContinuumProblem`); the material is the
     crack band's.
@@ -31,15 +33,18 @@ class CrackBandProblem(ContinuumProblem):
     ----------
     disc : MixedDiscretization
         Plane stress.
-    law : HordijkLaw
-    params : CohesiveParameters
-        E, nu of the bulk and ft, Gf, c1, c2 of the crack law.
+    law : TractionSeparationLaw
+        E.g. :class:`~fracid.fem.laws.HordijkLaw`; with ``steepest_slope`` (the snap-back limit).
+    params : ParameterSet
+        E, nu of the bulk and the law's parameters (``law.parameters``).
     band_width : array_like, shape (n_el,)
         Crack band width h of each element [mm] (the element's extent across the expected crack;
         twice that for an element on a symmetry line the crack runs along, whose band is mirrored).
     strength_factor : float or ndarray, shape (n_el, n_q)
-        Tensile strength relative to ``params.ft`` at equal fracture energy (wc divided by the same
-        factor): an imperfection that fixes where the band forms without changing Gf [-].
+        Tensile strength relative to the law's at equal fracture energy (openings divided by the same
+        factor: a sigma(a w)): an imperfection that fixes where the band forms without changing Gf [-].
+        Each element takes the mean factor of its points for the strength and the mean of its
+        inverse for the openings.
     crackable : float or ndarray, shape (n_el, n_q)
         1 where a crack may form, 0 where the material stays elastic [-].
     conditions : Conditions
@@ -47,7 +52,8 @@ class CrackBandProblem(ContinuumProblem):
         Young's modulus relative to ``params.E`` at the integration points [-].
     """
 
-    #: parameters :meth:`differentiate` differentiates with respect to (all of CohesiveParameters)
+    #: parameters :meth:`differentiate` differentiates with respect to with Hordijk's law (all of
+    #: CohesiveParameters); an instance's are all of its ``params`` if its law gives parameter derivatives
     differentiable = ("E", "nu", "ft", "Gf", "c1", "c2")
 
     def __init__(self, disc, law, params, conditions, band_width, *, strength_factor=1.0, crackable=1.0,
@@ -56,19 +62,26 @@ class CrackBandProblem(ContinuumProblem):
             raise ValueError("the crack band model is written for plane stress (3 strain components)")
         super().__init__(disc, params, conditions, stiffness_factor=stiffness_factor)
         self.law = law
+        self.differentiable = tuple(params.names()) if differentiable(law) else ()
         h = np.asarray(band_width, dtype=float)
         if h.shape != (disc.n_elements,) or not np.all(h > 0):
             raise ValueError(f"band_width must be {disc.n_elements} positive element widths [mm]")
         self.band_width = h[:, None]
         self.strength = np.broadcast_to(np.asarray(strength_factor, dtype=float), disc.weights.shape)
-        self.ft = params.ft * self.strength
+        self.ft = law.strength(params) * self.strength
         self.crackable = np.broadcast_to(np.asarray(crackable, dtype=float), disc.weights.shape)
-        limit = snap_back_limit(self.const.E.min(), self.ft.max(), *params.law()[1:])
-        widest = float(h[np.any(self.crackable > 0, axis=1)].max(initial=0.0))
+        # the law at the points: strength mean(a) ft, openings divided by 1 / mean(1 / a) (equal Gf for uniform a)
+        stress = element_mean(self.strength, disc.weights)
+        opening = 1.0 / element_mean(1.0 / self.strength, disc.weights)
+        self.local_law = ScaledLaw(law, params, stress, opening)
+        crackable_elements = np.any(self.crackable > 0, axis=1)
+        steepest = float(np.max(stress * opening, axis=1)[crackable_elements].max(initial=1.0))
+        limit = snap_back_limit(self.const.E.min(), law, params) / steepest
+        widest = float(h[crackable_elements].max(initial=0.0))
         if widest >= limit:
             raise ValueError(
-                f"crack band width {widest:g} mm exceeds the snap-back limit {limit:g} mm of E = {params.E:g} MPa, "
-                f"ft = {params.ft:g} MPa, Gf = {params.Gf:g} N/mm: refine the mesh where the crack runs"
+                f"crack band width {widest:g} mm exceeds the snap-back limit {limit:g} mm of E = {params.E:g} MPa "
+                f"with the {law.name} law at {params}: refine the mesh where the crack runs"
             )
 
     def onset_ratio(self, kappa: np.ndarray) -> float:
@@ -77,13 +90,8 @@ class CrackBandProblem(ContinuumProblem):
 
     def _stress(self, ue, kappa_old):
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
-        return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu, self.ft,
-                                 self._law(), self.crackable)
-
-    def _law(self):
-        """(wc, c1, c2) of Hordijk's law at the points: wc divided by the strength factor (equal Gf)."""
-        _, wc, c1, c2 = self.params.law()
-        return wc / self.strength, c1, c2
+        return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu,
+                                 self.local_law, self.crackable)
 
     def evaluate(self, q, kappa_old):
         ue = self.gather(q)
@@ -113,7 +121,7 @@ class CrackBandProblem(ContinuumProblem):
         :class:`~fracid.fem.damage_sensitivity.StepDerivative`).
 
         sigma = E (s - omega F(s, nu)) with s = D(nu) eps, omega = omega(kappa; E, h = (1 - nu^2) h_el,
-        ft, Gf, c1, c2) of the element's history kappa = max(kappa_old, mean lambda_1(s)). At fixed
+        the law's parameters) of the element's history kappa = max(kappa_old, mean lambda_1(s)). At fixed
         displacements, s moves with nu only; omega with the parameters at fixed kappa
         (:func:`~fracid.fem.crack_band.band_damage_parameter_derivatives`) and with kappa's explicit
         part: at loading elements the parameter derivative of mean lambda_1 at fixed eps (through
@@ -121,8 +129,8 @@ class CrackBandProblem(ContinuumProblem):
 
         Non-differentiable points, where the one-sided derivative of the branch the element is on
         is used: the onset of cracking of an element, kappa = ft / E (omega leaves 0 with a kink; its
-        parameter derivatives jump from 0), the opening at which Hordijk's traction reaches zero
-        (w = wc), loading versus unloading at kappa = mean lambda_1, and the closure of a crack
+        parameter derivatives jump from 0), the opening at which the law's traction reaches zero
+        (w = wc) and the law's own kinks (the bilinear law's w1), loading versus unloading at kappa = mean lambda_1, and the closure of a crack
         (lambda_1 = 0, where F switches off) or equal principal values (the crack direction is
         undefined). With the element's crack band advancing one element at a time, a recorded step
         exactly on such a point is rare.
@@ -145,14 +153,13 @@ class CrackBandProblem(ContinuumProblem):
 
         # omega and its parameter derivatives at fixed kappa, with the arguments crack_band_stress uses
         mean = lambda v: element_mean(v, weights)  # noqa: E731
-        wc, c1, c2 = self._law()
         width = np.broadcast_to(self.band_width, weights.shape)
         h, crackable = (1.0 - nu * nu) * width, mean(self.crackable)
-        arguments = (kappa, h, mean(const.E), mean(self.ft), mean(wc), c1, c2)
+        arguments = (kappa, h, mean(const.E), self.local_law)
         omega, d_omega = (crackable * v for v in band_damage(*arguments))
-        by_argument, law = band_damage_parameter_derivatives(*arguments, params)
-        law.update(E=by_argument["E"] * mean(const.E) / params.E, nu=by_argument["band_width"] * (-2.0 * nu * width))
-        law_rate = crackable[..., None] * ds.stacked(law, names, weights.shape)
+        by_argument, rates = band_damage_parameter_derivatives(*arguments)
+        rates.update(E=by_argument["E"] * mean(const.E) / params.E, nu=by_argument["band_width"] * (-2.0 * nu * width))
+        law_rate = crackable[..., None] * ds.stacked(rates, names, weights.shape)
 
         # s' at fixed displacements (nu only) and the explicit part of the driving mean lambda_1
         s_rate = np.zeros(s.shape + (p,))

@@ -1,11 +1,14 @@
 """Material laws as small objects: values and derivatives at all integration points at once.
 
 A formulation (gradient, local or integral damage; the crack band; the cohesive interface) takes a
-law and asks it for values and derivatives; it never names the law's parameters. A new law is a new
+law and asks it for values and derivatives; it never names the law's parameters. Damage laws:
+:class:`DamageLaw`; traction-separation laws (the contract: :class:`fracid.fem.tsl.TractionSeparationLaw`):
+:class:`HordijkLaw`, :class:`LinearSoftening`, :class:`BilinearSoftening`, by name in
+:data:`TRACTION_SEPARATION_LAWS`. A new law is a new
 object with the same methods (see :class:`DamageLaw`), nothing else changes. The parameter
 derivatives of the laws (for sensitivities computed inside the analysis) belong here too.
 
-Units: strains [-], stresses [MPa], openings [mm].
+Units: strains [-], stresses [MPa], openings [mm], fracture energies [N/mm].
 """
 
 from __future__ import annotations
@@ -15,11 +18,14 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
+from fracid.fem.cohesive import CohesiveParameters, hordijk_shape, hordijk_shape_derivatives
 from fracid.fem.damage import exponential_damage, exponential_damage_parameter_derivatives, kappa_at_damage
 from fracid.fem.equivalent_strain import (modified_von_mises_plane_stress,
                                           modified_von_mises_plane_stress_parameter_derivatives,
                                           modified_von_mises_uniaxial, modified_von_mises_uniaxial_parameter_derivatives)
 from fracid.fem.parameters import DamageParameters
+from fracid.fem.ranges import ELASTIC, Field, ParameterRange, compose
+from fracid.fem.tsl import STRENGTH_AND_ENERGY, ShapeLaw
 
 
 class SofteningLaw(Protocol):
@@ -133,22 +139,119 @@ class DamageLaw:
         return np.array([-float(partial[name][0]) / float(d_kappa[0]) if name in partial else 0.0 for name in names])
 
 
+# ------------------------------------------------------------------------------------------------
+# traction-separation laws (the contract: fracid.fem.tsl.TractionSeparationLaw)
+
+
 @dataclass(frozen=True)
-class HordijkLaw:
+class HordijkLaw(ShapeLaw):
     """Hordijk's traction-opening law, for the cohesive crack and the crack band (parameters of
-    :class:`~fracid.fem.cohesive.CohesiveParameters`: ft, Gf, c1, c2 and the elastic E, nu)."""
+    :class:`~fracid.fem.cohesive.CohesiveParameters`: ft, Gf, c1, c2 and the elastic E, nu); the
+    shape is :func:`~fracid.fem.cohesive.hordijk_shape`, wc = Gf / (ft I(c1, c2))."""
 
     name: ClassVar[str] = "hordijk"
+    parameters: ClassVar[type] = CohesiveParameters
 
-    @property
-    def parameters(self) -> type:
-        from fracid.fem.cohesive import CohesiveParameters
+    def shape(self, x, params):
+        return hordijk_shape(x, params.c1, params.c2)
 
-        return CohesiveParameters
+    def shape_derivatives(self, x, params) -> dict:
+        return hordijk_shape_derivatives(x, params.c1, params.c2)
 
-    def scales(self, params) -> dict:
-        """``strain`` = ft / E [-] and ``opening`` = wc, the opening of zero traction [mm]."""
-        return {"strain": params.ft / params.E, "opening": params.wc}
+    def area(self, params) -> float:
+        return params.area_factor
+
+    def area_derivatives(self, params) -> dict:
+        return dict(zip(("c1", "c2"), params.area_factor_derivatives()))
+
+    def steepest_shape_slope(self, params, samples: int = 2001) -> float:
+        """max |f'| over 2001 points of [0, 1] (the law is smooth there)."""
+        return float(np.max(np.abs(hordijk_shape(np.linspace(0.0, 1.0, samples), params.c1, params.c2)[1])))
+
+
+LinearSofteningParameters = compose(
+    "LinearSofteningParameters", ELASTIC, STRENGTH_AND_ENERGY,
+    summary="Parameters x = (E, nu, ft, Gf) of a bulk with linear-softening cohesive cracks, sigma = ft (1 - w / wc), "
+            "wc = 2 Gf / ft.")
+
+
+@dataclass(frozen=True)
+class LinearSoftening(ShapeLaw):
+    """Linear softening, sigma = ft (1 - w / wc) for 0 <= w < wc, wc = 2 Gf / ft [mm] (area Gf);
+    parameters :data:`LinearSofteningParameters` (E, nu, ft, Gf)."""
+
+    name: ClassVar[str] = "linear"
+    parameters: ClassVar[type] = LinearSofteningParameters
+
+    def shape(self, x, params):
+        x = np.asarray(x, dtype=float)
+        return 1.0 - x, np.full(x.shape, -1.0)
+
+    def shape_derivatives(self, x, params) -> dict:
+        return {}
+
+    def area(self, params) -> float:
+        return 0.5
+
+    def area_derivatives(self, params) -> dict:
+        return {}
+
+    def steepest_shape_slope(self, params) -> float:
+        return 1.0
+
+
+BILINEAR_SHAPE = (
+    Field("psi", 1.0 / 3.0, ParameterRange(0.0, False, 1.0, False, "-"), "Traction at the kink relative to ft"),
+    Field("chi", 2.0 / 9.0, ParameterRange(0.0, False, 1.0, False, "-"), "Opening at the kink relative to wc"),
+)
+
+BilinearSofteningParameters = compose(
+    "BilinearSofteningParameters", ELASTIC, STRENGTH_AND_ENERGY, BILINEAR_SHAPE,
+    summary="Parameters x = (E, nu, ft, Gf, psi, chi) of a bulk with bilinear-softening cohesive cracks: a kink at "
+            "(w1, sigma1) = (chi wc, psi ft), wc = 2 Gf / (ft (psi + chi)) (defaults: Petersson's "
+            "law, sigma1 = ft / 3 at w1 = 0.8 Gf / ft, wc = 3.6 Gf / ft).")
+
+
+@dataclass(frozen=True)
+class BilinearSoftening(ShapeLaw):
+    """Bilinear softening: from (0, ft) to the kink (w1, sigma1) = (chi wc, psi ft), then to (wc, 0).
+
+    The area is ft (w1 + psi wc) / 2 = ft wc (chi + psi) / 2 = Gf, so wc = 2 Gf / (ft (psi + chi))
+    [mm]. Parameters :data:`BilinearSofteningParameters` (E, nu, ft [MPa], Gf [N/mm], psi [-],
+    chi [-]); the defaults are Petersson's law (psi = 1/3, chi = 2/9: w1 = 0.8 Gf / ft, wc = 3.6 Gf /
+    ft). The law has kinks at w1 and wc. Every psi, chi in (0, 1) gives a decreasing law (the
+    ranges are a box); concrete's usual laws have psi + chi < 1, a first branch steeper than the second.
+    """
+
+    name: ClassVar[str] = "bilinear"
+    parameters: ClassVar[type] = BilinearSofteningParameters
+
+    def shape(self, x, params):
+        x = np.asarray(x, dtype=float)
+        psi, chi = params.psi, params.chi
+        first = x < chi
+        f = np.where(first, 1.0 - (1.0 - psi) * x / chi, psi * (1.0 - x) / (1.0 - chi))
+        return f, np.where(first, -(1.0 - psi) / chi, -psi / (1.0 - chi))
+
+    def shape_derivatives(self, x, params) -> dict:
+        x = np.asarray(x, dtype=float)
+        psi, chi = params.psi, params.chi
+        first = x < chi
+        return {"psi": np.where(first, x / chi, (1.0 - x) / (1.0 - chi)),
+                "chi": np.where(first, (1.0 - psi) * x / chi**2, psi * (1.0 - x) / (1.0 - chi) ** 2)}
+
+    def area(self, params) -> float:
+        return 0.5 * (params.psi + params.chi)
+
+    def area_derivatives(self, params) -> dict:
+        return {"psi": 0.5, "chi": 0.5}
+
+    def steepest_shape_slope(self, params) -> float:
+        return max((1.0 - params.psi) / params.chi, params.psi / (1.0 - params.chi))
+
+
+#: The traction-separation laws by name (a configuration's or a user's choice of law for the crack models)
+TRACTION_SEPARATION_LAWS = {law.name: law for law in (HordijkLaw, LinearSoftening, BilinearSoftening)}
 
 
 def as_array(value, shape) -> np.ndarray:

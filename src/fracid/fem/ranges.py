@@ -4,15 +4,31 @@ A model's parameter class is a frozen dataclass that derives from :class:`Parame
 its fields' valid ranges in the class attribute ``ranges`` (name -> :class:`ParameterRange`, in the
 order of the fields); it then has ``names``, ``units``, ``valid_bounds``, ``replace``, ``as_array``
 and ``from_array``, the interface the inverse code relies on (:mod:`fracid.models`).
+
+A parameter class can also be composed from parts (:func:`compose`): the elastic part
+:data:`ELASTIC` (E, nu), a law's own part (e.g. ft, Gf and its shape constants), a regularisation
+part (e.g. c), so that a new law defines only its own fields.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from typing import ClassVar, NamedTuple
+import sys
+import textwrap
+from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
+
+from fracid.field_error import FieldError
+
+
+class ParameterError(FieldError):
+    """An invalid parameter value: ``name``, ``value`` and ``range`` (its :class:`ParameterRange`)."""
+
+    def __init__(self, name: str, value, rng, message: str):
+        super().__init__(name, value, message)
+        self.range = rng
 
 
 class ParameterRange(NamedTuple):
@@ -45,9 +61,11 @@ class ParameterRange(NamedTuple):
         try:
             v = float(value)
         except (TypeError, ValueError):
-            raise ValueError(f"parameter {name!r} = {value!r} is not a number; valid range: {self.describe(name)}") from None
+            raise ParameterError(name, value, self, f"parameter {name!r} = {value!r} is not a number; valid range: "
+                                 f"{self.describe(name)}") from None
         if not self.admits(v):
-            raise ValueError(f"parameter {name!r} = {value!r} is out of range; valid range: {self.describe(name)}")
+            raise ParameterError(name, value, self, f"parameter {name!r} = {value!r} is out of range; valid range: "
+                                 f"{self.describe(name)}")
         return v
 
 
@@ -99,3 +117,94 @@ class ParameterSet:
         if x.shape != (len(names),):
             raise ValueError(f"expected a vector of {len(names)} parameters {list(names)}, got shape {x.shape}")
         return cls(**dict(zip(names, x)))
+
+
+class Field(NamedTuple):
+    """One parameter of a composed parameter class: its name, default value, valid range (with the
+    unit) and meaning in a few words (for the docstring, e.g. ``"Young's modulus"``)."""
+
+    name: str
+    default: float
+    range: ParameterRange
+    meaning: str
+
+
+#: The elastic part of every model's parameters: Young's modulus E [MPa] and Poisson's ratio nu [-]
+ELASTIC = (Field("E", 30000.0, ParameterRange(0.0, False, None, False, "MPa"), "Young's modulus of the bulk"),
+           Field("nu", 0.2, ParameterRange(-1.0, False, 0.5, False, "-"), "Poisson's ratio of the bulk"))
+
+
+def _docstring(summary: str, fields) -> str:
+    """A numpydoc docstring listing ``fields`` with their meaning, unit and valid range."""
+    lines = [textwrap.fill(summary, 100), "", "Parameters", "----------"]
+    for f in fields:
+        limits = f.range.describe(f.name)
+        lines += [f"{f.name} : float",
+                  f"    {f.meaning} [{f.range.unit}]" + ("" if limits == f.name else f", {limits}") + "."]
+    return "\n".join(lines) + "\n"
+
+
+def _checked_fields(parts, defaults) -> list:
+    fields = [f for part in parts for f in part]
+    if not all(isinstance(f, Field) for f in fields):
+        raise TypeError("compose: every part must be a sequence of Field(name, default, range, meaning)")
+    names = [f.name for f in fields]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"compose: parameter(s) {twice} defined by more than one part")
+    unknown = sorted(set(defaults).difference(names))
+    if unknown:
+        raise ValueError(f"compose: defaults for unknown parameter(s) {unknown}; the parameters are {names}")
+    return [f._replace(default=float(defaults.get(f.name, f.default))) for f in fields]
+
+
+def compose(class_name: str, *parts, summary: str = "", defaults: dict | None = None,
+            check: Callable | None = None, namespace: dict | None = None, module: str | None = None) -> type:
+    """A frozen :class:`ParameterSet` dataclass whose fields are those of ``parts``, in order.
+
+    Parameters
+    ----------
+    class_name : str
+        Name of the class; assign the result to this name at module level (pickling and the run
+        store find the class by its module and name).
+    *parts : sequence of Field
+        E.g. ``ELASTIC``, the law's part, a regularisation part; a name may appear in one part only.
+    summary : str
+        First line of the docstring (the fields' list is appended, numpydoc, with units and ranges).
+    defaults : dict, optional
+        Default values replacing those of the parts, e.g. ``{"E": 20000.0}``.
+    check : callable, optional
+        ``check(params)`` run after the range checks, raising ValueError for values that are valid
+        one by one but not together (name the parameters and the values in the message).
+    namespace : dict, optional
+        Further class members (properties, methods).
+    module : str, optional
+        The module the class belongs to (default: the caller's).
+
+    Returns
+    -------
+    type
+        The parameter class, with ``ranges`` in the order of the fields.
+
+    Examples
+    --------
+    >>> from fracid.fem.ranges import ELASTIC, Field, ParameterRange, compose
+    >>> STRENGTH = (Field("ft", 3.0, ParameterRange(0.0, False, None, False, "MPa"), "Tensile strength"),)
+    >>> P = compose("P", ELASTIC, STRENGTH, defaults={"E": 20000.0})
+    >>> P().names(), P().E
+    (('E', 'nu', 'ft'), 20000.0)
+    """
+    fields = _checked_fields(parts, defaults or {})
+    members = dict(namespace or {})
+    members.update(ranges={f.name: f.range for f in fields}, __doc__=_docstring(summary or f"Parameters of {class_name}.",
+                                                                               fields))
+    if check is not None:
+        def __post_init__(self):
+            ParameterSet.__post_init__(self)
+            check(self)
+
+        members["__post_init__"] = __post_init__
+    cls = dataclasses.make_dataclass(class_name, [(f.name, float, dataclasses.field(default=f.default)) for f in fields],
+                                     bases=(ParameterSet,), namespace=members, frozen=True)
+    cls.__module__ = module or sys._getframe(1).f_globals.get("__name__", __name__)
+    return cls

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fracid.data import ExperimentalData
+from fracid.data import Diagonal, ExperimentalData
 from fracid.inverse.forward_operator import ForwardOperator, Observation
 from fracid.inverse.space import ParameterSpace
 from fracid.inverse.sensitivity import ForwardRunError
@@ -440,7 +440,7 @@ def cross_calibration(source_model, source_params, target_model, target_base, ta
     notes = (f"cross-calibration data: force of {source_label} at {source_params}, {points.size} {control} points "
              f"from {points[0]:g} to {points[-1]:g} mm, no noise added; std {std:.4g} N "
              f"({relative_std:g} of its peak) at every point",)
-    data = ExperimentalData(points, y, np.diag(np.full(points.size, std**2)), (("global", 0, points.size),), notes)
+    data = ExperimentalData(points, y, Diagonal(np.full(points.size, std**2)), (("global", 0, points.size),), notes)
     candidate = Candidate(target_label, target_model, target_base, target_names, space, target_specimen)
     if log is not None:
         log(f"target: fitting {target_label} ({', '.join(candidate.names)})")

@@ -1,8 +1,9 @@
 """The forward operator h(x): a vector of identified parameters -> computed observations.
 
-An :class:`Observation` says what is measured on which specimen: a curve quantity (the force, or a
-local quantity such as the FPZ width) sampled at given values of the specimen's control quantity.
-:class:`ForwardOperator` maps a vector x of the identified parameters (a named subset of the model
+An observation kind (:mod:`fracid.inverse.observations`) says what is measured on which specimen and
+how it is sampled from a run: a curve quantity at control points (:class:`Observation`), a
+displacement field at points and frames (:class:`FieldObservation`), or any object with the members
+of :class:`ObservationKind`. :class:`ForwardOperator` maps a vector x of the identified parameters (a named subset of the model
 parameters; the others fixed) to the concatenated computed values ``y_comp``, in the order of the
 observations. A forward run that does not converge is retried once with smaller steps; if it still
 fails, the result records the failure (reason, how far it got) instead of raising, so a study goes on.
@@ -15,78 +16,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fracid.models import ConvergenceError, DamageModel, StepOptions
+from fracid.inverse.observations import FieldObservation, Observation, ObservationKind, check_control_points
+from fracid.inverse.probed import ProbedSpecimen, merge_probes
+from fracid.models import ConvergenceError, DamageModel, StepOptions, declared
 
-
-@dataclass(frozen=True, eq=False)
-class Observation:
-    """Computed counterpart of one measured data block.
-
-    Parameters
-    ----------
-    specimen
-        Specimen object (bar, beam, dog-bone).
-    control_points : array_like
-        Increasing values of the control quantity at which the data are sampled [mm].
-    quantity : str
-        ``"force"`` [N] or the name of an observable of the forward run (e.g. ``"fpz_width"`` [mm]).
-    control : str or None
-        The specimen's control quantity (its default if None).
-    name : str
-        Label of the block.
-    damage_threshold : float
-        Damage above which a point counts in a local width observable [-] (0: any damage).
-
-    Observations of the same specimen object, control and threshold share one forward run (the
-    force curve and the FPZ width of one test come from the same analysis).
-    """
-
-    specimen: object
-    control_points: np.ndarray
-    quantity: str = "force"
-    control: str | None = None
-    name: str = "global"
-    damage_threshold: float = 0.0
-
-    def __post_init__(self):
-        from fracid.forward import check_specimen
-
-        check_specimen(self.specimen)
-        object.__setattr__(self, "control_points", _control_points(self.control_points))
-        if not isinstance(self.quantity, str) or not self.quantity:
-            raise TypeError(f"quantity = {self.quantity!r}; give 'force' or the name of an observable of the "
-                            "forward run (e.g. 'fpz_width')")
-
-    @property
-    def run_key(self) -> tuple:
-        """(specimen, control, threshold): observations with compatible keys share one forward run.
-
-        The force does not depend on the threshold, so a force observation has threshold None.
-        """
-        try:
-            specimen = (hash(self.specimen), self.specimen)  # equal frozen specimens share a run
-        except TypeError:
-            specimen = id(self.specimen)
-        return (specimen, self.control, None if self.quantity == "force" else self.damage_threshold)
-
-
-def _control_points(values) -> np.ndarray:
-    """``values`` as a 1-D float array of finite, strictly increasing control values, or a ValueError."""
-    try:
-        points = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"control_points is a {type(values).__name__} that is not an array of numbers") from None
-    if points.ndim != 1 or points.size == 0:
-        raise ValueError(f"control_points has shape {points.shape}; give a non-empty 1-D array of control values [mm] "
-                         "(the data's control, e.g. ExperimentalData.control of one block)")
-    if not np.all(np.isfinite(points)):
-        raise ValueError("control_points holds NaN or infinite values; every control value must be a finite number")
-    steps = np.diff(points)
-    if np.any(steps <= 0):
-        i = int(np.argmax(steps <= 0))
-        raise ValueError(f"control_points must increase strictly, but point {i + 1} ({points[i + 1]:.6g} mm) does not "
-                         f"exceed point {i} ({points[i]:.6g} mm)")
-    return points
+__all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RunRecord"]
+_control_points = check_control_points  # the old private name
 
 
 @dataclass
@@ -132,7 +67,9 @@ class ForwardOperator:
 
     Parameters
     ----------
-    observations : sequence of Observation
+    observations : sequence of observation kinds
+        :class:`Observation`, :class:`FieldObservation` or any :class:`ObservationKind`; y is their
+        values concatenated in this order.
     base : parameter object
         Values of the parameters that are not identified (an instance of ``model.parameters``).
     names : sequence of str
@@ -165,15 +102,16 @@ class ForwardOperator:
             raise TypeError(f"names = {self.names!r} is a string; give a sequence of parameter names, e.g. "
                             f"({self.names!r},)")
         object.__setattr__(self, "names", tuple(self.names))
-        strangers = [type(o).__name__ for o in self.observations if not isinstance(o, Observation)]
+        strangers = [type(o).__name__ for o in self.observations if not isinstance(o, ObservationKind)]
         if strangers or not self.observations:
-            raise TypeError(f"observations must be a non-empty sequence of Observation, got {strangers or 'none'}")
+            raise TypeError(f"observations must be a non-empty sequence of Observation (or FieldObservation, or an "
+                            f"object with the members of ObservationKind), got {strangers or 'none'}")
         if self.model is None:
             object.__setattr__(self, "model", DamageModel(self.regularization or "gradient"))
-        elif self.regularization is not None and self.regularization != getattr(self.model, "regularization", None):
+        elif self.regularization is not None and self.regularization != declared(self.model).regularization:
             raise ValueError(f"regularization = {self.regularization!r} contradicts the model {self.model.key!r}; "
                              "give one of them")
-        object.__setattr__(self, "regularization", getattr(self.model, "regularization", None))
+        object.__setattr__(self, "regularization", declared(self.model).regularization)
         if not isinstance(self.base, self.model.parameters):
             raise TypeError(f"base is a {type(self.base).__name__}; the model {self.model.key!r} takes "
                             f"{self.model.parameters.__name__}")
@@ -181,23 +119,18 @@ class ForwardOperator:
         unknown = set(self.names) - set(known)
         if unknown or not self.names:
             raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {known}")
-        sizes = [o.control_points.size for o in self.observations]
+        sizes = [int(o.size) for o in self.observations]
         object.__setattr__(self, "_offsets", np.concatenate([[0], np.cumsum(sizes)]))
 
     @property
     def differentiable(self) -> bool:
         """Whether the model differentiates its runs with respect to every identified parameter and
-        every observed quantity has derivatives: the force, the functionals and energies do; the
-        specimen's ``observables`` and the model's ``observer_names`` (zone widths, crack lengths, from
-        observers) only with a model whose ``differentiates_observers`` is true."""
-        names = set(getattr(self.model, "differentiable", ()))
-        if getattr(self.model, "differentiates_observers", False):
-            return set(self.names) <= names
-        observed = {o.quantity for o in self.observations}
-        for o in self.observations:
-            if observed & {*getattr(o.specimen, "observables", ()), *getattr(self.model, "observer_names", ())}:
-                return False
-        return set(self.names) <= names
+        every observation has derivatives (its ``differentiable_with(model)``: the force, the
+        functionals, energies and probes do; the specimen's ``observables`` and the model's
+        ``observer_names`` (zone widths, crack lengths, from observers) only with a model whose
+        ``differentiates_observers`` is true)."""
+        names = set(declared(self.model).differentiable)
+        return set(self.names) <= names and all(o.differentiable_with(self.model) for o in self.observations)
 
     def differentiated(self) -> "ForwardOperator":
         """This operator with ``sensitivities=True`` if it is :attr:`differentiable`, else itself."""
@@ -265,35 +198,35 @@ class ForwardOperator:
 
     def _fill(self, record, group, params, limit, threshold) -> bool:
         """Run one group's analysis to its largest needed control value and sample its blocks."""
-        wanted = [obs.control_points[: min(part.stop, limit) - part.start] for obs, part in group]
-        checkpoints = np.unique(np.concatenate(wanted))
-        local = sorted({obs.quantity for obs, _ in group} - {"force"})  # observers cost time at every step
-        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold, local)
+        counts = [min(part.stop, limit) - part.start for _, part in group]
+        checkpoints = np.unique(np.concatenate([obs.controls[:n] for (obs, _), n in zip(group, counts)]))
+        observables = sorted({name for obs, _ in group for name in obs.observables})
+        probes = merge_probes(obs for obs, _ in group)
+        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold,
+                                        observables, probes)
         record.retried |= retried
         if run is None:
             record.status, record.error = "failed", error
             record.reached.append(0.0)
             return False
         record.reached.append(float(run.control[-1]))
-        for (obs, part), points in zip(group, wanted):
-            values = run.force if obs.quantity == "force" else run.observables[obs.quantity]
-            rows = slice(part.start, part.start + points.size)
-            record.y[rows] = np.interp(points, run.control, values)
-            if record.S is None:
-                continue
-            derivative = (getattr(run, "derivatives", None) or {}).get(obs.quantity)
-            if derivative is None:  # a quantity the run did not differentiate: no S from this run
+        for (obs, part), n in zip(group, counts):
+            y, S = obs.sample(run)
+            rows = slice(part.start, part.start + n)
+            record.y[rows] = np.asarray(y, float)[:n]
+            if record.S is not None and S is None:  # a quantity the run did not differentiate: no S
                 record.S = None
-            else:  # the checkpoints are steps: the interpolation picks the step's value
-                record.S[rows] = np.column_stack([np.interp(points, run.control, d) for d in derivative.T])
+            elif record.S is not None:  # the checkpoints are steps: the samples are the steps' values
+                record.S[rows] = np.asarray(S, float)[:n]
         return True
 
-    def _run(self, obs, params, target, checkpoints, threshold, observables):
+    def _run(self, obs, params, target, checkpoints, threshold, observables, probes):
         """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
         error = ""
+        specimen = ProbedSpecimen(obs.specimen, probes) if probes else obs.specimen
         for attempt, steps in enumerate(self._step_rules(obs, target)):
             try:
-                result = self.model.simulate(obs.specimen, params, control=obs.control, target=target,
+                result = self.model.simulate(specimen, params, control=obs.control, target=target,
                                              stop_force_fraction=None, steps=steps, field_steps=None,
                                              checkpoints=checkpoints, damage_threshold=threshold,
                                              observables=observables,
@@ -313,3 +246,4 @@ class ForwardOperator:
         smaller = replace(first, initial=quarter(first.initial), maximum=quarter(first.maximum),
                           max_factor=first.max_factor / 4, onset_fraction=first.onset_fraction / 4)
         return (first, smaller)
+

@@ -33,7 +33,7 @@ class _WhitenedProblem:
         self.y_exp, self.x0, self.result = y_exp, x0, result
         self.lower, self.upper = box
         self.s = np.sqrt(np.diag(C0))
-        self.L_exp = np.linalg.cholesky(C_exp)
+        self.C_exp = C_exp  # a Covariance (from _check_inputs): used through its whitening
         self.W0 = solve_triangular(np.linalg.cholesky(C0 / np.outer(self.s, self.s)), np.eye(x0.size), lower=True)
         self.points = {}  # x bytes -> (y, S), or None where the run failed
         self.best = np.inf  # smallest |r| met: a failed point gets a residual far above it
@@ -68,7 +68,7 @@ class _WhitenedProblem:
         if got is None:  # least_squares cannot take NaN: a large finite residual makes it shrink the step
             n = self.y_exp.size + x.size
             return np.full(n, 1e3 * (self.best + 1.0) / np.sqrt(n))
-        r = np.concatenate([solve_triangular(self.L_exp, got[0] - self.y_exp, lower=True),
+        r = np.concatenate([self.C_exp.whiten(got[0] - self.y_exp),
                             self.W0 @ ((x - self.x0) / self.s)])
         self.best = min(self.best, float(np.linalg.norm(r)))
         return r
@@ -76,7 +76,7 @@ class _WhitenedProblem:
     def jacobian_at(self, x):
         """J in z and the posterior covariance C = (S^T C_exp^-1 S + C0^-1)^-1 at x (x must have run)."""
         y, S = self.at(x)
-        J = np.vstack([solve_triangular(self.L_exp, S * self.s, lower=True), self.W0])
+        J = np.vstack([self.C_exp.whiten(S * self.s), self.W0])
         C = np.linalg.inv(J.T @ J) * np.outer(self.s, self.s)
         return y, J, 0.5 * (C + C.T)
 
@@ -99,8 +99,9 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
     ----------
     evaluate : callable(x, needed) -> RunRecord or ndarray
         The forward operator h.
-    y_exp, C_exp : ndarray
-        Measured observations and their covariance (any symmetric positive definite matrix).
+    y_exp, C_exp : ndarray or Covariance
+        Measured observations and their covariance (any symmetric positive definite (n, n) array, or a
+        :class:`~fracid.data.covariance_matrix.Covariance`: a diagonal one forms no n x n matrix).
     x0, C0 : ndarray
         Prior mean and covariance. x0 is moved into the bounds first and is the starting point.
     sensitivity : callable, optional

@@ -5,37 +5,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from fracid.data.covariance_matrix import as_covariance
+from fracid.inverse.assimilation import assimilate, information_update, kalman_update  # noqa: F401
 from fracid.inverse.kalman_status import GaussianEstimate, KalmanResult, judge_last_pass, relaxed  # noqa: F401
 from fracid.inverse.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
-
-
-def kalman_update(x, C, S, innovation, R):
-    """One Kalman update in Joseph form.
-
-    Parameters
-    ----------
-    x : ndarray, shape (p,)
-        Prior mean.
-    C : ndarray, shape (p, p)
-        Prior covariance.
-    S : ndarray, shape (m, p)
-        Sensitivity of the m observations to x.
-    innovation : ndarray, shape (m,)
-        Measured minus computed observations.
-    R : ndarray, shape (m, m)
-        Covariance of the measurement errors.
-
-    Returns
-    -------
-    x_new, C_new, K : ndarray
-        Posterior mean and covariance, and the gain. The Joseph form
-        (I - K S) C (I - K S)^T + K R K^T keeps C symmetric positive definite under round-off.
-    """
-    A = S @ C @ S.T + R
-    K = np.linalg.solve(A, S @ C).T  # C S^T A^-1 (A symmetric)
-    I_KS = np.eye(x.size) - K @ S
-    C_new = I_KS @ C @ I_KS.T + K @ R @ K.T
-    return x + K @ innovation, 0.5 * (C_new + C_new.T), K
 
 
 def project_to_box(x, C, lower, upper) -> np.ndarray:
@@ -73,15 +46,16 @@ def _observation_groups(n, groups):
 
 
 def _check_inputs(y_exp, C_exp, x0, C0):
+    """y_exp, x0 as float arrays, C_exp as a Covariance of their size, C0 checked (p, p) symmetric positive definite."""
     y_exp, x0 = np.asarray(y_exp, float), np.asarray(x0, float)
-    C_exp, C0 = np.atleast_2d(np.asarray(C_exp, float)), np.atleast_2d(np.asarray(C0, float))
-    if C_exp.shape != (y_exp.size, y_exp.size):
+    C_exp = as_covariance(C_exp if np.ndim(C_exp) != 0 else np.atleast_2d(C_exp), name="C_exp")
+    if C_exp.n != y_exp.size:
         raise ValueError(f"C_exp has shape {C_exp.shape}; expected {(y_exp.size, y_exp.size)}")
+    C0 = np.atleast_2d(np.asarray(C0, float))
     if C0.shape != (x0.size, x0.size):
         raise ValueError(f"C0 has shape {C0.shape}; expected {(x0.size, x0.size)}")
-    for name, M in (("C_exp", C_exp), ("C0", C0)):
-        if not np.allclose(M, M.T) or np.any(np.linalg.eigvalsh(0.5 * (M + M.T)) <= 0):
-            raise ValueError(f"{name} must be symmetric positive definite")
+    if not np.allclose(C0, C0.T) or np.any(np.linalg.eigvalsh(0.5 * (C0 + C0.T)) <= 0):
+        raise ValueError("C0 must be symmetric positive definite")
     return y_exp, C_exp, x0, C0
 
 
@@ -195,9 +169,13 @@ def kalman_filter(
     evaluate : callable(x, needed) -> RunRecord or ndarray
         The forward operator (e.g. :class:`~fracid.inverse.forward_operator.ForwardOperator`, or
         :class:`~fracid.inverse.runs.StoredOperator` to store every run).
-    y_exp, C_exp : ndarray
-        Measured observations and their covariance. Sequential assimilation assumes no correlation
-        between groups (a block-diagonal C_exp); within a group any covariance is used.
+    y_exp, C_exp : ndarray or Covariance
+        Measured observations and their covariance (an (n, n) array or a
+        :class:`~fracid.data.covariance_matrix.Covariance`). A group of more observations than
+        parameters is assimilated in information form (:func:`~fracid.inverse.assimilation.assimilate`),
+        so no n x n matrix is formed for a diagonal, low-rank or block C_exp. Sequential assimilation
+        assumes no correlation between groups (a block-diagonal C_exp); within a group any covariance
+        is used.
     x0, C0 : ndarray
         Prior mean and covariance (from KNN or the user). x0 is moved into the bounds first.
     groups : sequence of index arrays, optional
@@ -278,7 +256,7 @@ def kalman_filter(
                 point, y, S = got
                 x = last_point = point
             innovation = y_exp[rows] - y[rows] - S[rows] @ (x - point)
-            x, C, _ = kalman_update(x, C, S[rows], innovation, C_exp[np.ix_(rows, rows)])
+            x, C, _ = assimilate(x, C, S[rows], innovation, C_exp.take(rows))
             x = project_to_box(x, C, lower, upper)
             result.history.append({"iteration": iteration, "step": step, "observations": rows.tolist(),
                                    "x": x.copy(), "C": C.copy()})
@@ -302,11 +280,11 @@ def kalman_filter(
 def _map_objective(y_exp, C_exp, x0, C0):
     """(x, y) -> (y_exp - y)^T C_exp^-1 (y_exp - y) + (x - x0)^T C0^-1 (x - x0); without the prior's term
     when C0 is None."""
-    W_exp, W0 = np.linalg.inv(C_exp), None if C0 is None else np.linalg.inv(C0)
+    W0 = None if C0 is None else np.linalg.inv(C0)
 
     def f(x, y):
-        r, d = y_exp - y, x - x0
-        return float(r @ W_exp @ r + (0.0 if W0 is None else d @ W0 @ d))
+        d = x - x0
+        return float(C_exp.quadratic(y_exp - y) + (0.0 if W0 is None else d @ W0 @ d))
 
     return f
 

@@ -7,9 +7,9 @@ from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_triangular
 from scipy.stats import qmc
 
+from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.space import ParameterSpace  # also importable from here, as before
 
 
@@ -44,13 +44,16 @@ def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) 
 
 
 def objective(y_exp, C_exp, Y) -> np.ndarray:
-    """f_i = (y_exp - y_i)^T C_exp^-1 (y_exp - y_i) for every row of Y; inf for failed (NaN) rows."""
-    L = np.linalg.cholesky(np.asarray(C_exp, float))
+    """f_i = (y_exp - y_i)^T C_exp^-1 (y_exp - y_i) for every row of Y; inf for failed (NaN) rows.
+
+    ``C_exp`` is an (n, n) array or a :class:`~fracid.data.covariance_matrix.Covariance` (used through
+    its whitening: no n x n matrix for a diagonal one) [units of y squared]; f is dimensionless.
+    """
+    C_exp = as_covariance(C_exp, name="C_exp")
     Y = np.atleast_2d(np.asarray(Y, float))
     computed = np.all(np.isfinite(Y), axis=1)
     residual = np.where(computed[:, None], np.asarray(y_exp, float) - Y, 0.0)
-    r = solve_triangular(L, residual.T, lower=True)
-    return np.where(computed, np.sum(r * r, axis=0), np.inf)
+    return np.where(computed, C_exp.quadratic(residual.T), np.inf)
 
 
 @dataclass

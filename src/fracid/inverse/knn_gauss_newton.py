@@ -15,6 +15,7 @@ import numpy as np
 from fracid.inverse.gauss_newton import gauss_newton
 from fracid.inverse.knn_kalman import KnnSettings, knn_record, population_search
 from fracid.inverse.method import MethodResult, check_problem, identification_bounds, result_fields
+from fracid.inverse.plans import StagePlan, plural, population_plan, runs_per_linearisation
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.space import ParameterSpace
@@ -72,6 +73,26 @@ class KnnGaussNewton:
     tol: float = 0.01
     name: ClassVar[str] = "knn-gauss-newton"
     stages: ClassVar[dict] = {"knn": "KNN", "gauss_newton": "Gauss-Newton"}
+
+    @classmethod
+    def from_config(cls, identify, n_y: int | None) -> KnnGaussNewton:
+        """The method of a validated ``[identify]``: its ``knn`` and ``gauss_newton`` sections."""
+        if getattr(identify, "methods", {}).get(cls.name):
+            raise ValueError(f"the settings of {cls.name} are those of [identify.knn] and [identify.gauss-newton], "
+                             "not a table of its own")
+        knn, gn = identify.knn, identify.gauss_newton
+        return cls(KnnSettings(n=knn.n, method=knn.method, seed=knn.seed, k=knn.k), max_iterations=gn.max_iterations,
+                   tol=gn.tol)
+
+    def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
+        """The forward runs of both stages: the population side by side, then at most ``max_iterations``
+        linearisations one after another (each a full-curve run, or 2 p + 1 without exact sensitivities)."""
+        per_step, how = runs_per_linearisation(operator, p)
+        runs = (self.max_iterations + 1) * per_step
+        text = (f"at most {self.max_iterations} linearisations and a run at the estimate, {plural(per_step, 'run')} each "
+                f"({how}): at most {runs} full-curve runs one after another without backtracking")
+        return [population_plan(self.knn, p), StagePlan("gauss_newton", "Gauss-Newton", runs, False, float(runs), text,
+                                                        "[identify.gauss-newton] max_iterations", per_step == 1)]
 
     def search(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
                stats=None, retry_failed=False):

@@ -19,6 +19,7 @@ from fracid.inverse.kalman import kalman_filter
 from fracid.inverse.kalman_status import DEFAULT_MAX_STARTS, restarted
 from fracid.inverse.knn import knn_search
 from fracid.inverse.method import MethodResult, check_problem, identification_bounds, result_fields
+from fracid.inverse.plans import StagePlan, plural, population_plan, runs_per_linearisation
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.space import ParameterSpace
@@ -55,6 +56,11 @@ class IdentificationResult(MethodResult):
         runs = self.runs or {}
         return (f"{runs.get('knn_failed', 0)} of {runs.get('knn', 0)} KNN, "
                 f"{runs.get('kalman_failed', 0)} in the Kalman stage")
+
+
+#: Kalman steps per pass when [identify.kalman] groups is not given. A step costs one run (with exact
+#: sensitivities) up to its observations: a few steps are as informative as one per observation and cost less
+DEFAULT_GROUPS = 4
 
 
 @dataclass(frozen=True)
@@ -150,6 +156,39 @@ class KnnKalman:
         """The KNN stage: a :class:`~fracid.inverse.knn.KnnResult` (population, ranking, prior x0, C0)."""
         return population_search(self.knn, operator, y_exp, C_exp, space, executor=executor, store=store,
                                  progress=progress, stats=stats, retry_failed=retry_failed)
+
+    @classmethod
+    def from_config(cls, identify, n_y: int | None) -> KnnKalman:
+        """The method of a validated ``[identify]`` (its ``knn`` and ``kalman`` sections, as
+        :class:`fracid.config.KnnConfig` and :class:`fracid.config.KalmanConfig`); ``groups`` (a count)
+        becomes that many consecutive index arrays over the ``n_y`` observations, :data:`DEFAULT_GROUPS`
+        when not given."""
+        if getattr(identify, "methods", {}).get(cls.name):
+            raise ValueError(f"the settings of {cls.name} are those of [identify.knn] and [identify.kalman], not a "
+                             "table of its own")
+        knn, kalman = identify.knn, identify.kalman
+        n_y = max(int(n_y or 1), 1)
+        count = kalman.groups if kalman.groups is not None else min(DEFAULT_GROUPS, n_y)
+        groups = [np.asarray(g) for g in np.array_split(np.arange(n_y), count)]
+        return cls(KnnSettings(n=knn.n, method=knn.method, seed=knn.seed, k=knn.k),
+                   KalmanSettings(groups=groups, max_iterations=kalman.max_iterations, tol=kalman.tol,
+                                  restart=kalman.restart, max_starts=kalman.max_starts))
+
+    def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
+        """The forward runs of both stages (:class:`~fracid.inverse.plans.StagePlan`): the population side by
+        side; the filter's steps one after another (a step of the first pass runs up to its observations, each
+        later pass is one linearisation), at most ``max_iterations`` passes and a run at the estimate."""
+        per_step, how = runs_per_linearisation(operator, p)
+        groups = named_groups(self.kalman.groups, n_y)
+        steps = n_y if groups is None else len(groups)
+        passes = self.kalman.max_iterations
+        later = (passes - 1) * per_step + per_step
+        runs, full = steps * per_step + later, per_step * (steps + 1) / 2 + later
+        text = (f"{steps} steps per pass, {plural(per_step, 'run')} per step ({how}), at most {passes} passes and a run at "
+                f"the estimate: at most {runs} runs one after another without backtracking, about {full:.0f} "
+                "full-curve runs")
+        return [population_plan(self.knn, p), StagePlan("kalman", "Kalman filter", runs, False, full, text,
+                                                        "[identify.kalman] groups and max_iterations", per_step == 1)]
 
     def fit_from(self, evaluate, y_exp, C_exp, x0, C0, *, bounds=None, executor=None, blocks=()):
         """The Kalman filter alone from the prior (x0, C0), started once (a multi-start filter or a noisy
@@ -285,5 +324,5 @@ def population_search(knn: KnnSettings, operator, y_exp, C_exp, space: Parameter
                       executor=executor, store=store, progress=progress, stats=stats, retry_failed=retry_failed)
 
 
-__all__ = ["IdentificationResult", "KalmanSettings", "KnnKalman", "KnnSettings", "kalman_progress", "knn_output",
+__all__ = ["DEFAULT_GROUPS", "IdentificationResult", "KalmanSettings", "KnnKalman", "KnnSettings", "kalman_progress", "knn_output",
            "knn_record", "named_groups", "population_search", "refine"]

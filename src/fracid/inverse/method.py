@@ -18,8 +18,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.diagnostics import diagnostic_warnings, diagnostics_lines, fit_diagnostics
 from fracid.inverse.kalman import GaussianEstimate
+from fracid.inverse.problem_check import check_problem
 
 #: RMS fit error [% of the measured peak] above which a fit is reported as poor
 POOR_FIT_PERCENT = 10.0
@@ -46,8 +48,9 @@ class InverseMethod(Protocol):
         ``ok``, ``y`` and ``error``); its ``names`` are the space's.
     y_exp : ndarray, shape (n,)
         Measured values (units of the observations: N for forces, mm for widths).
-    C_exp : ndarray, shape (n, n)
-        Their covariance (squared units of y).
+    C_exp : Covariance
+        Their covariance (squared units of y): what :func:`check_problem` returns from an (n, n) array or
+        a :class:`~fracid.data.covariance_matrix.Covariance`.
     space : ParameterSpace
         Names and bounds of the identified parameters (units of the parameters).
     executor : Executor or None
@@ -319,74 +322,6 @@ def at_bounds(names, x, bounds) -> list[str]:
     return [n for n, v, lo, hi, w in zip(names, x, lower, upper, span) if min(v - lo, hi - v) <= 1e-9 * w]
 
 
-def _float_array(name: str, value) -> np.ndarray:
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} is a {type(value).__name__} that is not an array of numbers") from None
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} holds {int(np.sum(~np.isfinite(array)))} NaN or infinite values; every entry "
-                         "must be a finite number")
-    return array
-
-
-def _check_space(operator, space) -> None:
-    if not all(hasattr(space, attr) for attr in ("names", "lower", "upper", "log")):
-        raise TypeError(f"space is a {type(space).__name__}; give a fracid.inverse.space.ParameterSpace(names, lower, "
-                        "upper): the identified parameters and their bounds")
-    names = getattr(operator, "names", None)
-    if names is not None and tuple(space.names) != tuple(names):
-        raise ValueError(f"the space's parameters {list(space.names)} are not the operator's identified parameters "
-                         f"{list(names)}: give the same names in the same order")
-
-
-def check_problem(operator, y_exp, C_exp, space) -> tuple[np.ndarray, np.ndarray]:
-    """Check the arguments of an identification before any forward run.
-
-    Parameters
-    ----------
-    operator : ForwardOperator or callable
-        Its ``n_outputs`` (when it has one) sets the size of y; its ``names`` (when it has them) must
-        be the space's.
-    y_exp, C_exp : array_like
-        Measured values, shape (n,), and their covariance, shape (n, n), symmetric positive definite.
-    space : ParameterSpace
-
-    Returns
-    -------
-    y_exp, C_exp : ndarray
-        As float arrays.
-
-    Raises
-    ------
-    TypeError
-        An operator that is not callable, a space that is not a ParameterSpace, values that are not numbers.
-    ValueError
-        Shapes that do not match the operator's outputs, non-finite values, a covariance that is not
-        symmetric positive definite, parameter names that differ from the operator's.
-    """
-    if not callable(operator):
-        raise TypeError(f"operator is a {type(operator).__name__}; give a ForwardOperator "
-                        "(fracid.inverse.forward_operator) or a callable x -> run record")
-    _check_space(operator, space)
-    y, C = _float_array("y_exp", y_exp), _float_array("C_exp", C_exp)
-    n = int(getattr(operator, "n_outputs", y.size))
-    if y.shape != (n,):
-        raise ValueError(f"y_exp has shape {y.shape}, but the operator computes {n} values: give a vector of {n} "
-                         "measured values, in the order of its observations")
-    if C.shape != (n, n):
-        raise ValueError(f"C_exp has shape {C.shape}, but the covariance of {n} measured values has shape ({n}, {n}) "
-                         "(from standard deviations: np.diag(std**2))")
-    if not np.allclose(C, C.T, rtol=1e-10, atol=0.0):
-        raise ValueError("C_exp is not symmetric; a covariance matrix is")
-    try:
-        np.linalg.cholesky(C)
-    except np.linalg.LinAlgError:
-        raise ValueError("C_exp is not positive definite (a zero or negative variance, or dependent rows); every "
-                         "measured value needs a std > 0") from None
-    return y, C
-
-
 def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> dict:
     """The fields of a :class:`MethodResult` that follow from the problem and the estimate ``x``:
     ``names``, ``y_exp``, ``std_exp``, ``blocks``, ``notes``, ``units``, ``bounds``
@@ -397,7 +332,7 @@ def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> d
     """
     lower, upper = identification_bounds(operator, space)
     return {"names": list(space.names), "y_exp": np.asarray(y_exp, float),
-            "std_exp": np.sqrt(np.diag(np.asarray(C_exp, float))), "blocks": list(blocks), "notes": list(notes),
+            "std_exp": as_covariance(C_exp, name="C_exp").std(), "blocks": list(blocks), "notes": list(notes),
             "units": dict(operator.units), "bounds": (lower.tolist(), upper.tolist()),
             "at_bound": at_bounds(space.names, np.asarray(x, float), (lower, upper)),
             **observed_fields(operator, np.size(y_exp))}
@@ -408,11 +343,11 @@ def observed_fields(operator, n: int) -> dict:
     observations (:class:`~fracid.inverse.forward_operator.Observation`); empty when it has none or
     they do not hold ``n`` values."""
     observations = list(getattr(operator, "observations", None) or [])
-    if not observations or sum(np.size(o.control_points) for o in observations) != n:
+    if not observations or sum(o.size for o in observations) != n:
         return {}
-    return {"control": np.concatenate([np.asarray(o.control_points, float) for o in observations]),
+    return {"control": np.concatenate([np.asarray(o.controls, float) for o in observations]),
             "control_names": [str(o.control or getattr(o.specimen, "default_control", "") or "") for o in observations],
-            "quantities": [str(o.quantity) for o in observations]}
+            "quantities": [str(getattr(o, "quantity", o.name)) for o in observations]}
 
 
 __all__ = ["POOR_FIT_PERCENT", "POOR_FIT_STD", "InverseMethod", "MethodResult", "at_bounds", "check_problem",

@@ -12,12 +12,13 @@ mixture inside the cube (``inside``) makes the density of the kept draws exact.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import gammaln, logsumexp
 
-__all__ = ["GaussianMixture", "fit_mixture", "weighted_covariance"]
+__all__ = ["GaussianMixture", "amis_weights", "fit_mixture", "weighted_covariance", "weighted_quantile"]
 
 #: draws used to measure a mixture's mass inside the unit cube
 _MASS_DRAWS = 20_000
@@ -166,3 +167,24 @@ def _centre(z, w, member, previous):
     if not member.any() or w[member].sum() <= 0:
         return previous
     return (w[member] @ z[member]) / w[member].sum()
+
+
+def weighted_quantile(values, weights, q) -> np.ndarray:
+    """Quantiles of ``values`` under normalised ``weights`` (the inverse of the weighted CDF, with the
+    mid-point rule so that equal weights give the usual quantiles)."""
+    order = np.argsort(values)
+    v, w = np.asarray(values)[order], np.asarray(weights, float)[order]
+    cdf = (np.cumsum(w) - 0.5 * w) / w.sum()
+    return np.interp(np.atleast_1d(q), cdf, v)
+
+
+def amis_weights(densities, loglik, sizes) -> tuple[np.ndarray, float]:
+    """Deterministic-mixture weights of all draws against all proposals so far (``densities``: the log density
+    of proposal t at draw i, shape (rounds, draws); ``sizes``: the draws of each), normalised, and their ESS."""
+    n = np.array(sizes, float)
+    log_q = logsumexp(densities + np.log(n / n.sum())[:, None], axis=0)
+    log_w = np.where(np.isfinite(loglik), loglik - log_q, -np.inf)
+    if not np.any(np.isfinite(log_w)):
+        return np.zeros(len(loglik)), 0.0
+    w = np.exp(log_w - logsumexp(log_w))
+    return w, float(1.0 / np.sum(w**2)) if math.isfinite(np.sum(w**2)) else 0.0

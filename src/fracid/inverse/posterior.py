@@ -22,14 +22,19 @@ Why not MCMC on an emulator: the emulator's error enters the posterior unmeasure
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.special import logsumexp
 
-from fracid.inverse.mixture import GaussianMixture, fit_mixture, weighted_covariance
+from fracid.data.covariance_matrix import as_covariance
+from fracid.inverse.mixture import (
+    GaussianMixture,
+    amis_weights,
+    fit_mixture,
+    weighted_covariance,
+    weighted_quantile,
+)
 from fracid.inverse.sensitivity import ForwardRunError, evaluate_points
 
 __all__ = ["MIN_ESS", "MIN_ESS_FRACTION", "PosteriorResult", "PosteriorSettings", "ess_floor", "posterior",
@@ -246,21 +251,13 @@ class PosteriorResult:
                                                        "method": "adaptive importance sampling (fracid)"})
 
 
-def weighted_quantile(values, weights, q) -> np.ndarray:
-    """Quantiles of ``values`` under normalised ``weights`` (the inverse of the weighted CDF, with the
-    mid-point rule so that equal weights give the usual quantiles)."""
-    order = np.argsort(values)
-    v, w = np.asarray(values)[order], np.asarray(weights, float)[order]
-    cdf = (np.cumsum(w) - 0.5 * w) / w.sum()
-    return np.interp(np.atleast_1d(q), cdf, v)
-
-
-def _log_likelihood(records, y_exp, factor):
-    """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs."""
+def _log_likelihood(records, y_exp, C_exp):
+    """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs;
+    chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`)."""
     y = np.array([np.asarray(r.y, float) if r.ok else np.full(len(y_exp), np.nan) for r in records])
     good = np.all(np.isfinite(y), axis=1)
-    z = np.linalg.solve(factor, np.where(good[:, None], y - y_exp, 0.0).T)
-    return np.where(good, -0.5 * np.sum(z * z, axis=0), -np.inf), y
+    chi2 = C_exp.quadratic(np.where(good[:, None], y - y_exp, 0.0).T)
+    return np.where(good, -0.5 * chi2, -np.inf), y
 
 
 def _first_proposal(space, x0, C0, settings, rng) -> GaussianMixture:
@@ -286,8 +283,8 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         :class:`~fracid.inverse.runs.StoredOperator` stores every run and reuses stored ones.
     y_exp : ndarray, shape (m,)
         Measured values.
-    C_exp : ndarray, shape (m, m)
-        Their covariance.
+    C_exp : ndarray, shape (m, m), or Covariance
+        Their covariance [units of y squared] (a diagonal one forms no m x m matrix).
     space : ParameterSpace
         Names and bounds of the parameters: the prior is uniform on its unit cube.
     x0, C0 : ndarray
@@ -309,8 +306,8 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     ForwardRunError
         When every forward run failed or lacked outputs (nothing to weigh).
     """
-    y_exp, C_exp = np.asarray(y_exp, float), np.asarray(C_exp, float)
-    factor = np.linalg.cholesky(C_exp)
+    y_exp = np.asarray(y_exp, float)
+    C_exp = as_covariance(C_exp, y_exp.size, name="C_exp")
     rng = np.random.default_rng(settings.seed)
     proposal = _first_proposal(space, np.asarray(x0, float), C0, settings, rng)
     proposals, densities, sizes, history = [], [], [], []
@@ -319,14 +316,14 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     for round_ in range(settings.max_rounds):
         u = proposal.sample(rng, settings.samples_per_round)
         records = evaluate_points(evaluate, space.from_unit(u), None, executor)
-        ll, y = _log_likelihood(records, y_exp, factor)
+        ll, y = _log_likelihood(records, y_exp, C_exp)
         # every proposal's log density at every draw: the earlier ones at the new draws, the new one at all
         densities = [np.concatenate([row, q.logpdf(u)]) for row, q in zip(densities, proposals)]
         proposals.append(proposal)
         sizes.append(len(u))
         u_all, loglik, outputs = np.vstack([u_all, u]), np.concatenate([loglik, ll]), np.vstack([outputs, y])
         densities.append(proposal.logpdf(u_all))
-        weights, ess = _amis_weights(np.vstack(densities), loglik, sizes)
+        weights, ess = amis_weights(np.vstack(densities), loglik, sizes)
         history.append({"round": round_, "draws": len(u), "failed": int(np.sum(~np.isfinite(ll))), "ess": ess,
                         "components": len(proposal.weights)})
         if progress is not None:
@@ -344,7 +341,7 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     status = _status(ess, settings, len(u_all), len(proposals))
     lower, upper = space.lower, space.upper
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
-                           np.sqrt(np.diag(C_exp)), ess, len(proposals), failed, np.asarray(x0, float),
+                           C_exp.std(), ess, len(proposals), failed, np.asarray(x0, float),
                            np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
 
 
@@ -395,15 +392,3 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
                            settings=settings, executor=executor, progress=batch_progress(bar), log=log)
     result.units = dict(identification.units or {})
     return result
-
-
-def _amis_weights(densities, loglik, sizes) -> tuple[np.ndarray, float]:
-    """Deterministic-mixture weights of all draws against all proposals so far (``densities``: the log density
-    of proposal t at draw i, shape (rounds, draws); ``sizes``: the draws of each), normalised, and their ESS."""
-    n = np.array(sizes, float)
-    log_q = logsumexp(densities + np.log(n / n.sum())[:, None], axis=0)
-    log_w = np.where(np.isfinite(loglik), loglik - log_q, -np.inf)
-    if not np.any(np.isfinite(log_w)):
-        return np.zeros(len(loglik)), 0.0
-    w = np.exp(log_w - logsumexp(log_w))
-    return w, float(1.0 / np.sum(w**2)) if math.isfinite(np.sum(w**2)) else 0.0

@@ -129,11 +129,7 @@ def code_version(root: Path | str | None = None) -> str:
 def run_key(operator, x, needed: int | None = None) -> str:
     """Store key of the run of ``operator`` at ``x`` (outputs up to ``needed``, all if None): model,
     specimens, meshes, controls, parameters and :func:`code_version`."""
-    observations = [
-        {"specimen": o.specimen, "points": o.control_points.tolist(), "quantity": o.quantity, "control": o.control,
-         "damage_threshold": o.damage_threshold}
-        for o in operator.observations
-    ]
+    observations = [o.key() for o in operator.observations]  # each kind says what defines it
     return key_for(
         model=operator.model.key,
         model_options=operator.model,

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fracid.data.covariance_matrix import Block, Dense, Diagonal, as_covariance
 from fracid.inverse.forward_operator import RunRecord
 
 
@@ -178,6 +179,34 @@ class SensitivityHistory:
     variance_share: np.ndarray
 
 
+def _prefix_whitening(C_exp) -> bool:
+    """Whether ``C_exp.whiten`` is L^-1 with L its lower Cholesky factor, so that the first t whitened rows
+    depend on the first t observations only (Diagonal, Dense and blocks of them)."""
+    if isinstance(C_exp, Block):
+        return all(_prefix_whitening(block) for block in C_exp.blocks)
+    return isinstance(C_exp, (Diagonal, Dense))
+
+
+def cumulative_information(S, C_exp) -> np.ndarray:
+    """Fisher information of the observations 1..t for every t: S_1:t^T C_1:t^-1 S_1:t, shape (n, p, p).
+
+    With a Cholesky whitening W = L^-1 S (C = L L^T, L lower triangular, so that C_1:t = L_1:t L_1:t^T)
+    it is the running sum of w_t w_t^T: O(n p^2), no n x n matrix; other covariances (low rank) solve
+    every leading block, O(n^2) at least.
+
+    Parameters
+    ----------
+    S : ndarray, shape (n, p)
+        Sensitivities [units of y per unit of each parameter].
+    C_exp : Covariance
+        Covariance of the n observations [units of y squared].
+    """
+    if _prefix_whitening(C_exp):
+        W = C_exp.whiten(S)
+        return np.cumsum(W[:, :, None] * W[:, None, :], axis=0)
+    return np.array([S[: t + 1].T @ C_exp.take(slice(0, t + 1)).solve(S[: t + 1]) for t in range(S.shape[0])])
+
+
 def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sensitivity=None,
                         executor=None) -> SensitivityHistory:
     """Sensitivity of the response along the load history, and what the data up to each step identify.
@@ -188,8 +217,8 @@ def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sens
         The forward operator.
     x : array_like, shape (p,)
         Parameter values (e.g. an estimate or a nominal set).
-    C_exp : ndarray, shape (n, n)
-        Covariance of the measurements.
+    C_exp : ndarray, shape (n, n), or Covariance
+        Covariance of the measurements [units of y squared] (a diagonal one forms no n x n matrix).
     C0 : ndarray, shape (p, p)
         Prior covariance (e.g. from the bounds or from KNN): the reference the shares are taken from.
     names : sequence of str, optional
@@ -201,7 +230,8 @@ def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sens
     if sensitivity is None:
         evaluate, sensitivity = exact_sensitivity(evaluate)
     x = np.asarray(x, dtype=float)
-    C_exp, C0 = np.atleast_2d(np.asarray(C_exp, float)), np.atleast_2d(np.asarray(C0, float))
+    C_exp = as_covariance(C_exp if np.ndim(C_exp) != 0 else np.atleast_2d(C_exp), name="C_exp")
+    C0 = np.atleast_2d(np.asarray(C0, float))
     y, S, _ = sensitivity(evaluate, x, None, executor)
     n, p = S.shape
     if C_exp.shape != (n, n) or C0.shape != (p, p):
@@ -210,13 +240,8 @@ def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sens
     for _, start, stop in blocks or [("all", 0, n)]:
         scale[start:stop] = np.max(np.abs(y[start:stop]))
     normalised = S * x[None, :] / scale[:, None]
-    information = np.empty((n, p, p))
-    variance_share = np.empty((n, p))
-    prior_precision = np.linalg.inv(C0)
-    for t in range(n):
-        St = S[: t + 1]
-        information[t] = St.T @ np.linalg.solve(C_exp[: t + 1, : t + 1], St)
-        posterior = np.linalg.inv(prior_precision + information[t])
-        variance_share[t] = 1.0 - np.diag(posterior) / np.diag(C0)
+    information = cumulative_information(S, C_exp)
+    posterior = np.linalg.inv(np.linalg.inv(C0)[None, :, :] + information)
+    variance_share = 1.0 - np.diagonal(posterior, axis1=1, axis2=2) / np.diag(C0)[None, :]
     return SensitivityHistory(list(names) if names is not None else [f"x{j}" for j in range(p)], x, y, S,
                               normalised, information, variance_share)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.kalman import kalman_filter
 from fracid.parallel import concurrently
 
@@ -63,10 +64,14 @@ class Stability:
 
 
 def noisy_replicates(y, C_noise, n: int, seed: int = 0) -> np.ndarray:
-    """n draws of y + e, e ~ N(0, C_noise), shape (n, len(y)); reproducible from ``seed``."""
+    """n draws of y + e, e ~ N(0, C_noise), shape (n, len(y)); reproducible from ``seed``.
+
+    ``C_noise`` is an array or a :class:`~fracid.data.covariance_matrix.Covariance` [units of y squared];
+    e = L z with C_noise = L L^T (``C_noise.color``), z standard normal: no n x n matrix for a diagonal one.
+    """
     rng = np.random.default_rng(seed)
-    L = np.linalg.cholesky(np.atleast_2d(C_noise))
-    return np.asarray(y, float)[None, :] + rng.standard_normal((n, len(y))) @ L.T
+    C_noise = as_covariance(C_noise if np.ndim(C_noise) != 0 else np.atleast_2d(C_noise), name="C_noise")
+    return np.asarray(y, float)[None, :] + C_noise.color(rng.standard_normal((n, len(y))).T).T
 
 
 def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int = 0, C_noise=None, bounds=None,
@@ -77,16 +82,16 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     ----------
     evaluate : callable(x, needed)
         The forward operator.
-    y_exp, C_exp : ndarray
-        Data and covariance used by the filter.
+    y_exp, C_exp : ndarray, or ndarray and Covariance
+        Data and covariance used by the filter [units of y, and squared].
     x0, C0 : ndarray
         Prior of every replicate (the same for all, so only the noise differs).
     replicates : int
         N >= 2.
     seed : int
         Seed of the noise draws.
-    C_noise : ndarray, optional
-        Covariance of the added noise; C_exp if None.
+    C_noise : ndarray or Covariance, optional
+        Covariance of the added noise [units of y squared]; C_exp if None.
     fit : callable, optional
         The local fit of the replicates, ``fit(evaluate, y, C_exp, x0, C0, bounds=, executor=)`` (an
         inverse method's ``fit_from``); by default the Kalman filter with the settings ``kalman``.
@@ -96,7 +101,7 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     if int(replicates) != replicates or replicates < 2:
         raise ValueError(f"replicates = {replicates!r}: the scatter needs at least 2 replicates")
     y_exp = np.asarray(y_exp, float)
-    C_noise = np.asarray(C_exp if C_noise is None else C_noise, float)
+    C_noise = as_covariance(C_exp if C_noise is None else C_noise, np.size(y_exp), name="C_noise")
     data = noisy_replicates(y_exp, C_noise, int(replicates), seed)
     estimates, errors = np.full((len(data), np.size(x0)), np.nan), []
     stds, done = [], []
@@ -116,6 +121,6 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
             estimates[i], error = result.x, ""
             stds.append(result.std)
         errors.append(error)
-    noise = float(np.sqrt(np.mean(np.diag(C_noise) / np.maximum(y_exp**2, 1e-300))))
+    noise = float(np.sqrt(np.mean(C_noise.diag() / np.maximum(y_exp**2, 1e-300))))
     posterior = np.mean(stds, axis=0) if stds else None
     return Stability(estimates, errors, noise, seed, posterior)

@@ -27,7 +27,7 @@ import numpy as np
 
 from fracid.inverse.knn_kalman import KnnKalman
 from fracid.inverse.method import check_problem, identification_bounds
-from fracid.inverse.methods import StudyMethod
+from fracid.inverse.methods import StudyMethod, with_settings
 from fracid.inverse.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.runs import StoredOperator
 from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
@@ -112,29 +112,11 @@ class StudySettings:
         """
         own = {f.name for f in dataclasses.fields(self)}
         mine = {name: changes.pop(name) for name in list(changes) if name in own}
-        method = _replaced(mine.pop("method", self.method), changes)
+        try:
+            method = with_settings(mine.pop("method", self.method), **changes)
+        except TypeError as err:
+            raise TypeError(f"{err} (or a study setting: {', '.join(sorted(own))})") from None
         return replace(self, method=method, **mine)
-
-
-def _replaced(method, changes: dict):
-    """``method`` with ``changes`` to its fields and to the fields of its settings dataclasses."""
-    if not changes:
-        return method
-    fields = {f.name: getattr(method, f.name) for f in dataclasses.fields(method)}
-    top = {name: changes.pop(name) for name in list(changes) if name in fields}
-    nested = {}
-    for part, value in {**fields, **top}.items():
-        if dataclasses.is_dataclass(value) and not isinstance(value, type):
-            # "method" is the study's (the inverse method): a population design is knn=KnnSettings(method=...)
-            names = {f.name for f in dataclasses.fields(value)} - {"method"}
-            own = {name: changes.pop(name) for name in list(changes) if name in names}
-            if own:
-                nested[part] = replace(value, **own)
-    if changes:
-        known = sorted({f.name for f in dataclasses.fields(StudySettings)} | set(fields)
-                       | {f.name for v in fields.values() if dataclasses.is_dataclass(v) for f in dataclasses.fields(v)})
-        raise TypeError(f"unknown study setting(s) {', '.join(sorted(changes))}; known: {', '.join(known)}")
-    return replace(method, **{**top, **nested})
 
 
 def run_study(operator, data, space, settings: StudySettings = StudySettings(), *, held_out=(), executor=None,

@@ -73,8 +73,9 @@ def estimate_objective(ident, y, C):
 
 def describe_data(operator) -> DataDescription:
     """Number of specimens with a force curve and whether local data are present."""
-    sizes = {obs.run_key[0] for obs in operator.observations if obs.quantity == "force"}
-    return DataDescription(sizes=max(len(sizes), 1), local=any(o.quantity != "force" for o in operator.observations))
+    force = [getattr(obs, "quantity", None) == "force" for obs in operator.observations]
+    sizes = {obs.run_key[0] for obs, is_force in zip(operator.observations, force) if is_force}
+    return DataDescription(sizes=max(len(sizes), 1), local=not all(force))
 
 
 @dataclass

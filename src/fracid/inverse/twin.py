@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.data import ExperimentalData
+from fracid.data import Diagonal, ExperimentalData
 
 
 def synthetic_data(operator, x_true, std, *, seed: int | None = 0) -> ExperimentalData:
@@ -47,8 +47,8 @@ def synthetic_data(operator, x_true, std, *, seed: int | None = 0) -> Experiment
         notes.append(f"twin experiment: block {obs.name!r} computed at {dict(zip(operator.names, np.ravel(x_true)))}, "
                      f"noise std {block_std:.4g}" + ("" if seed is not None else " (not added)"))
     noisy = y if seed is None else y + np.random.default_rng(seed).standard_normal(y.size) * s
-    control = np.concatenate([obs.control_points for obs in operator.observations])
-    return ExperimentalData(control, noisy, np.diag(s**2), tuple(blocks), tuple(notes))
+    control = np.concatenate([obs.controls for obs in operator.observations])
+    return ExperimentalData(control, noisy, Diagonal(s**2), tuple(blocks), tuple(notes))
 
 
 def _block_std(std, name, values) -> float:

@@ -7,15 +7,24 @@ from typing import ClassVar
 
 import numpy as np
 
+from fracid.field_error import FieldError
 from fracid.specimens.checks import require_positive
 from fracid.specimens.description import Description, Load, Measure, Support, ZoneWidth
+from fracid.specimens.protocol import (
+    BAR_BYTES_PER_ELEMENT,
+    MAX_BAR_ELEMENTS,
+    Resolution,
+    SizeEstimate,
+    SpecimenDefaults,
+    bar_resolution,
+)
 
 _WEAKENINGS = ("modulus", "area")
 _PROFILES = ("step", "hat")
 
 
 @dataclass(frozen=True)
-class BarWithWeakZone:
+class BarWithWeakZone(SpecimenDefaults):
     """A bar of length L fixed at x = 0 and pulled at x = L, weakened in a centre zone of width W.
 
     Parameters
@@ -54,19 +63,25 @@ class BarWithWeakZone:
     default_control = "end_displacement"
     controls: ClassVar[tuple] = ("end_displacement", "weak_zone_elongation")
     observables: ClassVar[tuple] = ("damaged_zone_width",)
+    size_field: ClassVar[str] = "length"
+    steps_per_target: ClassVar[None] = None  # the path follower's default steps
 
     def __post_init__(self):
         require_positive(self, ("length", "area", "weak_zone_width"), " [mm or mm^2]")
         if self.weak_zone_width >= self.length:
-            raise ValueError(f"weak_zone_width = {self.weak_zone_width} must be smaller than length = {self.length}")
+            raise FieldError(("weak_zone_width", "length"), self.weak_zone_width,
+                             f"weak_zone_width = {self.weak_zone_width} must be smaller than length = {self.length}")
         if not 0.0 < self.weak_zone_factor <= 1.0:
-            raise ValueError(f"weak_zone_factor = {self.weak_zone_factor!r}; it must be in (0, 1]")
+            raise FieldError("weak_zone_factor", self.weak_zone_factor,
+                             f"weak_zone_factor = {self.weak_zone_factor!r}; it must be in (0, 1]")
         if self.weakening not in _WEAKENINGS:
-            raise ValueError(f"weakening = {self.weakening!r}; choose one of {_WEAKENINGS}")
+            raise FieldError("weakening", self.weakening,
+                             f"weakening = {self.weakening!r}; choose one of {_WEAKENINGS}")
         if self.profile not in _PROFILES:
-            raise ValueError(f"profile = {self.profile!r}; choose one of {_PROFILES}")
+            raise FieldError("profile", self.profile, f"profile = {self.profile!r}; choose one of {_PROFILES}")
         if int(self.n_elements) != self.n_elements or self.n_elements < 3:
-            raise ValueError(f"n_elements = {self.n_elements!r}; it must be an integer >= 3")
+            raise FieldError("n_elements", self.n_elements,
+                             f"n_elements = {self.n_elements!r}; it must be an integer >= 3")
 
     @property
     def characteristic_size(self) -> float:
@@ -85,7 +100,7 @@ class BarWithWeakZone:
         n_weak += (n - n_weak) % 2
         n_out = (n - n_weak) // 2
         if n_out < 1:
-            raise ValueError(f"n_elements = {n} is too few to mesh the weak zone and both outer parts")
+            raise FieldError("n_elements", n, f"n_elements = {n} is too few to mesh the weak zone and both outer parts")
         a, b = 0.5 * (L - W), 0.5 * (L + W)
         return np.concatenate([np.linspace(0, a, n_out + 1), np.linspace(a, b, n_weak + 1)[1:], np.linspace(b, L, n_out + 1)[1:]])
 
@@ -122,3 +137,13 @@ class BarWithWeakZone:
         """A control value well past the peak: 50 times the bar's elongation at the model's
         characteristic strain ``scales["strain"]`` (the strain at damage onset) [mm]."""
         return 50.0 * scales["strain"] * self.length
+
+    def resolution(self, internal_length: float | None = None) -> Resolution:
+        """The element size length / n_elements [mm]; the advice: the n_elements that resolves ``internal_length``."""
+        return bar_resolution(self.length, int(self.n_elements), internal_length)
+
+    def size_estimate(self) -> SizeEstimate:
+        """``n_elements`` bar elements, limited to :data:`~fracid.specimens.protocol.MAX_BAR_ELEMENTS`."""
+        n = int(self.n_elements)
+        return SizeEstimate("n_elements", n, f"{n:,} bar elements", n, "element", BAR_BYTES_PER_ELEMENT,
+                            MAX_BAR_ELEMENTS, "a few elements per internal length l = sqrt(2 c) are enough")

@@ -7,7 +7,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from fracid.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
+from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
@@ -16,7 +18,7 @@ FINE_PER_DEPTH = 0.2  # default fine_width / D: 10 mm at D = 50 mm
 
 
 @dataclass(frozen=True)
-class NotchedBeam:
+class NotchedBeam(FineSizeDefaults):
     """Notched beam in three-point bending; the default geometry is the Gregoire et al. (2013) beam.
 
     The half x >= 0 is meshed (symmetry: u_x = 0 on the ligament above the notch). The load acts on
@@ -68,6 +70,7 @@ class NotchedBeam:
     default_control = "cmod"
     controls: ClassVar[tuple] = ("cmod", "deflection")
     observables: ClassVar[tuple] = ("fpz_width",)
+    size_field: ClassVar[str] = "depth"
 
     def __post_init__(self):
         require_positive(self, ("depth", "thickness", "length", "span", "notch_depth", "notch_width", "plate_width",
@@ -75,11 +78,14 @@ class NotchedBeam:
         resolve_defaults(self, {"h_coarse": self._default_coarse, "fine_width": self._default_fine_width})
         require_positive(self, ("h_coarse", "fine_width"), " [mm]")
         if not self.span <= self.length:
-            raise ValueError(f"span = {self.span} must not exceed length = {self.length} (S = L: supports at the ends)")
+            raise FieldError(("span", "length"), self.span,
+                             f"span = {self.span} must not exceed length = {self.length} (S = L: supports at the ends)")
         if not self.notch_depth < self.depth:
-            raise ValueError(f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
+            raise FieldError(("notch_depth", "depth"), self.notch_depth,
+                             f"notch_depth = {self.notch_depth} must be smaller than depth = {self.depth}")
         if not self.notch_width / 2 < self.fine_width < self.span / 2 - self.plate_width / 2:
-            raise ValueError(f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
+            raise FieldError(("fine_width", "notch_width", "span"), self.fine_width,
+                             f"fine_width = {self.fine_width} must lie between notch_width/2 and span/2")
 
     def _default_coarse(self) -> float:
         """h_coarse when not given: D / 12.5, at least h_fine [mm]."""
@@ -161,12 +167,6 @@ class NotchedBeam:
             crack=CrackPath("ligament", normal=0, mirrored=True, element_size=self.h_fine),
             zone=ZoneWidth("fpz_width", axis=0, mirror=True, along_range=(self.notch_depth, self.depth)),
         )
-
-    def default_steps(self, target: float):
-        """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
-        from fracid.fem.path_following import StepOptions
-
-        return StepOptions(maximum=target / 60)
 
     def default_target(self, scales) -> float:
         """CMOD 0.3 mm, whatever the model (``scales``: its characteristic strain and opening)."""

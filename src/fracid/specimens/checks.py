@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from fracid.field_error import FieldError
+
 
 def require_positive(specimen, names, unit: str = "") -> None:
     """Raise ValueError naming the class, field and value unless every field in ``names`` is a
@@ -11,7 +13,8 @@ def require_positive(specimen, names, unit: str = "") -> None:
     for name in names:
         value = getattr(specimen, name)
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ValueError(f"{type(specimen).__name__}.{name} = {value!r}; it must be a positive number{unit}")
+            raise FieldError(name, value,
+                             f"{type(specimen).__name__}.{name} = {value!r}; it must be a positive number{unit}")
 
 
 def resolve_defaults(specimen, defaults) -> None:

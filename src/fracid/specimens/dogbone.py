@@ -8,13 +8,15 @@ from typing import ClassVar
 
 import numpy as np
 
+from fracid.field_error import FieldError
 from fracid.specimens.checks import require_positive
+from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
 
 @dataclass(frozen=True)
-class DogBone:
+class DogBone(FineSizeDefaults):
     """Dog-bone specimen of size D: width D, height 1.5 D, circular side notches of radius 0.725 D
     reducing the width to 0.6 D at mid-height, thickness 100 mm; ends glued to loading platens.
 
@@ -76,6 +78,7 @@ class DogBone:
     default_control = "elongation"
     controls: ClassVar[tuple] = ("elongation", "platen_displacement")
     observables: ClassVar[tuple] = ("fpz_width",)
+    size_field: ClassVar[str] = "size"
 
     def __post_init__(self):
         optional = ("gauge_length", "fine_height", "h_coarse")  # None: derived from the size
@@ -83,17 +86,21 @@ class DogBone:
                                             "notch_radius", "notch_width")
                                 if not (n in optional and getattr(self, n) is None)])
         if not self.notch_width < 1.0 or (1.0 - self.notch_width) / 2 > self.notch_radius:
-            raise ValueError(f"notch_width = {self.notch_width} and notch_radius = {self.notch_radius}: "
+            raise FieldError(("notch_width", "notch_radius"), self.notch_width,
+                             f"notch_width = {self.notch_width} and notch_radius = {self.notch_radius}: "
                              "the notch must narrow the width (notch_width < 1) and fit its radius")
         if self.platens not in ("glued", "hinged"):
-            raise ValueError(f"DogBone.platens = {self.platens!r}; choose 'glued' or 'hinged'")
+            raise FieldError("platens", self.platens, f"DogBone.platens = {self.platens!r}; choose 'glued' or 'hinged'")
         for name in ("platen_height", "platen_stiffness"):
             if not getattr(self, name) > 0:
-                raise ValueError(f"DogBone.{name} = {getattr(self, name)!r}; it must be positive")
+                raise FieldError(name, getattr(self, name),
+                                 f"DogBone.{name} = {getattr(self, name)!r}; it must be positive")
         if not abs(self.hinge_offset) < 0.5 * self.size or (self.hinge_offset and self.platens != "hinged"):
-            raise ValueError(f"DogBone.hinge_offset = {self.hinge_offset!r} mm: it needs hinged platens and |offset| < D/2")
+            raise FieldError("hinge_offset", self.hinge_offset,
+                             f"DogBone.hinge_offset = {self.hinge_offset!r} mm: it needs hinged platens and |offset| < D/2")
         if self._gauge / 2 >= 0.75 * self.size:
-            raise ValueError(f"gauge_length = {self._gauge} mm must be shorter than the height 1.5 D")
+            raise FieldError("gauge_length", self._gauge,
+                             f"gauge_length = {self._gauge} mm must be shorter than the height 1.5 D")
 
     @property
     def _gauge(self) -> float:
@@ -194,12 +201,6 @@ class DogBone:
             functionals={"elongation": (Measure("gauge", 1, 2.0),), "platen_displacement": (Measure("top", 1, 2.0),)},
             symmetry_factor=4.0, symmetry_planes=((0, 0.0), (1, 0.0)),
             zone=ZoneWidth("fpz_width", axis=1, mirror=True, along_range=(0.0, half)), **common)
-
-    def default_steps(self, target: float):
-        """Adaptive steps capped at 1/60 of the target, so the softening branch takes tens of steps."""
-        from fracid.fem.path_following import StepOptions
-
-        return StepOptions(maximum=target / 60)
 
     def default_target(self, scales) -> float:
         """Elongation well past the peak: 20 times the gauge length times the model's characteristic

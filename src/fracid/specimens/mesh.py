@@ -14,14 +14,17 @@ this module checks the groups against the mesh and writes a description's mesh a
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.mesh_reading import MeshError, PlaneMesh, mesh_size, mesh_unknowns, plane_mesh, read_mesh
+from fracid.specimens.protocol import BYTES_PER_UNKNOWN, MAX_UNKNOWNS, Resolution, SizeEstimate, SpecimenDefaults
 
 __all__ = ["MeshError", "MeshSpecimen", "PlaneMesh", "mesh_size", "mesh_unknowns", "plane_mesh", "read_mesh",
            "write_gmsh"]
@@ -30,7 +33,7 @@ _COMPONENTS = {"x": 0, "y": 1}
 
 
 @dataclass(frozen=True)
-class MeshSpecimen:
+class MeshSpecimen(SpecimenDefaults):
     """A plane-stress test described by a Gmsh mesh and the names of its physical groups.
 
     Parameters
@@ -81,6 +84,9 @@ class MeshSpecimen:
     regions: tuple = ()
     checksum: str = ""
 
+    #: ``[specimen] type = "mesh"`` is read by its own section (file, group lists), not by its fields
+    config_section: ClassVar[str] = "fracid.config.mesh_section:SECTION"
+
     def __post_init__(self):
         if not self.checksum and os.path.isfile(self.path):
             with open(self.path, "rb") as handle:
@@ -101,8 +107,35 @@ class MeshSpecimen:
         return ("fpz_width",) if self.crack else ()
 
     @property
+    def control_names(self) -> tuple:
+        """The names of its controls (``controls`` holds their definitions); the first is the default."""
+        return tuple(name for name, _ in self.controls)
+
+    @property
     def default_control(self) -> str:
         return self.controls[0][0]
+
+    @classmethod
+    def default_instance(cls):
+        """None: a mesh specimen needs its file and group names."""
+        return None
+
+    def options_text(self, options: dict) -> str:
+        """The mesh file (its groups are in the configuration)."""
+        return f"file {self.path}"
+
+    def resolution(self, internal_length: float | None = None) -> Resolution:
+        """The smallest element side of the mesh [mm], set by the file."""
+        return dataclasses.replace(super().resolution(internal_length), field="file", value=self.path)
+
+    def size_estimate(self) -> SizeEstimate:
+        """The unknowns once the mid-edge nodes are added, counted from the file without building the mesh."""
+        n_vertices, n_cells = mesh_size(self.path)
+        unknowns = mesh_unknowns(n_vertices, n_cells)
+        return SizeEstimate("file", self.path, f"{n_cells:,} elements and {n_vertices:,} corner nodes, about "
+                            f"{unknowns:,} unknowns once fracid adds the mid-edge nodes", unknowns, "unknown",
+                            BYTES_PER_UNKNOWN, MAX_UNKNOWNS, "use a coarser mesh (small elements only where the crack "
+                            "runs; a few elements per internal length l = sqrt(2 c) are enough)")
 
     def describe(self) -> Description:
         return self.describe_mesh(read_mesh(self.path))
@@ -210,13 +243,6 @@ class MeshSpecimen:
         for _, terms in self.controls:
             for group, *_ in terms:
                 yield group
-
-    def default_steps(self, target: float):
-        """Adaptive steps capped at 1/60 of the target (as the notched beam), so the softening branch
-        takes tens of steps."""
-        from fracid.fem.path_following import StepOptions
-
-        return StepOptions(maximum=target / 60)
 
     def default_target(self, scales) -> float:
         raise ValueError(f"a mesh specimen has no default target: give target= (the final {self.default_control} "

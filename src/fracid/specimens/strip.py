@@ -7,13 +7,15 @@ from typing import ClassVar
 
 import numpy as np
 
+from fracid.field_error import FieldError
 from fracid.specimens.checks import require_positive
+from fracid.specimens.protocol import Resolution, SizeEstimate, SpecimenDefaults, bar_resolution, plane_estimate
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support
-from fracid.specimens.meshing import structured_quad8
+from fracid.specimens.meshing import quad8_grid_size, structured_quad8
 
 
 @dataclass(frozen=True)
-class TensionStrip:
+class TensionStrip(SpecimenDefaults):
     """Plane-stress strip L x H (thickness t) pulled by a rigid platen at x = L, held at x = 0.
 
     The element column at mid-length is weaker (tensile strength times ``weak_factor``) so the crack
@@ -42,22 +44,38 @@ class TensionStrip:
     default_control = "band_opening"
     controls: ClassVar[tuple] = ("band_opening", "elongation")
     observables: ClassVar[tuple] = ()
+    steps_per_target: ClassVar[float] = 50.0
 
     def __post_init__(self):
         require_positive(self, ("length", "height", "thickness"), " [mm]")
         if not (isinstance(self.n_elements, int) and self.n_elements >= 3 and self.n_elements % 2 == 1):
-            raise ValueError(f"TensionStrip.n_elements = {self.n_elements!r}; it must be an odd integer >= 3 "
+            raise FieldError("n_elements", self.n_elements,
+                             f"TensionStrip.n_elements = {self.n_elements!r}; it must be an odd integer >= 3 "
                              "(the weak column sits in the middle)")
         if not 0.0 < self.weak_factor <= 1.0:
-            raise ValueError(f"TensionStrip.weak_factor = {self.weak_factor!r}; it must be in (0, 1]")
+            raise FieldError("weak_factor", self.weak_factor,
+                             f"TensionStrip.weak_factor = {self.weak_factor!r}; it must be in (0, 1]")
 
     @property
     def element_size(self) -> float:
         return self.length / self.n_elements
 
+    @property
+    def _rows(self) -> int:
+        return max(1, round(self.height / self.element_size))
+
     def mesh(self):
-        rows = max(1, round(self.height / self.element_size))
-        return structured_quad8(np.linspace(0.0, self.length, self.n_elements + 1), np.linspace(0.0, self.height, rows + 1))
+        return structured_quad8(np.linspace(0.0, self.length, self.n_elements + 1),
+                                np.linspace(0.0, self.height, self._rows + 1))
+
+    def resolution(self, internal_length: float | None = None) -> Resolution:
+        """The element size length / n_elements [mm] (square elements)."""
+        return bar_resolution(self.length, self.n_elements, internal_length)
+
+    def size_estimate(self) -> SizeEstimate:
+        """The unknowns of the n_elements x rows grid, counted without building it."""
+        return plane_estimate("n_elements", self.n_elements, *quad8_grid_size(self.n_elements, self._rows),
+                              "use fewer n_elements")
 
     def describe(self) -> Description:
         """The strip held at x = 0 (one node also vertically), pulled by a rigid platen at x = L, the
@@ -77,12 +95,6 @@ class TensionStrip:
             strength_factor=lambda points: np.where(centre(points), self.weak_factor, 1.0),
             crack=CrackPath(None, normal=0, mirrored=False),
         )
-
-    def default_steps(self, target: float):
-        """Adaptive steps capped at 1/50 of the target."""
-        from fracid.fem.path_following import StepOptions
-
-        return StepOptions(maximum=target / 50)
 
     def default_target(self, scales) -> float:
         """Band opening 0.99 wc [mm] (wc = ``scales["opening"]`` of the weak column, which keeps Gf at a

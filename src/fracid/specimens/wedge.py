@@ -12,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fracid.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
+from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import Description
 from fracid.specimens.mesh import MeshSpecimen, plane_mesh
 from fracid.specimens.meshing import graded_lines, structured_quad8
@@ -21,7 +23,7 @@ COARSE_PER_SIZE = 0.125  # default h_coarse / min(width, height): 25 mm for the 
 
 
 @dataclass(frozen=True)
-class WedgeSplitting:
+class WedgeSplitting(FineSizeDefaults):
     """Half of a wedge-splitting specimen (x >= 0, the notch plane x = 0 a symmetry line), plane stress.
 
     The wedge of full angle ``wedge_angle`` pushes the loading pieces on the groove walls at height
@@ -104,18 +106,22 @@ class WedgeSplitting:
         resolve_defaults(self, {"h_coarse": lambda: max(self.h_fine, COARSE_PER_SIZE * min(self.width, self.height))})
         require_positive(self, ("h_coarse",), " [mm]")
         if not self.notch_width < self.groove_width < self.width:
-            raise ValueError(f"need notch_width = {self.notch_width} < groove_width = {self.groove_width} < "
+            raise FieldError(("notch_width", "groove_width", "width"), self.notch_width,
+                             f"need notch_width = {self.notch_width} < groove_width = {self.groove_width} < "
                              f"width = {self.width}")
         if not self.groove_depth < self.notch_depth < self.height:
-            raise ValueError(f"need groove_depth = {self.groove_depth} < notch_depth = {self.notch_depth} < "
+            raise FieldError(("groove_depth", "notch_depth", "height"), self.groove_depth,
+                             f"need groove_depth = {self.groove_depth} < notch_depth = {self.notch_depth} < "
                              f"height = {self.height}")
         piece = (self.load_height - self.load_piece / 2, self.load_height + self.load_piece / 2)
         if not (self.height - self.groove_depth <= piece[0] and piece[1] <= self.height):
-            raise ValueError(f"load_height = {self.load_height} with load_piece = {self.load_piece}: the loading "
+            raise FieldError(("load_height", "load_piece"), self.load_height,
+                             f"load_height = {self.load_height} with load_piece = {self.load_piece}: the loading "
                              f"piece must lie on the groove wall, between y = {self.height - self.groove_depth:g} "
                              f"and {self.height:g}")
         if not 0.0 < self.wedge_angle < 180.0:
-            raise ValueError(f"wedge_angle = {self.wedge_angle} degrees; it must be in (0, 180)")
+            raise FieldError("wedge_angle", self.wedge_angle,
+                             f"wedge_angle = {self.wedge_angle} degrees; it must be in (0, 180)")
 
     @property
     def ligament(self) -> float:
@@ -180,12 +186,6 @@ class WedgeSplitting:
         groups["support"] = {"vertex": np.array([0])}
         points = np.column_stack([corners, np.zeros(len(corners))])
         return self.mesh_specimen().describe_mesh(plane_mesh(points, blocks, groups, "wedge-splitting specimen"))
-
-    def default_steps(self, target: float):
-        """Adaptive steps capped at 1/60 of the target."""
-        from fracid.fem.path_following import StepOptions
-
-        return StepOptions(maximum=target / 60)
 
     def default_target(self, scales) -> float:
         """An opening of 2 wc at the load line when the model has a crack opening scale (wc), else 1 mm."""

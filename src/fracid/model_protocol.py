@@ -1,0 +1,98 @@
+"""The written contract of a forward model, :class:`ForwardModel` (described in :mod:`fracid.models`),
+the defaults of a model that declares only ``key``, ``parameters`` and ``simulate``
+(:class:`ModelDefaults`, :func:`declared`) and :func:`runs_on`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Protocol, runtime_checkable
+
+
+@runtime_checkable
+class ForwardModel(Protocol):
+    """The written contract of a forward model (see the module docstring)."""
+
+    key: str
+    parameters: type
+    differentiable: tuple
+    differentiates_observers: bool
+    observer_names: tuple
+    regularization: str | None
+
+    def simulate(self, specimen, params, **options): ...
+
+    def runs_on(self, specimen) -> bool: ...
+
+    def why_not(self, specimen) -> str | None: ...
+
+    def scales(self, params) -> dict: ...
+
+    def default_target(self, specimen, params) -> float: ...
+
+
+class ModelDefaults:
+    """The capabilities of a model that declares nothing more than ``key``, ``parameters`` and ``simulate``:
+    it runs on every specimen, differentiates nothing, has no observers of its own and no regularisation,
+    and takes the specimen's default target with no characteristic scales."""
+
+    differentiable: ClassVar[tuple] = ()
+    differentiates_observers: ClassVar[bool] = False
+    observer_names: ClassVar[tuple] = ()
+    regularization: ClassVar[str | None] = None
+
+    def why_not(self, specimen) -> str | None:
+        return None
+
+    def runs_on(self, specimen) -> bool:
+        return self.why_not(specimen) is None
+
+    def scales(self, params) -> dict:
+        return {}
+
+    def default_target(self, specimen, params) -> float:
+        """The specimen's default final control value for this model with ``params`` [mm]."""
+        return specimen.default_target(self.scales(params))
+
+
+@dataclass(frozen=True)
+class _Declared(ModelDefaults):
+    """A model of a few lines with the capabilities of :class:`ModelDefaults` (:func:`declared`)."""
+
+    model: object
+
+    @property
+    def key(self) -> str:
+        return self.model.key
+
+    @property
+    def parameters(self) -> type:
+        return self.model.parameters
+
+    def simulate(self, specimen, params, **options):
+        return self.model.simulate(specimen, params, **options)
+
+
+def declared(model) -> ForwardModel:
+    """``model`` itself when it declares every capability of :class:`ForwardModel`, else ``model``
+    completed with the defaults of :class:`ModelDefaults` (it must have ``key``, ``parameters`` and
+    ``simulate``).
+
+    Raises
+    ------
+    TypeError
+        When ``model`` lacks ``key``, ``parameters`` or ``simulate``.
+    """
+    if isinstance(model, ForwardModel):
+        return model
+    missing = [name for name in ("key", "parameters", "simulate") if not hasattr(model, name)]
+    if missing:
+        raise TypeError(f"model = {model!r} is no forward model: it lacks {', '.join(missing)} (see fracid.models)")
+    return _Declared(model)
+
+
+def runs_on(model, specimen) -> bool:
+    """Whether ``model`` can run on ``specimen`` (an instance or its class: its default instance); a
+    model that declares no ``runs_on`` (:func:`declared`) runs on every specimen."""
+    if isinstance(specimen, type):
+        specimen = specimen()
+    return declared(model).runs_on(specimen)

@@ -1,0 +1,247 @@
+"""The written contract of a specimen (:class:`Specimen`) and the defaults most specimens share
+(:class:`SpecimenDefaults`).
+
+A specimen says what a test is: its :class:`~fracid.specimens.description.Description`, the named
+controls (the first the default), the local observables its damage models record [mm], its default
+target and steps, the field a size-effect series scales, and its limits: how fine its mesh is
+(:class:`Resolution`) and how much memory a forward run needs (:class:`SizeEstimate`). The
+configuration asks the specimen these things instead of branching on its type name, so a specimen
+registered in :data:`fracid.specimens.SPECIMENS` (from a test file too) is read, checked and run like
+the built-in ones.
+
+The memory limits live here (measured on forward runs) and are re-exported by :mod:`fracid.config`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+
+#: largest number of bar elements: about 4 kB each in a forward run (measured), so 2e5 elements
+#: take about 1 GB; 1e8 elements hung the machine
+MAX_BAR_ELEMENTS = 200_000
+
+#: measured memory of a forward run of the bar per element [bytes]
+BAR_BYTES_PER_ELEMENT = 4_000
+
+#: largest number of unknowns (2 displacements per node + 1 nonlocal strain per vertex) of a 2D
+#: mesh: about 6 kB each in a forward run (measured, before the sparse factorisation's own
+#: memory), so 2e6 unknowns take about 12 GB, and every step factorises the matrix again
+MAX_UNKNOWNS = 2_000_000
+
+#: measured memory of a forward run of the 2D specimens per unknown [bytes]
+BYTES_PER_UNKNOWN = 6_000
+
+#: the advice of a mesh specimen whose element size is a field
+_FIELD_ADVICE = "use {field} <= l/2"
+_ENOUGH = "a few elements per internal length l = sqrt(2 c) are enough"
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """How fine a specimen's mesh is where the damage localises.
+
+    Parameters
+    ----------
+    field : str or None
+        The configuration key that sets the element size (``"h_fine"``, ``"n_elements"``, ``"file"``),
+        None if no key does.
+    value : object
+        That key's value (a number, or the mesh file's path).
+    h : float
+        The element size [mm] (in the process zone, or the smallest side of a mesh).
+    text : str
+        The element size in words, e.g. ``"the element size h_fine = 1 mm"``.
+    advice : str
+        What to change to resolve an internal length (the words of a warning).
+    """
+
+    field: str | None
+    value: object
+    h: float
+    text: str
+    advice: str
+
+
+@dataclass(frozen=True)
+class SizeEstimate:
+    """The size of a forward run's problem, estimated from the geometry without building the mesh.
+
+    Parameters
+    ----------
+    field : str or None
+        The configuration key that sets the size (``"h_fine"``, ``"n_elements"``), None if none.
+    value : object
+        That key's value.
+    summary : str
+        The size in words, e.g. ``"about 1,200 elements and 9,800 unknowns"``.
+    count : int
+        The number of the limited items (bar elements or unknowns).
+    unit : str
+        Their name in the singular (``"element"``, ``"unknown"``).
+    bytes_per : int
+        Measured memory of a forward run per item [bytes].
+    limit : int
+        The largest count a configuration accepts.
+    advice : str
+        What to change to make the problem smaller.
+    """
+
+    field: str | None
+    value: object
+    summary: str
+    count: int
+    unit: str
+    bytes_per: int
+    limit: int
+    advice: str
+
+    @property
+    def memory(self) -> float:
+        """Estimated memory of a forward run [bytes]."""
+        return float(self.count) * self.bytes_per
+
+    @property
+    def too_large(self) -> bool:
+        return self.count > self.limit
+
+
+@runtime_checkable
+class Specimen(Protocol):
+    """What every specimen of :data:`fracid.specimens.SPECIMENS` provides (a test checks each).
+
+    ``control_names`` are the names of its controls (the first is ``default_control``; a mesh
+    specimen's ``controls`` field holds their definitions), ``observables`` the local observables its
+    damage models record [mm], ``size_field`` the field a size-effect series scales (None: no series).
+    ``config_section`` names the module attribute ``"module:name"`` that reads and checks its
+    ``[specimen]`` section when that is not its dataclass fields (None: the fields are the keys).
+    ``default_instance()`` is the specimen with its defaults (None when it needs the user's input).
+    """
+
+    size_field: str | None
+    config_section: str | None
+
+    @property
+    def control_names(self) -> tuple: ...
+
+    @property
+    def observables(self) -> tuple: ...
+
+    @property
+    def default_control(self) -> str: ...
+
+    def describe(self): ...
+
+    def default_target(self, scales) -> float: ...
+
+    def default_steps(self, target: float): ...
+
+    def resolution(self, internal_length: float | None = None) -> Resolution: ...
+
+    def size_estimate(self) -> SizeEstimate: ...
+
+    def options_text(self, options: dict) -> str: ...
+
+    @classmethod
+    def default_instance(cls): ...
+
+
+def element_sides(description) -> tuple:
+    """(smallest, largest) element side of a description [mm]: corner to corner (2D), element length (bar)."""
+    cells = description.cells
+    if description.dim == 1:  # vertex i is node 2 i
+        lengths = np.abs(np.diff(description.nodes[2 * cells][..., 0], axis=1))
+    else:
+        corners = description.nodes[description.corners]
+        lengths = np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=-1)
+    return float(lengths.min()), float(lengths.max())
+
+
+def plane_estimate(field: str | None, value, elements: int, nodes: int, vertices: int, advice: str) -> SizeEstimate:
+    """The :class:`SizeEstimate` of a plane mesh of ``elements`` 8-node (or 6-node) elements, ``nodes``
+    nodes and ``vertices`` corner nodes: 2 displacements per node + 1 nonlocal strain per vertex."""
+    unknowns = 2 * int(nodes) + int(vertices)
+    return SizeEstimate(field, value, f"about {int(elements):,} elements and {unknowns:,} unknowns", unknowns,
+                        "unknown", BYTES_PER_UNKNOWN, MAX_UNKNOWNS, advice)
+
+
+class SpecimenDefaults:
+    """Defaults of the :class:`Specimen` members for a specimen class to inherit.
+
+    ``controls`` (a class attribute of names) gives ``control_names`` and ``default_control``;
+    ``steps_per_target`` the default steps (at most ``target / steps_per_target``; None: the path
+    follower's defaults); the resolution and size are those of the described mesh (a specimen whose
+    element size is a field says so by overriding :meth:`resolution` and :meth:`size_estimate`).
+    """
+
+    size_field: ClassVar[str | None] = None
+    config_section: ClassVar[str | None] = None
+    steps_per_target: ClassVar[float | None] = 60.0
+    observables: ClassVar[tuple] = ()
+
+    @property
+    def control_names(self) -> tuple:
+        return tuple(self.controls)
+
+    @property
+    def default_control(self) -> str:
+        return self.control_names[0]
+
+    def default_steps(self, target: float):
+        """Adaptive steps capped at ``target / steps_per_target``, so the softening branch takes tens of steps."""
+        from fracid.fem.path_following import StepOptions
+
+        return StepOptions() if self.steps_per_target is None else StepOptions(maximum=target / self.steps_per_target)
+
+    def resolution(self, internal_length: float | None = None) -> Resolution:
+        """The smallest element side of the described mesh [mm] (no field sets it)."""
+        h = element_sides(self.describe())[0]
+        return Resolution(None, None, h, f"its smallest element side, {h:.3g} mm,",
+                          "refine the mesh where the crack runs to sides <= l/2")
+
+    def size_estimate(self) -> SizeEstimate:
+        """The size of the described mesh (built once: override for a large mesh)."""
+        d = self.describe()
+        return plane_estimate(None, None, len(d.cells), len(d.nodes), d.n_vertices, f"use a coarser mesh ({_ENOUGH})")
+
+    def options_text(self, options: dict) -> str:
+        """The options given in ``[specimen]`` in words: ``"depth = 100, h_fine = 2"``, or ``"defaults"``."""
+        return ", ".join(f"{k} = {v}" for k, v in options.items()) or "defaults"
+
+    @classmethod
+    def default_instance(cls):
+        """The specimen with its default fields (None for one that needs the user's input, e.g. a file)."""
+        return cls()
+
+
+class FineSizeDefaults(SpecimenDefaults):
+    """The resolution and size of a plane specimen meshed with ``h_fine`` in its process zone and a
+    ``mesh_size()`` method that counts its mesh from the geometry."""
+
+    def resolution(self, internal_length: float | None = None) -> Resolution:
+        h = float(self.h_fine)
+        return Resolution("h_fine", self.h_fine, h, f"the element size h_fine = {h:g} mm",
+                          _FIELD_ADVICE.format(field="h_fine"))
+
+    def size_estimate(self) -> SizeEstimate:
+        return plane_estimate("h_fine", self.h_fine, *self.mesh_size(), f"use a larger h_fine ({_ENOUGH})")
+
+
+def bar_resolution(length: float, n_elements: int, internal_length: float | None) -> Resolution:
+    """The :class:`Resolution` of a uniform mesh of ``n_elements`` along ``length`` [mm]: the advice is
+    the element count that gives h <= l/2 (or says it is beyond :data:`MAX_BAR_ELEMENTS`)."""
+    h = length / n_elements
+    advice = "use n_elements >= 2 length / l (h <= l/2)"
+    if internal_length is not None:
+        needed = 2.0 * length / internal_length
+        advice = (f"use n_elements >= {int(np.ceil(needed))} (h <= l/2)" if needed <= MAX_BAR_ELEMENTS else
+                  f"that needs {needed:.3g} elements, beyond the limit {MAX_BAR_ELEMENTS}: is c in mm^2?")
+    return Resolution("n_elements", n_elements, h, f"the element size length / n_elements = {h:.3g} mm", advice)
+
+
+def field_names(cls) -> tuple:
+    """The dataclass fields of a specimen class (its ``[specimen]`` keys besides type and control)."""
+    return tuple(f.name for f in dataclasses.fields(cls)) if dataclasses.is_dataclass(cls) else ()
