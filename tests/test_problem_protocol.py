@@ -6,7 +6,7 @@ import pytest
 
 import fracid
 from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.protocol import Problem
+from fracid.fem.protocol import Problem, allocate_history, initial_history
 from fracid.models import MODEL_TYPES, model_from_type, runs_on
 from fracid.specimens import DogBone, NotchedBeam
 
@@ -21,6 +21,8 @@ def test_every_problem_implements_the_protocol(kind):
     assert isinstance(problem, Problem)
     assert set(problem.functionals) == {"cmod", "deflection"} and problem.load_vector.shape == (problem.n_free,)
     assert set(problem.blocks) <= {"u", "ebar"} and problem.element_dofs.max() < problem.n_free
+    # its declared history is the layout of the history the path starts from
+    assert np.shape(allocate_history(problem.history_spec, problem.disc)) == np.shape(initial_history(problem))
 
 
 def test_the_cohesive_problem_keeps_no_state_between_calls():
@@ -40,11 +42,16 @@ def test_the_cohesive_problem_keeps_no_state_between_calls():
 
 
 def test_tolerances_per_named_field():
-    options = fracid.NewtonOptions(rtol_u=1e-9, field_rtol={"crack": 1e-6})
-    assert options.tolerance("u") == 1e-9 and options.tolerance("ebar") == 1e-8 and options.tolerance("crack") == 1e-6
-    assert options.tolerance("other") == 1e-9
+    options = fracid.NewtonOptions(rtol_u=1e-9, field_rtol={"crack": 1e-6, "ebar": 1e-7})
+    assert options.tolerance("u") == 1e-9 and options.tolerance("ebar") == 1e-7 and options.tolerance("crack") == 1e-6
+    assert options.tolerance("other") == 1e-9  # a field named nowhere gets rtol_u
     with pytest.raises(ValueError, match=r"field_rtol\['crack'\]"):
         fracid.NewtonOptions(field_rtol={"crack": 0.0})
+
+
+def test_the_removed_ebar_tolerance_names_its_replacement():
+    with pytest.raises(TypeError, match=r"rtol_ebar.*removed.*field_rtol=\{'ebar': 1e-06\}"):
+        fracid.NewtonOptions(rtol_ebar=1e-6)
 
 
 def test_a_model_that_does_not_run_on_a_specimen_says_why():

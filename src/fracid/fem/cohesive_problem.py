@@ -21,6 +21,7 @@ from fracid.fem.cohesive import hordijk_envelope
 from fracid.fem.elements import gauss_line, line_quadratic
 from fracid.fem.level_sets import superlevel_length
 from fracid.fem.problem import ElasticProblem
+from fracid.fem.protocol import HistoryVariable
 from fracid.fem.tsl import differentiable, secant_unloading, secant_unloading_parameter_derivatives
 
 _GAUSS = 3
@@ -180,9 +181,10 @@ class CohesiveCrackProblem(ElasticProblem):
         self.dA = thickness * jac[:, None] * weights[None, :]  # crack area per edge Gauss point [mm^2]
         self.y = positions[:, [0]] + (1.0 + s[None, :]) * jac[:, None]  # Gauss points along the path [mm]
 
-    def initial_history(self):
-        """Largest opening reached at each crack Gauss point [mm], shape (n_edges, n_g)."""
-        return np.zeros(self.dA.shape)
+    @property
+    def history_spec(self) -> dict:
+        """The largest opening reached at each crack Gauss point [mm], shape (n_edges, n_g)."""
+        return {"crack_opening_max": HistoryVariable(points=self.dA.shape)}
 
     def openings(self, q):
         """Crack opening at the Gauss points [mm]: twice the normal displacement away from the line."""
@@ -217,12 +219,12 @@ class CohesiveCrackProblem(ElasticProblem):
         y, w = self.y.ravel()[order], w_max.ravel()[order]
         return superlevel_length(y, w, self.law.strength(self.params) / self.penalty, y[0], y[-1])
 
-    def fields(self, q, w_max, omega):
-        out = super().fields(q, np.zeros(self.disc.weights.shape), omega)
+    def fields(self, q, w_max, arrays):
+        out = super().fields(q, np.zeros(self.disc.weights.shape), arrays)
         out.update(crack_opening_max=w_max.copy())
         return out
 
-    def elastic_energy(self, q, w_max, omega):
+    def elastic_energy(self, q, w_max, arrays):
         """Bulk strain energy plus the energy the crack gives back on unloading (penalty and secant) [N mm]."""
         w = self.openings(q)
         sigma, _, _ = self._traction(w, w_max)

@@ -11,7 +11,7 @@ from fracid.fem.crack_band import (band_damage, band_damage_parameter_derivative
                                    crack_direction_stress, crack_direction_stress_nu_derivative, element_mean,
                                    snap_back_limit)
 from fracid.fem.damage import update_history
-from fracid.fem.forms import ElementArrays, _btdb
+from fracid.fem.forms import ElementArrays, _btdb, point_outputs
 from fracid.fem.problem import ContinuumProblem
 from fracid.fem.tsl import ScaledLaw, differentiable
 
@@ -103,11 +103,12 @@ class CrackBandProblem(ContinuumProblem):
         self._tangent -= np.einsum("ei,ej->eij", np.einsum("eqsi,eqs->ei", B, a * w[..., None]),
                                    np.einsum("eqs,eqsj->ej", b, self.const.DB))
         residual = assemble_vector(self.element_dofs, forces, self.n_free)
-        arrays = ElementArrays(forces, self._tangent, {"u": forces}, kappa, omega)
+        arrays = ElementArrays(forces, self._tangent, {"u": forces}, kappa, outputs={"omega": omega})
         return residual, arrays, {"u": norm2(residual)}
 
-    def elastic_energy(self, q, kappa, omega):
+    def elastic_energy(self, q, kappa, arrays):
         """Energy recovered on unloading to zero stress, 1/2 int eps . sigma dV (secant unloading) [N mm]."""
+        omega = point_outputs(arrays)["omega"]
         ue = self.gather(q)
         eps = np.einsum("eqsi,ei->eqs", self.disc.strain_operator, ue)
         s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)

@@ -27,6 +27,7 @@ import numpy as np
 
 from fracid.fem.assembly import dot
 from fracid.fem.linear_solvers import factorize
+from fracid.fem.protocol import initial_history
 
 
 class PathDerivatives:
@@ -62,7 +63,7 @@ class PathDerivatives:
                              f"differentiates {list(problem.differentiable)}")
         self.problem, self.names = problem, tuple(names)
         p = len(self.names)
-        self.history_rate = np.zeros(np.shape(problem.initial_history()) + (p,))
+        self.history_rate = _rates_like(initial_history(problem), p)
         self.load_point = problem.symmetry_factor * problem.load_vector
         self.observers = {name: fn for name, fn in (observers or {}).items() if getattr(fn, "differentiable", False)}
         keys = ["force", "load_point", "work", "elastic", *problem.functionals, *self.observers]
@@ -99,7 +100,7 @@ class PathDerivatives:
         for name, vector in problem.functionals.items():
             rec[name].append(np.einsum("i,ip->p", vector, dq))
         for name, observer in self.observers.items():
-            rec[name].append(observer.derivative(problem, arrays.kappa, self.history_rate, self.names))
+            rec[name].append(observer.derivative(problem, arrays.history, self.history_rate, self.names))
         self._last = (force, displacement)
         return factor
 
@@ -113,3 +114,10 @@ class PathDerivatives:
                    elastic_energy=rec["elastic"], dissipated_energy=rec["work"] - rec["elastic"])
         out["names"] = self.names
         return out
+
+
+def _rates_like(history, p: int):
+    """Zero derivatives of a history (an array, or a dict of arrays) with respect to p parameters."""
+    if isinstance(history, dict):
+        return {name: _rates_like(value, p) for name, value in history.items()}
+    return np.zeros(np.shape(history) + (p,))

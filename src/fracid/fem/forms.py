@@ -17,25 +17,38 @@ from fracid.fem.nonlocal_average import NonlocalAveraging, softening_coupling
 
 
 class ElementArrays:
-    """Element vectors and matrices of one evaluation.
+    """Element vectors and matrices of one evaluation, the trial history and the formulation's outputs.
 
-    ``residual`` is (n_el, n_dof_el) with the displacement dofs first; ``tangent`` is
-    (n_el, n_dof_el, n_dof_el); ``reference`` holds per field the element vectors whose assembled
-    norm scales that field's residual (internal forces for u, the equivalent-strain source for ebar);
-    ``coupling`` holds the tangent entries between points of different elements that the integral
-    model adds (None for the element-local models) [N/mm].
-
-    ``tangent`` may be given as a function of no argument: it is then computed at its first access
-    (an iteration of modified Newton needs only the residual; the tangent is half the cost of an
-    evaluation). It fills the problem's tangent buffer, so it must be taken before the next
-    evaluation of the problem.
+    Parameters
+    ----------
+    residual : ndarray, shape (n_el, n_dof_el)
+        Element internal forces, in the columns of the dof map (displacements first, then each
+        named field's).
+    tangent : ndarray, shape (n_el, n_dof_el, n_dof_el), or callable
+        The element tangents; a function of no argument is called at the first access (an iteration
+        of modified Newton needs only the residual; the tangent is half the cost of an evaluation).
+        It fills the problem's tangent buffer, so it must be taken before the next evaluation.
+    reference : dict {field: ndarray, shape (n_el, n_dof_el of the field)}
+        Per field, the element vectors whose assembled norm scales that field's residual.
+    history : ndarray or dict of ndarray
+        The trial history at this state, in the layout the problem declares (its ``history_spec``):
+        the solver carries it opaquely to the next step.
+    omega : ndarray, optional
+        Shorthand for ``outputs["omega"]`` (the damage of the damage formulations).
+    coupling : sparse matrix (n_free, n_free), optional
+        Tangent entries between points of different elements (the integral model) [N/mm].
+    outputs : dict {name: ndarray}, optional
+        Named point outputs the formulation derives from the state (damage, stress, ...).
     """
 
-    __slots__ = ("residual", "_tangent", "reference", "kappa", "omega", "coupling")
+    __slots__ = ("residual", "_tangent", "reference", "history", "outputs", "coupling")
 
-    def __init__(self, residual, tangent, reference, kappa, omega, coupling=None):
+    def __init__(self, residual, tangent, reference, history, omega=None, coupling=None, *, outputs=None):
         self.residual, self._tangent, self.reference = residual, tangent, reference
-        self.kappa, self.omega, self.coupling = kappa, omega, coupling
+        self.history, self.coupling = history, coupling
+        self.outputs = dict(outputs or {})
+        if omega is not None:
+            self.outputs["omega"] = omega
 
     @property
     def tangent(self) -> np.ndarray:
@@ -43,11 +56,32 @@ class ElementArrays:
             self._tangent = self._tangent()
         return self._tangent
 
+    @property
+    def kappa(self):
+        """The history (the name of the damage formulations' history variable)."""
+        return self.history
+
+    @property
+    def omega(self) -> np.ndarray:
+        """The point output ``"omega"`` (damage) of the formulations that give one."""
+        if "omega" not in self.outputs:
+            raise AttributeError(f"these element arrays have no point output 'omega'; outputs: {sorted(self.outputs)}")
+        return self.outputs["omega"]
+
     def _replace(self, **changes) -> "ElementArrays":
-        values = {name: getattr(self, name) for name in ("residual", "reference", "kappa", "omega", "coupling")}
-        values["tangent"] = self._tangent
+        """A copy with some of the constructor's arguments changed (``kappa`` is ``history``)."""
+        if "kappa" in changes:
+            changes["history"] = changes.pop("kappa")
+        values = dict(residual=self.residual, tangent=self._tangent, reference=self.reference, history=self.history,
+                      coupling=self.coupling, outputs=self.outputs)
         values.update(changes)
         return ElementArrays(**values)
+
+
+def point_outputs(arrays) -> dict:
+    """The named point outputs of :class:`ElementArrays`, or ``{"omega": arrays}`` for a bare damage
+    array (what ``fields`` and ``elastic_energy`` were given before named outputs)."""
+    return arrays.outputs if isinstance(arrays, ElementArrays) else {"omega": arrays}
 
 
 class ModelConstants(NamedTuple):
@@ -56,19 +90,22 @@ class ModelConstants(NamedTuple):
     E: np.ndarray  # Young's modulus at every integration point [MPa], (n_el, n_q)
     D: np.ndarray  # unit elastic matrix (n_strain, n_strain)
     DB: np.ndarray  # D times the strain operator, (n_el, n_q, n_strain, n_u)
-    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant (None without ebar)
+    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant (None without the gradient field)
     damageable: np.ndarray  # 1 where the material can damage, 0 in elastic parts (platens), (n_el, n_q)
 
 
-def model_constants(disc, params, stiffness_factor, damageable=1.0, ebar: bool = True) -> ModelConstants:
-    """Precompute the parts of the tangent that do not change during a computation (``ebar``: also
-    the matrix of the gradient model's diffusion equation, which needs ``params.c``)."""
+def model_constants(disc, params, stiffness_factor, damageable=1.0, gradient_space=None) -> ModelConstants:
+    """Precompute the parts of the tangent that do not change during a computation (with
+    ``gradient_space``, a :class:`~fracid.fem.discretization.ScalarSpace`: also the matrix of the
+    gradient model's diffusion equation on it, which needs ``params.c``)."""
     E = params.E * np.broadcast_to(stiffness_factor, disc.weights.shape)
     mask = np.broadcast_to(np.asarray(damageable, dtype=float), disc.weights.shape)
     D = disc.strain_state.unit_elastic_matrix(params.nu)
     DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
-    N, G, w = disc.ebar_shape, disc.ebar_gradient, disc.weights
-    M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G) if ebar else None
+    M = None
+    if gradient_space is not None:
+        N, G, w = gradient_space.shape, gradient_space.gradient, disc.weights
+        M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
     return ModelConstants(E, D, DB, M, mask)
 
 
@@ -101,11 +138,13 @@ def _secant(B, const, w_sec):
     return _btdb(B * w_sec[..., None, None], const.DB)
 
 
-def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
+def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
     """Implicit gradient-enhanced damage: residuals of equilibrium and of the diffusion equation.
 
     Parameters
     ----------
+    space : ScalarSpace
+        The interpolation of the nonlocal strain ebar.
     law : DamageLaw
     params
         The law's parameters (``E``, ``nu`` and ``c`` besides the law's own).
@@ -116,7 +155,7 @@ def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old,
     out_tangent : ndarray, shape (n_el, n_u + n_e, n_u + n_e)
         Buffer for the element tangents; its ebar-ebar block must already hold ``const.ebar_matrix``.
     """
-    B, N, w = disc.strain_operator, disc.ebar_shape, disc.weights
+    B, N, w = disc.strain_operator, space.shape, disc.weights
     nu = B.shape[-1]
     eps = np.einsum("eqsi,ei->eqs", B, ue)
     ebar = ee @ N.T
@@ -134,7 +173,8 @@ def gradient_damage(disc, law, params, const: ModelConstants, ue, ee, kappa_old,
         out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
         return out_tangent
 
-    return ElementArrays(np.concatenate([f_u, f_e], axis=1), tangent, {"u": f_u, "ebar": f_eq}, kappa, omega)
+    return ElementArrays(np.concatenate([f_u, f_e], axis=1), tangent, {"u": f_u, "ebar": f_eq}, kappa,
+                         outputs={"omega": omega})
 
 
 def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
@@ -152,7 +192,7 @@ def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_ta
         out_tangent[:] = _secant(B, const, w_sec) - softening
         return out_tangent
 
-    return ElementArrays(f_u, tangent, {"u": f_u}, kappa, omega)
+    return ElementArrays(f_u, tangent, {"u": f_u}, kappa, outputs={"omega": omega})
 
 
 def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
@@ -189,7 +229,7 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
     h = _bt(d_eq, B)  # d eps_eq / d u at each point
     out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
     coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
-    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, omega, coupling)
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, coupling=coupling, outputs={"omega": omega})
 
 
 def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
@@ -203,4 +243,5 @@ def elastic_bulk(disc, const: ModelConstants, ue, out_tangent) -> ElementArrays:
     """Linear elastic material (the bulk of a discrete-crack model): internal forces and stiffness."""
     _, f_u, w_sec = _secant_equilibrium(disc.strain_operator, const, disc.weights, ue, np.zeros(disc.weights.shape))
     out_tangent[:] = _secant(disc.strain_operator, const, w_sec)
-    return ElementArrays(f_u, out_tangent, {"u": f_u}, np.zeros(disc.weights.shape), np.zeros(disc.weights.shape))
+    no_history = np.zeros(disc.weights.shape)
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, no_history, outputs={"omega": no_history})

@@ -161,8 +161,8 @@ class ZoneWidthObserver:
         points = problem.disc.points
         if points.shape[-1] == 1:
             start, end = self.zone.along_range
-            return superlevel_length(points[..., 0].ravel(), arrays.kappa.ravel(), self.kappa_threshold, start, end)
-        return fpz_width(self._sampler(problem), arrays.kappa.ravel(), self.kappa_threshold, self.zone.mirror)
+            return superlevel_length(points[..., 0].ravel(), arrays.history.ravel(), self.kappa_threshold, start, end)
+        return fpz_width(self._sampler(problem), arrays.history.ravel(), self.kappa_threshold, self.zone.mirror)
 
     @property
     def differentiable(self) -> bool:

@@ -12,6 +12,7 @@ import numpy as np
 from fracid.fem.assembly import dot
 from fracid.fem.ddm import PathDerivatives
 from fracid.fem.linear_solvers import SingularMatrixError, linear_solver as _make_linear_solver
+from fracid.fem.protocol import initial_history, state_energy, state_fields
 from fracid.fem.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
 
@@ -32,7 +33,8 @@ class PathResult:
         the force, so for a symmetric model it is scaled by the number of copies), the external work,
         elastic energy and dissipated energy [N mm], and the specimen's observers.
     fields : dict {step: dict}
-        Fields (u, ebar, kappa, omega) at the requested steps.
+        Fields at the requested steps, as the problem's ``fields`` names them (nodal u and the named
+        fields, the history and point outputs: e.g. u, ebar, kappa, omega of the gradient model).
     stats : SolverStatistics
     status : str
         Why the analysis ended.
@@ -191,7 +193,9 @@ def follow_path(
 
     Parameters
     ----------
-    problem : DamageProblem
+    problem : Problem
+        Any :class:`~fracid.fem.protocol.Problem`; its history is allocated from its declaration
+        (:func:`~fracid.fem.protocol.initial_history`) and carried from step to step.
     control : str
         Name of the prescribed functional (one of ``problem.functionals``).
     target : float
@@ -239,7 +243,7 @@ def follow_path(
     factor = None  # a factorization to start the next increment with (the derivatives' or the last iteration's)
 
     z = np.zeros(problem.n_free + 1)
-    kappa = problem.initial_history()
+    history = initial_history(problem)
     state = None  # evaluation at the current converged z, reused by the next increment
     tau, status = 0.0, "target reached"
     base = steps.initial  # reference increment; set from the onset of damage when not given
@@ -265,7 +269,7 @@ def follow_path(
             increment = ahead[0] - tau
         try:
             z_new, arrays, iterations, state, factor = solve_increment(
-                system, z, tau + increment, kappa, solver, newton, stats, state, factor
+                system, z, tau + increment, history, solver, newton, stats, state, factor
             )
         except IncrementFailed as err:
             state = factor = None  # the failed iterations overwrote the problem's tangent buffer
@@ -278,13 +282,13 @@ def follow_path(
         tau += increment
         if derivatives is not None:
             try:
-                factor = derivatives.step(system, z_new, kappa, arrays, solver, stats)
+                factor = derivatives.step(system, z_new, history, arrays, solver, stats)
             except SingularMatrixError as err:
                 message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
                            f"derivatives are not defined there (a bifurcation of the path): {err}")
                 raise ConvergenceError(message, result("failed: singular tangent for the derivatives"),
                                        control=control, functionals=tuple(problem.functionals)) from None
-        z, kappa = z_new, arrays.kappa
+        z, history = z_new, arrays.history
         stats.steps += 1
         force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
         if callback is not None:
@@ -292,7 +296,7 @@ def follow_path(
         if stop_force_fraction is not None and abs(force) < stop_force_fraction * recorder.peak:
             status = f"force below {stop_force_fraction:g} of the peak"
             break
-        onset_ratio = problem.onset_ratio(kappa)
+        onset_ratio = problem.onset_ratio(history)
         if elastic and 0.0 < onset_ratio < 1.0 and steps.jump_to_onset:
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
@@ -341,13 +345,13 @@ class _Recorder:
         rec["tau"].append(tau)
         rec["force"].append(force)
         rec["load_point"].append(displacement)
-        rec["elastic"].append(problem.elastic_energy(q, arrays.kappa, arrays.omega))
+        rec["elastic"].append(state_energy(problem, q, arrays))
         for name, vec in problem.functionals.items():
             rec[name].append(dot(vec, q))
         for name, fn in self.observers.items():
             rec[name].append(float(fn(problem, q, arrays)))
         if self.keep(step):
-            self.fields[step] = problem.fields(q, arrays.kappa, arrays.omega)
+            self.fields[step] = state_fields(problem, q, arrays)
         self.last = (step, q, arrays)
         self.peak = max(self.peak, abs(force))
         return force
@@ -355,7 +359,7 @@ class _Recorder:
     def result(self, stats, status) -> PathResult:
         if self.last is not None and self.field_steps is not None and self.last[0] not in self.fields:
             step, q, arrays = self.last
-            self.fields[step] = self.problem.fields(q, arrays.kappa, arrays.omega)
+            self.fields[step] = state_fields(self.problem, q, arrays)
         rec = {name: np.array(values) for name, values in self.records.items()}
         obs = {name: rec[name] for name in [*self.problem.functionals, *self.observers]}
         obs["load_point_displacement"] = rec["load_point"]

@@ -13,24 +13,27 @@ import numpy as np
 from fracid.fem.assembly import assemble_vector, norm2
 from fracid.fem import damage_sensitivity as ds
 from fracid.fem.discretization import MixedDiscretization
-from fracid.fem.dofs import Conditions, number_dofs
+from fracid.fem.dofs import Conditions, FieldSpec, number_dofs
 from fracid.fem.forms import (_damage, elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage,
-                              model_constants)
+                              model_constants, point_outputs)
 from fracid.fem.laws import DamageLaw
 from fracid.fem.nonlocal_average import averaging_length_derivative, internal_length, nonlocal_averaging
+from fracid.fem.protocol import HistoryVariable, allocate_history
 
 
 class ContinuumProblem:
     """What every continuum formulation shares: the unknowns under the conditions (a
     :class:`~fracid.fem.dofs.DofMap`), the constant parts of the tangent, the assembly of the element
-    arrays, the fields and the elastic energy. Subclasses give ``_element_arrays(qe, history_old)``.
+    arrays, the fields and the elastic energy. Subclasses give ``_element_arrays(qe, history_old)``, and
+    declare their named scalar fields (``field_specs``, none here) and history (``history_spec``: one
+    scalar ``kappa`` per integration point here).
 
     Parameters
     ----------
     disc : MixedDiscretization
     params
-        Parameters with the elastic ``E`` [MPa] and ``nu`` [-] of the bulk (and ``c`` [mm^2] if
-        ``with_ebar``).
+        Parameters with the elastic ``E`` [MPa] and ``nu`` [-] of the bulk (and whatever the
+        subclass's fields need).
     conditions : Conditions
         Supports, load pattern, tied groups, functionals and symmetry factor.
     stiffness_factor : float or ndarray, shape (n_el, n_q)
@@ -39,28 +42,38 @@ class ContinuumProblem:
         1 where the material softens, 0 where it stays elastic (loading platens) [-].
     """
 
-    with_ebar = False
+    #: the named scalar fields besides the displacements (:class:`~fracid.fem.dofs.FieldSpec`)
+    field_specs: tuple = ()
 
     def __init__(self, disc: MixedDiscretization, params, conditions: Conditions, *, stiffness_factor=1.0,
                  damageable=1.0):
         self.disc, self.params = disc, params
-        self.dofs = number_dofs(disc, conditions, with_ebar=self.with_ebar)
+        self.dofs = number_dofs(disc, conditions, self.field_specs)
         self.n_free, self.element_dofs, self.blocks = self.dofs.n_free, self.dofs.element_dofs, self.dofs.blocks
         self.load_vector, self.functionals = self.dofs.load_vector, self.dofs.functionals
         self.symmetry_factor = float(conditions.symmetry_factor)
-        self.const = model_constants(disc, params, stiffness_factor, damageable, ebar=self.with_ebar)
+        self.const = model_constants(disc, params, stiffness_factor, damageable, self._gradient_space())
         self._tangent = np.zeros((disc.n_elements,) + (self.element_dofs.shape[1],) * 2)
 
-    def initial_history(self) -> np.ndarray:
-        """History variable of the virgin material, at every integration point."""
-        return np.zeros(self.disc.weights.shape)
+    def _gradient_space(self):
+        """The scalar space of a diffusion equation whose constant matrix the constants hold (none here)."""
+        return None
+
+    @property
+    def history_spec(self) -> dict:
+        """``{"kappa": HistoryVariable()}``: one scalar per integration point."""
+        return {"kappa": HistoryVariable()}
+
+    def initial_history(self):
+        """History of the virgin material, allocated from :attr:`history_spec`."""
+        return allocate_history(self.history_spec, self.disc)
 
     def gather(self, q: np.ndarray) -> np.ndarray:
         """Element dof values from the free-dof vector (eliminated dofs are zero)."""
         return self.dofs.gather(q)
 
     def full_vector(self, q: np.ndarray) -> np.ndarray:
-        """All dofs (displacements then ebar), eliminated ones zero."""
+        """All dofs (displacements, then the named fields'), eliminated ones zero."""
         return self.dofs.full_vector(q)
 
     def restrict(self, full: np.ndarray) -> np.ndarray:
@@ -84,25 +97,25 @@ class ContinuumProblem:
         (see :meth:`fracid.fem.protocol.Problem.evaluate`)."""
         arrays = self._element_arrays(self.gather(q), history_old)
         residual = assemble_vector(self.element_dofs, arrays.residual, self.n_free)
-        n_u = self.dofs.n_u
         references = {}
         for field, element_ref in arrays.reference.items():
-            dofs = self.element_dofs[:, :n_u] if field == "u" else self.element_dofs[:, n_u:]
+            dofs = self.element_dofs[:, self.dofs.columns[field]]
             references[field] = float(norm2(assemble_vector(dofs, element_ref, self.n_free)))
         return residual, arrays, references
 
-    def fields(self, q: np.ndarray, kappa: np.ndarray, omega: np.ndarray) -> dict:
-        """Nodal u [mm] (and ebar [-]), and kappa, omega [-] at the integration points."""
-        full = self.full_vector(q)
-        out = {"u": full[: self.disc.n_u_dofs], "kappa": kappa.copy(), "omega": omega.copy()}
-        if self.with_ebar:
-            out["ebar"] = full[self.disc.n_u_dofs :]
+    def fields(self, q: np.ndarray, history, arrays) -> dict:
+        """Nodal u [mm] and the named fields, the history (``kappa`` [-]) and the point outputs
+        (``omega`` [-]) of the state; ``arrays`` are its :class:`~fracid.fem.forms.ElementArrays` (or,
+        as before named outputs, the damage omega at the points)."""
+        out = self.dofs.split(q)
+        out["kappa"] = history.copy()
+        out.update({name: value.copy() for name, value in point_outputs(arrays).items()})
         return out
 
-    def elastic_energy(self, q: np.ndarray, kappa: np.ndarray, omega: np.ndarray) -> float:
-        """Recoverable elastic energy of the state [N mm]."""
-        ue = self.gather(q)[:, : self.dofs.n_u]
-        return self.symmetry_factor * elastic_energy(self.disc, self.const, ue, omega)
+    def elastic_energy(self, q: np.ndarray, history, arrays) -> float:
+        """Recoverable elastic energy of the state [N mm]; ``arrays`` as for :meth:`fields`."""
+        ue = self.gather(q)[:, self.dofs.columns["u"]]
+        return self.symmetry_factor * elastic_energy(self.disc, self.const, ue, point_outputs(arrays)["omega"])
 
 
 class ElasticProblem(ContinuumProblem):
@@ -211,40 +224,48 @@ class DamageProblem(ContinuumProblem):
 
 
 class GradientDamageProblem(DamageProblem):
-    """Implicit gradient-enhanced damage: the nonlocal strain ebar is a nodal field solving
-    ebar - c laplacian(ebar) = eps_eq (natural boundary condition, which is also the symmetry condition)."""
+    """Implicit gradient-enhanced damage: the nonlocal strain ebar is a nodal field on the element
+    corners solving ebar - c laplacian(ebar) = eps_eq (natural boundary condition, which is also the
+    symmetry condition)."""
 
-    with_ebar = True
+    field_specs = (FieldSpec("ebar", "linear"),)
 
     def __init__(self, disc, law, params, conditions, **options):
         super().__init__(disc, law, params, conditions, **options)
-        n_u = self.dofs.n_u
-        self._tangent[:, n_u:, n_u:] = self.const.ebar_matrix
+        e = self.dofs.columns["ebar"]
+        self._tangent[:, e, e] = self.const.ebar_matrix
+
+    def _gradient_space(self):
+        return self.disc.space(self.field_specs[0].space)
+
+    def _ebar(self, qe):
+        """The element values of ebar (n_el, n_e, ...) of element dof values ``qe``."""
+        return qe[:, self.dofs.columns["ebar"]]
 
     def _driving(self, qe):
         _, eps, eq, d_eq = super()._driving(qe)
-        return qe[:, self.dofs.n_u:] @ self.disc.ebar_shape.T, eps, eq, d_eq
+        return self._ebar(qe) @ self._gradient_space().shape.T, eps, eq, d_eq
 
     def _driving_parameter_rate(self, eps, eq, names):
         return np.zeros(eq.shape + (len(names),))  # kappa follows the nodal unknown ebar
 
     def _driving_response(self, dqe, eps, d_eq):
-        return np.einsum("eip,qi->eqp", dqe[:, self.dofs.n_u:], self.disc.ebar_shape)
+        return np.einsum("eip,qi->eqp", self._ebar(dqe), self._gradient_space().shape)
 
     def _with_field_rows(self, force, qe, eps, names):
         # r_ebar = (M + c K_g) ebar - int N^T eps_eq
-        disc, ee = self.disc, qe[:, self.dofs.n_u:]
+        disc, space, ee = self.disc, self._gradient_space(), self._ebar(qe)
         eq_rate = ds.equivalent_strain_parameter_derivatives(self.law, self.params, disc.strain_state, eps, names)
-        rows = -np.einsum("eq,qi,eqp->eip", disc.weights, disc.ebar_shape, eq_rate)
+        rows = -np.einsum("eq,qi,eqp->eip", disc.weights, space.shape, eq_rate)
         if "c" in names:
-            G = disc.ebar_gradient
+            G = space.gradient
             rows[..., names.index("c")] += np.einsum("eq,eqdi,eqdj,ej->ei", disc.weights, G, G, ee)
         return np.concatenate([force, rows], axis=1)
 
     def _element_arrays(self, qe, kappa_old):
-        n_u = self.dofs.n_u
-        return gradient_damage(self.disc, self.law, self.params, self.const, qe[:, :n_u], qe[:, n_u:], kappa_old,
-                               self._tangent)
+        u = self.dofs.columns["u"]
+        return gradient_damage(self.disc, self._gradient_space(), self.law, self.params, self.const, qe[:, u],
+                               self._ebar(qe), kappa_old, self._tangent)
 
 
 class IntegralDamageProblem(DamageProblem):

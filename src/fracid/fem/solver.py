@@ -1,7 +1,7 @@
 """Monolithic Newton-Raphson on a damage problem under indirect displacement control.
 
-The unknowns are the free dofs q and the load factor lambda. The equations are equilibrium (and the
-diffusion equation) r(q) - lambda f_hat = 0 and the control constraint v . q = tau, with v a linear
+The unknowns are the free dofs q and the load factor lambda. The equations are equilibrium (and those
+of the problem's named fields) r(q) - lambda f_hat = 0 and the control constraint v . q = tau, with v a linear
 functional of the displacements (an end displacement, an elongation over a gauge length, a CMOD).
 With v the displacement of the loaded point this is plain displacement control; with another v it
 traces snap-back. The bordered matrix [[K, -f_hat], [v^T, 0]] is assembled into one sparse pattern
@@ -28,22 +28,19 @@ class IncrementFailed(RuntimeError):
 class NewtonOptions:
     """Convergence settings of the Newton-Raphson iterations.
 
-    The solver checks the residual of every field a problem declares (its ``blocks``: ``"u"``, and
-    ``"ebar"`` for the gradient model, or any other name a new formulation gives) against
-    :meth:`tolerance` of that field.
+    The solver checks the residual of every field a problem declares (its ``blocks``: ``"u"`` and
+    the formulation's named fields) against :meth:`tolerance` of that field, each relative to the
+    reference norm the formulation gives for it (the internal forces for ``"u"``).
 
     Parameters
     ----------
     rtol_u : float
         Relative tolerance on the equilibrium residual, scaled by the norm of the internal forces.
-    rtol_ebar : float
-        Relative tolerance on the residual of the diffusion equation, scaled by the norm of the
-        equivalent-strain source.
     max_iterations : int
         Iterations with a new factorization before an increment counts as failed.
     field_rtol : mapping {field: float}
-        Relative tolerances of other fields (or overriding the two above); a field named nowhere
-        gets ``rtol_u``.
+        Relative tolerances of named fields (or of ``"u"``, overriding ``rtol_u``); a field named
+        nowhere gets ``rtol_u``.
     reuse_ratio : float
         Modified Newton while the residual falls fast. The progress of an iterate is its largest
         relative residual over the field's tolerance (converged at 1). The factorization in hand
@@ -57,19 +54,24 @@ class NewtonOptions:
         their tolerance in the curves (docs/speed/README.md).
     reuse_iterations : int
         See ``reuse_ratio``.
+    rtol_ebar : None
+        Removed: ``field_rtol={field: value}`` gives a named field its tolerance.
     """
 
     rtol_u: float = 1e-8
-    rtol_ebar: float = 1e-8
     max_iterations: int = 12
     field_rtol: tuple = ()
     reuse_ratio: float = 0.3
     reuse_iterations: int = 6
+    rtol_ebar: None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
+        if self.rtol_ebar is not None:
+            raise TypeError(f"NewtonOptions(rtol_ebar={self.rtol_ebar!r}) was removed: give the tolerance of a named "
+                            f"field in field_rtol, e.g. field_rtol={{'ebar': {self.rtol_ebar!r}}}")
         named = dict(self.field_rtol.items() if hasattr(self.field_rtol, "items") else self.field_rtol)
         object.__setattr__(self, "field_rtol", tuple(sorted(named.items())))
-        for name, value in [("rtol_u", self.rtol_u), ("rtol_ebar", self.rtol_ebar)] + [
+        for name, value in [("rtol_u", self.rtol_u)] + [
                 (f"field_rtol[{field!r}]", v) for field, v in self.field_rtol]:
             if not (0.0 < value < 1.0):
                 raise ValueError(f"NewtonOptions.{name} = {value!r}; it must be in (0, 1)")
@@ -83,8 +85,7 @@ class NewtonOptions:
 
     def tolerance(self, field_name: str) -> float:
         """Relative tolerance of the residual of field ``field_name``."""
-        named = dict(self.field_rtol)
-        return named.get(field_name, self.rtol_ebar if field_name == "ebar" else self.rtol_u)
+        return dict(self.field_rtol).get(field_name, self.rtol_u)
 
 
 @dataclass
@@ -106,7 +107,7 @@ class SolverStatistics:
 
 @dataclass
 class ControlledSystem:
-    """A :class:`~fracid.fem.problem.DamageProblem` bordered by the load factor and one control functional."""
+    """A problem (:class:`~fracid.fem.protocol.Problem`) bordered by the load factor and one control functional."""
 
     problem: object
     control: np.ndarray
@@ -126,12 +127,13 @@ class ControlledSystem:
         self.border_values = np.concatenate([-self.problem.load_vector[f_idx], self.control[v_idx]])
         self.pattern = SparsePattern.shared(n + 1, self.problem.element_dofs, rows, cols)
 
-    def evaluate(self, z: np.ndarray, tau: float, kappa_old: np.ndarray, state=None):
+    def evaluate(self, z: np.ndarray, tau: float, history_old, state=None):
         """Residual of the bordered system, element arrays, relative residual per field, and the
-        problem's evaluation ``state`` (pass it back to skip re-evaluating at the same z and history)."""
+        problem's evaluation ``state`` (pass it back to skip re-evaluating at the same z and history).
+        ``history_old`` is the history of the last converged step, as the problem declares it."""
         p = self.problem
         q, lam = z[:-1], z[-1]
-        internal, arrays, references = state if state is not None else p.evaluate(q, kappa_old)
+        internal, arrays, references = state if state is not None else p.evaluate(q, history_old)
         residual = np.append(internal - lam * p.load_vector, dot(self.control, q) - tau)
         external = abs(lam) * norm2(p.load_vector)
         errors = {}
@@ -189,7 +191,7 @@ def _add_coupling(matrix, coupling):
 
 
 def solve_increment(
-    system: ControlledSystem, z0, tau, kappa_old, solver, options: NewtonOptions, stats: SolverStatistics, state=None,
+    system: ControlledSystem, z0, tau, history_old, solver, options: NewtonOptions, stats: SolverStatistics, state=None,
     factor=None,
 ):
     """Newton-Raphson iterations for one increment to the control value ``tau``.
@@ -207,7 +209,7 @@ def solve_increment(
     z : ndarray
         Converged free dofs followed by the load factor.
     arrays : ElementArrays
-        Element arrays at the converged state (trial history and damage).
+        Element arrays at the converged state (trial history and point outputs).
     iterations : int
         Newton iterations: the factorizations of the increment, plus one if it started with ``factor``
         (for full Newton, every iteration).
@@ -229,7 +231,7 @@ def solve_increment(
     accepted = None  # (z, progress) of the iterate the kept factorization last solved at
     progress, rejected = None, False
     for iteration in range(options.max_iterations * (options.reuse_iterations + 1) + 1):
-        residual, arrays, errors, state = system.evaluate(z, tau, kappa_old, state if iteration == 0 else None)
+        residual, arrays, errors, state = system.evaluate(z, tau, history_old, state if iteration == 0 else None)
         if not np.all(np.isfinite(residual)):
             raise IncrementFailed(f"non-finite residual at iteration {iteration}")
         if iteration > 0 and abs(residual[-1]) <= 1e-10 * scale and all(
