@@ -28,10 +28,10 @@ import numpy as np
 
 from fracid.cli import demo_config_path
 from fracid.config import build_data, build_parameters, build_space, build_specimen, identify_settings, load_config
-from fracid.inverse.cross_model import Candidate, compare_models, cross_calibration
-from fracid.inverse.knn import ParameterSpace
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.parameters import DamageParameters
+from fracid.inverse.studies.cross_model import Candidate, compare_models, cross_calibration
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.material.parameters import DamageParameters
 from fracid.models import CohesiveCrackModel, CrackBandModel, DamageModel
 from fracid.parallel import make_executor
 from fracid.report.cross_model import (CurvePanel, comparison_rows, cross_rows, curves_figure, markdown_table,

@@ -25,7 +25,7 @@ import time
 
 import fracid
 from fracid.models import DamageModel
-from fracid.fem.linear_solvers import SuperLUSolver, linear_solver
+from fracid.fem.path.linear_solvers import SuperLUSolver, linear_solver
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 

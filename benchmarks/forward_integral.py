@@ -16,8 +16,8 @@ import time
 
 import fracid
 from fracid.models import DamageModel
-from fracid.fem import forms
-from fracid.fem.nonlocal_average import internal_length, nonlocal_averaging
+from fracid.fem.formulations import forms
+from fracid.fem.formulations.nonlocal_average import internal_length, nonlocal_averaging
 
 
 class _Timed:

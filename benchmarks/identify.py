@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace, design, evaluate_population
-from fracid.inverse.strategy import identify
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace, design, evaluate_population
+from fracid.inverse.methods.strategy import identify
 from fracid.parallel import make_executor
 from fracid.specimens.beam import NotchedBeam
 

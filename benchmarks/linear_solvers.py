@@ -112,7 +112,7 @@ class Capture:
 
 
 def capture(names, directory: Path, delegate: str, softening: float, max_steps: int):
-    from fracid.fem.linear_solvers import linear_solver
+    from fracid.fem.path.linear_solvers import linear_solver
     from fracid.models import DamageModel
 
     cases = _cases()
@@ -259,7 +259,7 @@ class Pardiso:
         return solver
 
     def prepare(self, matrix):
-        from fracid.fem.pardiso import PardisoSolver
+        from fracid.fem.path.pardiso import PardisoSolver
 
         self.cls = PardisoSolver
         self.solver = self._new()

@@ -20,8 +20,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import fracid
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.path_following import follow_path
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.path.path_following import follow_path
 from fracid.models import CohesiveCrackModel, CrackBandModel
 from fracid.report.figures import to_png
 from fracid.specimens.beam import NotchedBeam

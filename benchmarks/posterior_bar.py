@@ -5,7 +5,7 @@ The bar with a weak zone (60 elements), force-elongation curve at 12 points up t
 (c, beta) = (2, 250) mm^2 and -, bounds c in [0.5, 4], beta in [100, 500]: c and beta lie along a curved valley.
 
 1. ``reference``: one noisy data set; the identification (KNN 16 + Kalman filter) gives the Gaussian seed; the
-   posterior by :func:`fracid.inverse.posterior.posterior`; the reference by quadrature on a grid of the exact
+   posterior by :func:`fracid.inverse.sampling.posterior.posterior`; the reference by quadrature on a grid of the exact
    model that follows the valley (``--grid`` x ``--grid`` points, see :func:`grid_reference`) and, with ``--emcee``, a long emcee run on the exact
    model. Prints means, stds, 90 % intervals and the differences in reference stds; writes the figure
    docs/posterior/bar_reference.png (the draws over the reference density).
@@ -26,11 +26,11 @@ from pathlib import Path
 import numpy as np
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.posterior import PosteriorSettings, posterior
-from fracid.inverse.sensitivity import evaluate_points
-from fracid.inverse.strategy import identify
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
+from fracid.inverse.core.sensitivity import evaluate_points
+from fracid.inverse.methods.strategy import identify
 from fracid.parallel import executor_session
 
 TRUTH = np.array([2.0, 250.0])
@@ -111,7 +111,7 @@ def emcee_reference(operator, y, C, steps, executor, start_at, seed=0):
 
 
 def moments(points, weights):
-    from fracid.inverse.posterior import weighted_quantile
+    from fracid.inverse.sampling.posterior import weighted_quantile
 
     mean = weights @ points
     std = np.sqrt(weights @ (points - mean) ** 2)

@@ -25,7 +25,7 @@ import numpy as np
 
 from fracid.cli import demo_config_path
 from fracid.config import build_data, build_operator, load_config
-from fracid.inverse.sensitivity import CentralDifferences
+from fracid.inverse.core.sensitivity import CentralDifferences
 
 ESTIMATE = {"kappa_i": 4.798e-5, "beta": 1086.5, "c": 21.46}  # docs/demo/result.json (rounded)
 

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 import fracid
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.twin import dogbone_cases, twin_matrix
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.studies.twin import dogbone_cases, twin_matrix
 from fracid.parallel import make_executor
 from fracid.report.figures import _new_figure, to_png
 from fracid.report.study import stability_figure, valley_figure

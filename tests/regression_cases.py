@@ -13,7 +13,7 @@ import numpy as np
 
 import fracid
 from fracid.specimens.beam import NotchedBeam
-from fracid.fem.cohesive import CohesiveParameters
+from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.models import model_from_type
 from fracid.specimens.dogbone import DogBone
 from fracid.specimens.strip import TensionStrip

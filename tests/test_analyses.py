@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.sensitivity import sensitivity_history
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.core.sensitivity import sensitivity_history
 
 
 def test_linear_model_information_and_shares_are_exact():

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation, RunRecord
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import KnnGaussNewton, KnnKalman, identify, identify_data
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation, RunRecord
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.methods.strategy import KnnGaussNewton, KnnKalman, identify, identify_data
 from fracid.models import DamageModel, implausible, usual_range_text
 
 BAR = fracid.BarWithWeakZone(n_elements=40)
@@ -74,7 +74,7 @@ def test_simulate_with_a_dict_of_parameters_says_how_to_build_the_class(no_forwa
 
 
 def test_simulate_with_the_parameters_of_another_model_is_refused(no_forward_run):
-    from fracid.fem.cohesive import CohesiveParameters
+    from fracid.fem.material.cohesive import CohesiveParameters
 
     with pytest.raises(TypeError, match="takes a DamageParameters"):
         fracid.simulate(BAR, CohesiveParameters())

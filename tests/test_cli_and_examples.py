@@ -54,7 +54,7 @@ def test_vtk_skipped_is_said_only_when_vtk_was_asked_for(tmp_path, capsys, monke
 
 @pytest.mark.parametrize("count, text", [(1, "1 run"), (2, "2 runs"), (0, "0 runs")])
 def test_plural(count, text):
-    from fracid.inverse.plans import plural
+    from fracid.inverse.core.plans import plural
 
     assert plural(count, "run") == text
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 import fracid
-from fracid.inverse import runs
+from fracid.inverse.core import runs
 
 PACKAGE = Path(fracid.__file__).resolve().parent
 
@@ -33,11 +33,11 @@ def test_hash_reads_every_module_of_the_forward_chain(monkeypatch):
     files = {path.relative_to(PACKAGE) for path in read}
     assert len(read) == len(files)  # each once
     expected = _python_files(PACKAGE, "fem") | _python_files(PACKAGE, "specimens")
-    expected |= {Path("models.py"), Path("forward.py"), Path("inverse/forward_operator.py")}
+    expected |= {Path("models.py"), Path("forward.py"), Path("inverse/core/forward_operator.py")}
     assert expected <= files
     # not the code that only chooses the runs or shows their results
     assert not {f for f in files if f.parts[0] in ("report", "config") or f.name.startswith("cli")
-                or f in (Path("inverse/runs.py"), Path("inverse/kalman.py"), Path("__init__.py"))}
+                or f in (Path("inverse/core/runs.py"), Path("inverse/methods/kalman.py"), Path("__init__.py"))}
     # in the order of the relative paths
     assert read == [PACKAGE / f for f in sorted(files, key=Path.as_posix)]
     # computed once per process
@@ -58,8 +58,8 @@ def test_a_new_forward_module_is_hashed(package_copy):
     assert runs.code_version(package_copy) != before
 
 
-@pytest.mark.parametrize("relative", ["fem/damage.py", "specimens/beam.py", "models.py", "forward.py",
-                                      "inverse/forward_operator.py"])
+@pytest.mark.parametrize("relative", ["fem/material/damage.py", "specimens/beam.py", "models.py", "forward.py",
+                                      "inverse/core/forward_operator.py"])
 def test_hash_changes_with_a_forward_module(package_copy, relative):
     before = runs.code_version(package_copy)
     assert before == runs.code_version(PACKAGE)  # the content is hashed, not where it is
@@ -71,7 +71,7 @@ def test_hash_changes_with_a_forward_module(package_copy, relative):
 
 def test_hash_ignores_code_outside_the_forward_chain(package_copy):
     before = runs.code_version(package_copy)
-    for relative in ("cli.py", "report/html.py", "inverse/kalman.py", "config/loading.py"):
+    for relative in ("cli.py", "report/html.py", "inverse/methods/kalman.py", "config/loading.py"):
         path = package_copy / relative
         path.write_bytes(path.read_bytes() + b"\n# edited\n")
     runs._source_hash.cache_clear()
@@ -82,7 +82,7 @@ def test_modules_imported_by_the_forward_chain_are_hashed(package_copy):
     """A module outside fem/ and specimens/ that the forward chain starts to import joins the hash."""
     (package_copy / "materials.py").write_text("E = 37000.0\n")
     assert Path("materials.py") not in runs.forward_sources(package_copy)
-    laws = package_copy / "fem" / "laws.py"
+    laws = package_copy / "fem" / "material" / "laws.py"
     laws.write_text(laws.read_text() + "\nfrom fracid.materials import E  # noqa: E402,F401\n")
     assert Path("materials.py") in runs.forward_sources(package_copy)
     before = runs.code_version(package_copy)

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from fracid.fem.cohesive import (
+from fracid.fem.material.cohesive import (
     CohesiveParameters,
     cohesive_traction,
     dissipated_energy_density,

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from fracid.fem.cohesive import CohesiveParameters, dissipated_energy_density
-from fracid.fem.cohesive_problem import crack_traction
+from fracid.fem.material.cohesive import CohesiveParameters, dissipated_energy_density
+from fracid.fem.formulations.cohesive_problem import crack_traction
 from fracid.models import CohesiveCrackModel
 from fracid.specimens.beam import NotchedBeam
 
@@ -58,10 +58,10 @@ def test_cohesive_beam_curve_peaks_then_softens(separated):
 
 @pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
-    from fracid.inverse.forward_operator import Observation, ForwardOperator
-    from fracid.inverse.knn import ParameterSpace
-    from fracid.inverse.strategy import identify
-    from fracid.inverse.twin import synthetic_data
+    from fracid.inverse.core.forward_operator import Observation, ForwardOperator
+    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.methods.strategy import identify
+    from fracid.inverse.studies.twin import synthetic_data
     from fracid.parallel import make_executor
 
     beam = NotchedBeam(h_fine=4.0, h_coarse=8.0)  # coarse: data and model share the mesh

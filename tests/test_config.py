@@ -22,10 +22,10 @@ from fracid.config import (
     simulate_settings,
 )
 from fracid.data import gregoire2013_beam4_path
-from fracid.inverse.forward_operator import ForwardOperator
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import KnnSettings
-from fracid.fem.parameters import DamageParameters
+from fracid.inverse.core.forward_operator import ForwardOperator
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.methods.strategy import KnnSettings
+from fracid.fem.material.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
 from fracid.specimens.beam import NotchedBeam
@@ -466,7 +466,7 @@ log = ["Gf"]"""))
 
 
 def test_cohesive_model_config_builds_its_operator(tmp_path):
-    from fracid.fem.cohesive import CohesiveParameters
+    from fracid.fem.material.cohesive import CohesiveParameters
     from fracid.models import CohesiveCrackModel
 
     cfg = load_config(write(tmp_path, COHESIVE))

@@ -13,7 +13,7 @@ from fracid.data.covariance_matrix import (
     as_covariance,
     block_diagonal,
 )
-from fracid.inverse.kalman import assimilate, information_update, kalman_update
+from fracid.inverse.methods.kalman import assimilate, information_update, kalman_update
 
 
 def _spd(n, seed):
@@ -168,7 +168,7 @@ def test_information_form_equals_gain_form(kind):
 
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_cumulative_information_is_the_leading_block_solve(kind):
-    from fracid.inverse.sensitivity import cumulative_information
+    from fracid.inverse.core.sensitivity import cumulative_information
 
     cov, C = _pair(kind)
     S = np.random.default_rng(8).normal(size=(cov.n, 3))
@@ -177,7 +177,7 @@ def test_cumulative_information_is_the_leading_block_solve(kind):
 
 
 def test_noise_draws_through_the_object_are_those_of_the_matrix():
-    from fracid.inverse.stability import noisy_replicates
+    from fracid.inverse.studies.stability import noisy_replicates
 
     var = np.linspace(1.0, 4.0, 5)
     np.testing.assert_allclose(noisy_replicates(np.zeros(5), Diagonal(var), 3, seed=2),
@@ -187,8 +187,8 @@ def test_noise_draws_through_the_object_are_those_of_the_matrix():
 
 
 def test_check_problem_gives_a_covariance_object():
-    from fracid.inverse.method import check_problem
-    from fracid.inverse.space import ParameterSpace
+    from fracid.inverse.core.method import check_problem
+    from fracid.inverse.core.space import ParameterSpace
 
     space = ParameterSpace(("a",), [0.0], [1.0])
     y, C = check_problem(lambda x: x, np.ones(3), np.diag([1.0, 2.0, 3.0]), space)

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from fracid.fem.assembly import SparsePattern
-from fracid.fem.cohesive import CohesiveParameters, hordijk_stress
-from fracid.fem.crack_band import band_damage, crack_band_stress, principal_tension, snap_back_limit
-from fracid.fem.laws import HordijkLaw
-from fracid.fem.tsl import ScaledLaw
+from fracid.fem.mesh.assembly import SparsePattern
+from fracid.fem.material.cohesive import CohesiveParameters, hordijk_stress
+from fracid.fem.material.crack_band import band_damage, crack_band_stress, principal_tension, snap_back_limit
+from fracid.fem.material.laws import HordijkLaw
+from fracid.fem.material.tsl import ScaledLaw
 from fracid.models import CrackBandModel
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.strip import TensionStrip
@@ -89,7 +89,7 @@ def test_band_wider_than_the_snap_back_limit_is_refused():
 
 
 def _dissipated(strip, band_width=None):
-    from fracid.fem.path_following import follow_path
+    from fracid.fem.path.path_following import follow_path
 
     problem = CrackBandModel(band_width).build(strip, PARAMS)
     # the crack opens to 0.99 wc: the column's elongation is the opening times element size / band width
@@ -147,10 +147,10 @@ def test_beam_curve_converges_with_the_mesh_and_matches_the_cohesive_crack():
 
 @pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.knn import ParameterSpace
-    from fracid.inverse.strategy import identify
-    from fracid.inverse.twin import synthetic_data
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.methods.strategy import identify
+    from fracid.inverse.studies.twin import synthetic_data
     from fracid.parallel import make_executor
 
     # coarse: data and model share the mesh. On this mesh Newton stalls beyond CMOD 0.15 mm, when the

@@ -1,4 +1,4 @@
-"""Cross-model calibration and comparison (fracid.inverse.cross_model) on a coarse notched beam.
+"""Cross-model calibration and comparison (fracid.inverse.studies.cross_model) on a coarse notched beam.
 
 The cohesive crack's curve is fitted by the gradient damage model and the gradient damage model's
 curve by the cohesive crack; then both models are compared on one data set. Small populations and
@@ -9,11 +9,11 @@ cores; the tolerances were set from measured values (stated beside each) with a 
 import numpy as np
 import pytest
 
-from fracid.inverse.cross_model import Candidate, compare_models, cross_calibration, relative_rms
-from fracid.inverse.knn import ParameterSpace
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.parameters import DamageParameters
-from fracid.fem.path_following import StepOptions
+from fracid.inverse.studies.cross_model import Candidate, compare_models, cross_calibration, relative_rms
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.material.parameters import DamageParameters
+from fracid.fem.path.path_following import StepOptions
 from fracid.models import CohesiveCrackModel, DamageModel
 from fracid.specimens.beam import NotchedBeam
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from fracid.fem.damage import exponential_damage, kappa_at_damage, update_history
+from fracid.fem.material.damage import exponential_damage, kappa_at_damage, update_history
 
 KI = 1e-4
 

@@ -12,12 +12,12 @@ import pytest
 
 import fracid
 from fracid.specimens import SPECIMENS
-from fracid.fem.damage import exponential_damage, exponential_damage_parameter_derivatives
-from fracid.fem.elasticity import plane_stress_matrix, plane_stress_matrix_derivative
-from fracid.fem.equivalent_strain import (modified_von_mises_plane_stress,
+from fracid.fem.material.damage import exponential_damage, exponential_damage_parameter_derivatives
+from fracid.fem.material.elasticity import plane_stress_matrix, plane_stress_matrix_derivative
+from fracid.fem.material.equivalent_strain import (modified_von_mises_plane_stress,
                                           modified_von_mises_plane_stress_parameter_derivatives,
                                           modified_von_mises_uniaxial, modified_von_mises_uniaxial_parameter_derivatives)
-from fracid.fem.nonlocal_average import averaging_length_derivative, averaging_matrix
+from fracid.fem.formulations.nonlocal_average import averaging_length_derivative, averaging_matrix
 from fracid.models import DamageModel, StepOptions
 
 RELATIVE_STEP = 1e-6

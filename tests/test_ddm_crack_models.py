@@ -1,4 +1,4 @@
-"""Direct differentiation (fracid.fem.ddm) of the crack models' paths: the cohesive crack and the crack band.
+"""Direct differentiation (fracid.fem.path.ddm) of the crack models' paths: the cohesive crack and the crack band.
 
 The DDM derivatives of the recorded force and energies are compared with central differences of runs
 (relative step 1e-6 per parameter) at the same control values, checkpoints covering the rise, the peak
@@ -23,7 +23,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fracid.fem.cohesive import CohesiveParameters
+from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.models import CohesiveCrackModel, CrackBandModel, StepOptions
 from fracid.specimens import SPECIMENS
 

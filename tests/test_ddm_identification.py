@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.runs import StoredOperator
-from fracid.inverse.sensitivity import (CentralDifferences, DirectDifferentiation, exact_sensitivity,
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.runs import StoredOperator
+from fracid.inverse.core.sensitivity import (CentralDifferences, DirectDifferentiation, exact_sensitivity,
                                         sensitivity_label)
 from fracid.models import CohesiveCrackModel
 from fracid.specimens import SPECIMENS

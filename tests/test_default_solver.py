@@ -10,7 +10,7 @@ from fracid.specimens import SPECIMENS
 
 
 def test_the_default_backend_is_the_fastest_installed():
-    from fracid.fem.linear_solvers import _has_pardiso, linear_solver
+    from fracid.fem.path.linear_solvers import _has_pardiso, linear_solver
 
     expected = "pardiso" if _has_pardiso() else "superlu"
     assert linear_solver().name == linear_solver("auto").name == expected
@@ -33,7 +33,7 @@ def test_default_curves_equal_superlu_with_full_newton(specimen, target):
 
 
 def test_a_factorization_is_kept_only_while_the_residual_falls_fast():
-    from fracid.fem.solver import _keeps_factorization
+    from fracid.fem.path.solver import _keeps_factorization
 
     options = fracid.NewtonOptions(reuse_ratio=0.3, reuse_iterations=6)
     assert _keeps_factorization(options, 1e3, 1e4)  # rate 0.1: 3 more iterations

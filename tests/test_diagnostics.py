@@ -1,4 +1,4 @@
-"""Fit diagnostics (fracid.inverse.diagnostics): elastic slope and peak of the computed curve against the
+"""Fit diagnostics (fracid.inverse.core.diagnostics): elastic slope and peak of the computed curve against the
 measured one, the worst residual, their warnings; in the result (summary, warnings, JSON) and a twin whose
 bar is shorter than the test's (stiffer) that gets the elastic-slope warning."""
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.diagnostics import (PEAK_TOLERANCE, SLOPE_TOLERANCE, diagnostic_warnings, elastic_points,
+from fracid.inverse.core.diagnostics import (PEAK_TOLERANCE, SLOPE_TOLERANCE, diagnostic_warnings, elastic_points,
                                         fit_diagnostics, line_slope)
-from fracid.inverse.method import MethodResult, estimate_text
+from fracid.inverse.core.method import MethodResult, estimate_text
 
 CONTROL = np.linspace(0.0, 1.0, 41)  # [mm]
 STD = np.full(CONTROL.size, 0.1)  # [N]
@@ -129,10 +129,10 @@ def test_estimates_are_rounded_to_two_digits_of_their_std(value, std, text):
 def test_a_twin_on_a_shorter_bar_gets_the_elastic_slope_warning():
     """Data from a 100 mm bar, identified (c, beta) with a 70 mm model of it: E fixed, the model is about
     100/70 times stiffer, which no (c, beta) mends; the result says so."""
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.knn import ParameterSpace
-    from fracid.inverse.strategy import identify_data
-    from fracid.inverse.twin import synthetic_data
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.methods.strategy import identify_data
+    from fracid.inverse.studies.twin import synthetic_data
 
     points = np.linspace(0.001, 0.03, 20)  # end displacement [mm]
     truth = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=20), points)], fracid.DamageParameters(),

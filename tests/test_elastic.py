@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.elastic import initial_slope, modulus_from_initial_slope
+from fracid.inverse.studies.elastic import initial_slope, modulus_from_initial_slope
 
 
 def test_initial_slope_through_origin():

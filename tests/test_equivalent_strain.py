@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from fracid.fem.equivalent_strain import (
+from fracid.fem.material.equivalent_strain import (
     modified_von_mises_3d,
     modified_von_mises_plane_stress,
     modified_von_mises_uniaxial,

@@ -153,7 +153,7 @@ def test_a_failure_without_snap_back_is_not_called_one():
     ([0.0, 1.0], False),  # too short to tell
 ])
 def test_snaps_back_reads_the_slope_past_the_peak(force, expected):
-    from fracid.fem.path_following import snaps_back
+    from fracid.fem.path.path_following import snaps_back
 
     control = [0.0, 1.0, 2.0, 2.1, 2.2][:len(force)]
     assert snaps_back(force, control) is expected
@@ -162,7 +162,7 @@ def test_snaps_back_reads_the_slope_past_the_peak(force, expected):
 def test_convergence_error_keeps_its_diagnosis_when_pickled():
     import pickle
 
-    from fracid.fem.path_following import ConvergenceError
+    from fracid.fem.path.path_following import ConvergenceError
 
     err = pickle.loads(pickle.dumps(ConvergenceError("failed", None, True, "deflection", ("cmod", "deflection"))))
     assert (str(err), err.snap_back, err.control, err.functionals) == ("failed", True, "deflection",

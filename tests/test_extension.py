@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import identify
-from fracid.inverse.twin import synthetic_data
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.laws import DamageLaw
-from fracid.fem.ranges import ParameterRange, ParameterSet
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.methods.strategy import identify
+from fracid.inverse.studies.twin import synthetic_data
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.material.laws import DamageLaw
+from fracid.fem.material.ranges import ParameterRange, ParameterSet
 from fracid.models import CohesiveCrackModel, DamageModel
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import structured_quad8

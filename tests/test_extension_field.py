@@ -20,13 +20,13 @@ with natural boundary conditions for phi. Equilibrium makes sigma uniform, so
 import numpy as np
 import pytest
 
-from fracid.fem.assembly import assemble_vector, norm2
-from fracid.fem.discretization import bar_discretization
-from fracid.fem.dofs import Conditions, FieldSpec, number_dofs
-from fracid.fem.forms import ElementArrays
-from fracid.fem.path_following import ConvergenceError, StepOptions, follow_path
-from fracid.fem.protocol import Problem
-from fracid.fem.solver import NewtonOptions
+from fracid.fem.mesh.assembly import assemble_vector, norm2
+from fracid.fem.mesh.discretization import bar_discretization
+from fracid.fem.mesh.dofs import Conditions, FieldSpec, number_dofs
+from fracid.fem.formulations.forms import ElementArrays
+from fracid.fem.path.path_following import ConvergenceError, StepOptions, follow_path
+from fracid.fem.formulations.protocol import Problem
+from fracid.fem.path.solver import NewtonOptions
 
 L, A, E = 40.0, 2.0, 1000.0  # mm, mm^2, MPa
 

@@ -1,7 +1,7 @@
 """A traction-separation law written in this file only, run by the cohesive crack through ``simulate``
 and the ``ForwardOperator``, with its exact sensitivities, and no package file edited: the law is an
-object with values and derivatives (:class:`fracid.fem.tsl.TractionSeparationLaw`), its parameter
-class composed of the elastic part and the law's own (:func:`fracid.fem.ranges.compose`)."""
+object with values and derivatives (:class:`fracid.fem.material.tsl.TractionSeparationLaw`), its parameter
+class composed of the elastic part and the law's own (:func:`fracid.fem.material.ranges.compose`)."""
 
 from dataclasses import dataclass
 from typing import ClassVar
@@ -11,10 +11,10 @@ import pytest
 from scipy.integrate import quad
 
 import fracid
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.ranges import ELASTIC, compose
-from fracid.fem.tsl import STRENGTH_AND_ENERGY
-from fracid.inverse.forward_operator import ForwardOperator, Observation
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.material.ranges import ELASTIC, compose
+from fracid.fem.material.tsl import STRENGTH_AND_ENERGY
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.models import CohesiveCrackModel, StepOptions
 from fracid.specimens.beam import NotchedBeam
 

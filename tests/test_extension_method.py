@@ -1,6 +1,6 @@
 """A new inverse method, written in this file only (no package file edited): KNN over a small population,
 then Nelder-Mead (scipy) on the Bayesian objective, with the covariance of the linearised problem at the end.
-Registered in ``fracid.inverse.methods.METHODS``, it runs through ``identify``, ``run_study`` and a
+Registered in ``fracid.inverse.methods.registry.METHODS``, it runs through ``identify``, ``run_study`` and a
 configuration file (``[identify] method`` with its own ``[identify.<name>]`` table) by ``fracid identify``
 and ``fracid study``."""
 
@@ -17,16 +17,16 @@ from hostile import TRUTH, bar_config, synthetic_curve, write_csv
 
 import fracid
 from fracid import cli
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn_kalman import KnnSettings, population_search
-from fracid.inverse.method import MethodResult, identification_bounds, result_fields
-from fracid.inverse.methods import METHODS, StudyMethod
-from fracid.inverse.runs import StoredOperator
-from fracid.inverse.sensitivity import ForwardRunError, exact_sensitivity
-from fracid.inverse.space import ParameterSpace
-from fracid.inverse.strategy import identify
-from fracid.inverse.study import StudySettings, run_study
-from fracid.inverse.twin import synthetic_data
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn_kalman import KnnSettings, population_search
+from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
+from fracid.inverse.methods.registry import METHODS, StudyMethod
+from fracid.inverse.core.runs import StoredOperator
+from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.strategy import identify
+from fracid.inverse.studies.study import StudySettings, run_study
+from fracid.inverse.studies.twin import synthetic_data
 
 optimize = pytest.importorskip("scipy.optimize")
 pytestmark = pytest.mark.slow

@@ -2,7 +2,7 @@
 the notched beam (cohesive crack, symmetric half) at given control values, with its exact
 sensitivities, run by the unchanged ForwardOperator and identified by the unchanged inverse code.
 
-The kind is a plain class with the members of ``fracid.inverse.observations.ObservationKind``: the
+The kind is a plain class with the members of ``fracid.inverse.core.observations.ObservationKind``: the
 run it needs, the displacement functionals (probes) the run must record (the opening of a node of the
 crack line is twice its displacement normal to the line: the half model's symmetry), its size and
 control values, the coordinates of its values and ``sample(run) -> (y, S)``, S from the run's
@@ -14,10 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.observations import ObservationKind
-from fracid.inverse.strategy import identify
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.observations import ObservationKind
+from fracid.inverse.methods.strategy import identify
 from fracid.models import CohesiveCrackModel, StepOptions
 from fracid.specimens import SPECIMENS
 
@@ -72,7 +72,7 @@ class CrackOpeningProfile:
     def coordinates(self):
         return {"control": self.controls, "position": np.tile(self.position, self.frames.size)}
 
-    # read by the inverse code's result fields (fracid.inverse.method.observed_fields) until it reads
+    # read by the inverse code's result fields (fracid.inverse.core.method.observed_fields) until it reads
     # ``controls`` and ``name``: not part of the protocol
     control_points = controls
     quantity = "opening"

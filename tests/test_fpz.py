@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fracid.fem.fpz import across_sampler, fpz_width
+from fracid.fem.formulations.fpz import across_sampler, fpz_width
 
 
 def _points(h=2.0):
@@ -43,7 +43,7 @@ def test_no_damage_gives_zero_width_and_a_half_model_is_doubled():
 
 
 def test_superlevel_length_of_many_lines_at_once_equals_line_by_line():
-    from fracid.fem.level_sets import superlevel_length
+    from fracid.fem.mesh.level_sets import superlevel_length
 
     x = np.linspace(0.0, 10.0, 41)
     lines = np.sin(x[None, :] + np.arange(5)[:, None]) + 0.2

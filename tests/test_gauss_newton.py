@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from fracid.inverse.forward_operator import RunRecord
-from fracid.inverse.gauss_newton import gauss_newton
-from fracid.inverse.kalman import batch_kalman, kalman_filter
-from fracid.inverse.sensitivity import ForwardRunError, evaluate_points
+from fracid.inverse.core.forward_operator import RunRecord
+from fracid.inverse.methods.gauss_newton import gauss_newton
+from fracid.inverse.methods.kalman import batch_kalman, kalman_filter
+from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points
 
 
 def linear_problem(seed=0, n=12):

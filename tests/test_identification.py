@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.kalman import kalman_filter
-from fracid.inverse.knn import ParameterSpace, design, knn_from_population, knn_search, objective
-from fracid.inverse.strategy import identify
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.kalman import kalman_filter
+from fracid.inverse.methods.knn import ParameterSpace, design, knn_from_population, knn_search, objective
+from fracid.inverse.methods.strategy import identify
 
 BAR = fracid.BarWithWeakZone(n_elements=100)
 POINTS = np.linspace(0.004, 0.03, 16)  # end displacement [mm]: pre-peak, peak and softening
@@ -78,7 +78,7 @@ def test_failed_forward_runs_are_recorded_and_do_not_stop_the_study(bar_operator
 def test_study_counts_failed_runs_and_stays_in_the_bounds(bar_operator, bar_data):
     """A population with failing corners: the study goes on and states the failures in its summary (verdict.txt)."""
     from fracid.data import ExperimentalData
-    from fracid.inverse.study import StudySettings, run_study
+    from fracid.inverse.studies.study import StudySettings, run_study
 
     y, std = bar_data
     data = ExperimentalData(control=POINTS, y=y, covariance=np.eye(y.size) * std**2, blocks=[("global", 0, y.size)])
@@ -156,7 +156,7 @@ def test_twin_noisy_dogbone_truth_within_two_sigma():
 def test_global_and_local_blocks_from_experimental_data(bar_operator):
     """Force curve plus the damaged-zone width (local data) as a second block, through fracid.data."""
     from fracid.data import ExperimentalData, stack
-    from fracid.inverse.strategy import identify_data
+    from fracid.inverse.methods.strategy import identify_data
 
     op = ForwardOperator([Observation(BAR, POINTS, name="global"),
                           Observation(BAR, POINTS[4:], quantity="damaged_zone_width", name="local")],

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
-from fracid.inverse.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
-from fracid.inverse.study import StudySettings
-from fracid.inverse.twin import synthetic_data
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
+from fracid.inverse.methods.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
+from fracid.inverse.studies.study import StudySettings
+from fracid.inverse.studies.twin import synthetic_data
 
 optimize = pytest.importorskip("scipy.optimize")
 
@@ -163,7 +163,7 @@ def test_a_fit_within_the_scatter_is_not_flagged():
 
 def test_verdict_txt_carries_the_warnings_of_the_identification(tmp_path):
     """The study's summary (verdict.txt) gives the warnings stderr and report.html give: misfit, bound."""
-    from fracid.inverse.study import StudyResult
+    from fracid.inverse.studies.study import StudyResult
 
     class Verdict:
         measure = "Gaussian (linearised) std"

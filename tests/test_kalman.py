@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fracid.inverse.kalman import batch_kalman, kalman_filter, kalman_update
+from fracid.inverse.methods.kalman import batch_kalman, kalman_filter, kalman_update
 
 
 def linear_problem(seed=0, n=12, p=3):
@@ -76,7 +76,7 @@ def test_bad_inputs_are_refused():
 
 def recording(h, fails=lambda x: False):
     """h that records every point it is asked for, and fails (a failed RunRecord) where ``fails``."""
-    from fracid.inverse.forward_operator import RunRecord
+    from fracid.inverse.core.forward_operator import RunRecord
 
     asked = []
 
@@ -108,7 +108,7 @@ def test_estimates_stay_inside_the_bounds_and_are_flagged(groups):
 
 
 def test_projection_is_the_most_probable_point_in_the_box():
-    from fracid.inverse.kalman import project_to_box
+    from fracid.inverse.methods.kalman import project_to_box
 
     C = np.array([[1.0, 0.95], [0.95, 1.0]])
     x = np.array([2.0, 1.8])

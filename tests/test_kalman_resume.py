@@ -13,9 +13,9 @@ import pytest
 from _bar_study import stored_rows, write_bar_study
 
 import fracid
-from fracid.inverse import runs as runs_module
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.runs import StoredOperator, run_key
+from fracid.inverse.core import runs as runs_module
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.core.runs import StoredOperator, run_key
 from fracid.store import RunStore
 
 N_KNN = 8

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.kalman import kalman_filter
-from fracid.inverse.kalman_status import (CONVERGED_STEP, POOR_CHI2_PER_POINT, chi2_per_point, oscillates,
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.kalman import kalman_filter
+from fracid.inverse.methods.kalman_status import (CONVERGED_STEP, POOR_CHI2_PER_POINT, chi2_per_point, oscillates,
                                           pass_change, restarted, valley_text)
-from fracid.inverse.knn import ParameterSpace, design, knn_from_population
+from fracid.inverse.methods.knn import ParameterSpace, design, knn_from_population
 
 T = np.array([0.5, 1.0, 1.5])
 
@@ -128,7 +128,7 @@ def test_an_oscillation_that_damping_has_not_stopped_yet_is_reported():
 def test_convergence_is_judged_on_the_step_in_std_and_the_objective():
     """The criteria on hand-made last passes: a step below 0.1 std with an objective change below 1 chi^2 unit
     or 1 % converges; a larger objective change or step does not."""
-    from fracid.inverse.kalman_status import KalmanResult, judge
+    from fracid.inverse.methods.kalman_status import KalmanResult, judge
 
     C = np.diag([1.0, 1.0])
     names = ["a", "b"]

@@ -1,5 +1,5 @@
 """A twin experiment with 100 000 data values and a diagonal covariance: identified back through
-``fracid.inverse.strategy.identify`` with no cap on the data size and no n x n matrix (issue 26, item 3)."""
+``fracid.inverse.methods.strategy.identify`` with no cap on the data size and no n x n matrix (issue 26, item 3)."""
 
 import time
 import tracemalloc
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from fracid.data import Diagonal, ExperimentalData
-from fracid.inverse.forward_operator import RunRecord
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import identify
+from fracid.inverse.core.forward_operator import RunRecord
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.methods.strategy import identify
 
 N = 100_000
 SPACE = ParameterSpace(("a", "b"), [1.0, 0.05], [5.0, 1.0])

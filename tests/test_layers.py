@@ -178,8 +178,8 @@ def test_no_import_cycle_at_module_level():
 def test_no_import_cycle_through_function_level_imports_but_the_known_ones():
     """With the imports inside functions too (fracid's lazy imports, which keep start-up fast), the only
     cycles are those of :data:`KNOWN_LAZY_CYCLES`: the command (fracid.cli and its siblings, which share
-    fracid.cli_common) and the linear solvers (fracid.fem.linear_solvers, whose backends import
-    fracid.fem.linear_backend) are in none."""
+    fracid.cli_common) and the linear solvers (fracid.fem.path.linear_solvers, whose backends import
+    fracid.fem.path.linear_backend) are in none."""
     new = [cycle for cycle in import_cycles(import_graph(lazy=True))
            if not any(set(cycle) <= known for known in KNOWN_LAZY_CYCLES)]
     assert new == []

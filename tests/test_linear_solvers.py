@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 
 import fracid
-from fracid.fem.linear_solvers import SuperLUSolver, SymmetricOrdering, linear_solver
+from fracid.fem.path.linear_solvers import SuperLUSolver, SymmetricOrdering, linear_solver
 from fracid.models import DamageModel
 from fracid.specimens import SPECIMENS
 
@@ -49,7 +49,7 @@ def test_curves_equal_those_of_superlus_own_ordering(specimen, target):
 
 
 def test_runs_on_one_mesh_share_the_pattern_and_the_ordering():
-    from fracid.fem.assembly import SparsePattern
+    from fracid.fem.mesh.assembly import SparsePattern
 
     beam = SPECIMENS["notched-beam"](h_fine=4.0, h_coarse=12.0)
     solver = linear_solver("superlu")

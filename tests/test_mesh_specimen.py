@@ -246,7 +246,7 @@ def test_the_notched_beam_rebuilt_from_a_gmsh_file_traces_the_built_in_curve(tmp
     # support's centre and spreads the load over the plate (rigid plates would clamp the cracked halves)
     from dataclasses import replace
 
-    from fracid.fem.cohesive import CohesiveParameters
+    from fracid.fem.material.cohesive import CohesiveParameters
     from fracid.models import CohesiveCrackModel
 
     open_crack = replace(rebuilt, supports=(("support_point", "y"),), loads=(("loading_plate", "y", False, -0.5),))
@@ -317,8 +317,8 @@ def test_the_triangle_meshed_beam_matches_the_built_in_q8_beam(tmp_path):
 def test_twin_identification_of_c_and_beta_on_a_triangle_meshed_beam(tmp_path):
     """Noise-free CMOD data of the gradient model on the beam meshed with triangles at (c, beta) = (4, 500):
     Gauss-Newton with the exact sensitivities from (6, 400) finds them back within 1 %."""
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.gauss_newton import gauss_newton
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.methods.gauss_newton import gauss_newton
     from fracid.specimens.beam import NotchedBeam
 
     specimen = beam_msh(NotchedBeam(h_fine=4.0, h_coarse=12.0), tmp_path / "beam.msh", triangles=True)

@@ -1,4 +1,4 @@
-"""The registry of inverse methods (fracid.inverse.methods.METHODS) and ``[identify] method``: chosen in
+"""The registry of inverse methods (fracid.inverse.methods.registry.METHODS) and ``[identify] method``: chosen in
 the configuration, validated, and run by ``fracid identify``."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pytest
 from hostile import TRUTH, bar_config, check, run_fracid, synthetic_curve, write_csv
 
 from fracid.config import ConfigError, build_method, load_config
-from fracid.inverse.methods import METHODS
-from fracid.inverse.strategy import KnnGaussNewton, KnnKalman
+from fracid.inverse.methods.registry import METHODS
+from fracid.inverse.methods.strategy import KnnGaussNewton, KnnKalman
 
 OUT = ("--out", "out", "--workers", "1", "--quiet")
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.strategy import identify
-from fracid.inverse.study import StudySettings, run_study
-from fracid.inverse.twin import synthetic_data
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.methods.strategy import identify
+from fracid.inverse.studies.study import StudySettings, run_study
+from fracid.inverse.studies.twin import synthetic_data
 from fracid.models import DamageModel, parameter_units
 
 
@@ -94,7 +94,7 @@ def test_operator_rejects_parameters_of_another_model():
 
 
 def test_damage_model_is_the_default_and_keys_differ_between_models():
-    from fracid.inverse.runs import run_key
+    from fracid.inverse.core.runs import run_key
 
     bar = fracid.BarWithWeakZone(n_elements=40)
     gradient = ForwardOperator([Observation(bar, POINTS)], fracid.DamageParameters(), ("c",))
@@ -112,7 +112,7 @@ class FailingBar(LinearCohesiveBar):
     key: ClassVar[str] = "test-failing-bar"
 
     def simulate(self, specimen, p, **options):
-        from fracid.fem.path_following import ConvergenceError
+        from fracid.fem.path.path_following import ConvergenceError
 
         result = super().simulate(specimen, p, **options)
         if p.Gf < 0.09:
@@ -122,7 +122,7 @@ class FailingBar(LinearCohesiveBar):
 
 
 def test_model_comparison_records_a_failed_fit_and_keeps_the_others():
-    from fracid.inverse.cross_model import Candidate, compare_models
+    from fracid.inverse.studies.cross_model import Candidate, compare_models
 
     op = ForwardOperator([Observation(Bar(), POINTS)], SofteningBarParameters(), ("ft", "Gf"), model=LinearCohesiveBar())
     data = synthetic_data(op, [3.0, 0.05], {"global:relative": 0.01}, seed=None)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fracid.fem.cohesive import CohesiveParameters
+from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.models import MODEL_TYPES, CohesiveCrackModel, CrackBandModel, model_from_type, runs_on
 from fracid.specimens import SPECIMENS, BarWithWeakZone, DogBone, NotchedBeam, TensionStrip, WedgeSplitting
 

@@ -4,10 +4,10 @@ blocks, the scalar spaces' interpolation, the history allocation and the element
 import numpy as np
 import pytest
 
-from fracid.fem.discretization import bar_discretization, plane_stress_discretization
-from fracid.fem.dofs import Conditions, FieldSpec, number_dofs
-from fracid.fem.forms import ElementArrays
-from fracid.fem.protocol import HistoryVariable, allocate_history, initial_history
+from fracid.fem.mesh.discretization import bar_discretization, plane_stress_discretization
+from fracid.fem.mesh.dofs import Conditions, FieldSpec, number_dofs
+from fracid.fem.formulations.forms import ElementArrays
+from fracid.fem.formulations.protocol import HistoryVariable, allocate_history, initial_history
 from fracid.specimens.meshing import structured_quad8, structured_tri6
 
 N_EL = 4  # bar elements: 9 displacement nodes, 5 vertices

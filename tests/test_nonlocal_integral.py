@@ -11,11 +11,11 @@ from test_mesh_objectivity import run
 from test_tangent import finite_difference_jacobian, post_peak_state
 
 import fracid
-from fracid.fem.assembly import SparsePattern
-from fracid.fem.discretization import bar_discretization, plane_stress_discretization
-from fracid.fem.nonlocal_average import averaging_matrix, internal_length
-from fracid.fem.problem import DamageProblem
-from fracid.fem.solver import ControlledSystem
+from fracid.fem.mesh.assembly import SparsePattern
+from fracid.fem.mesh.discretization import bar_discretization, plane_stress_discretization
+from fracid.fem.formulations.nonlocal_average import averaging_matrix, internal_length
+from fracid.fem.formulations.problem import DamageProblem
+from fracid.fem.path.solver import ControlledSystem
 from fracid.models import MODEL_TYPES, DamageModel
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
@@ -183,10 +183,10 @@ def test_integral_model_is_mesh_objective_where_the_local_model_is_not():
 
 
 def test_twin_experiment_recovers_c_and_beta_noise_free():
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.knn import ParameterSpace
-    from fracid.inverse.strategy import identify
-    from fracid.inverse.twin import synthetic_data
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.methods.strategy import identify
+    from fracid.inverse.studies.twin import synthetic_data
 
     bar = fracid.BarWithWeakZone(n_elements=100)
     op = ForwardOperator([Observation(bar, np.linspace(0.004, 0.03, 16))], fracid.DamageParameters(), ("c", "beta"),

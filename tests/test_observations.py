@@ -1,15 +1,15 @@
-"""Observations as objects: the point-probe operator (fracid.fem.probes), the field observation kind
+"""Observations as objects: the point-probe operator (fracid.fem.mesh.probes), the field observation kind
 and the curve kind behind the ObservationKind protocol of the forward operator."""
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from fracid.fem.elements import quad_serendipity, triangle_quadratic
-from fracid.fem.probes import dof_matrix, locate, probe_matrix
-from fracid.inverse.forward_operator import FieldObservation, ForwardOperator, Observation, ObservationKind
-from fracid.inverse.probed import ProbedSpecimen, merge_probes
-from fracid.inverse.runs import run_key
+from fracid.fem.mesh.elements import quad_serendipity, triangle_quadratic
+from fracid.fem.mesh.probes import dof_matrix, locate, probe_matrix
+from fracid.inverse.core.forward_operator import FieldObservation, ForwardOperator, Observation, ObservationKind
+from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
+from fracid.inverse.core.runs import run_key
 from fracid.models import DamageModel, StepOptions
 from fracid.specimens import SPECIMENS
 from fracid.specimens.meshing import structured_quad8, structured_tri6

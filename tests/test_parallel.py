@@ -261,9 +261,9 @@ def test_filters_run_side_by_side_on_the_pool_and_share_the_store(tmp_path):
     """The multi-start filters run in threads that submit their runs to the pool; each thread writes
     the store through a connection of its own; the ends equal those of the filters run one by one."""
     import fracid
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.runs import StoredOperator
-    from fracid.inverse.uniqueness import multi_start
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.core.runs import StoredOperator
+    from fracid.inverse.studies.uniqueness import multi_start
     from fracid.parallel import concurrently, executor_width
 
     op = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=40), np.linspace(0.004, 0.03, 6))],

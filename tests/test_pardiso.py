@@ -10,11 +10,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import fracid
-from fracid.fem import pardiso as pardiso_module
-from fracid.fem.linear_solvers import SingularMatrixError, SuperLUSolver
-from fracid.fem.pardiso import PardisoSolver
+from fracid.fem.path import pardiso as pardiso_module
+from fracid.fem.path.linear_solvers import SingularMatrixError, SuperLUSolver
+from fracid.fem.path.pardiso import PardisoSolver
 
-pytest.importorskip("pypardiso")  # fracid.fem.pardiso itself imports it only when a solver is made
+pytest.importorskip("pypardiso")  # fracid.fem.path.pardiso itself imports it only when a solver is made
 
 # Step rule made insensitive to round-off, so that both backends take the same steps: with the defaults,
 # the step after the jump to 0.999 x onset lands exactly on the onset (0.999 + 0.02/20), and whether it
@@ -178,7 +178,7 @@ def test_plane_stress_dog_bone_matches_superlu():
 
 
 def test_registered_by_name_when_available():
-    from fracid.fem import linear_solvers
+    from fracid.fem.path import linear_solvers
 
     if "pardiso" not in linear_solvers._BACKENDS:
         pytest.skip("'pardiso' is not registered in linear_solvers._BACKENDS yet")
@@ -197,7 +197,7 @@ def test_missing_pypardiso_gives_a_clear_error(monkeypatch):
 
 
 def test_importing_fracid_does_not_import_pypardiso():
-    code = "import sys, fracid, fracid.fem.pardiso; assert 'pypardiso' not in sys.modules"
+    code = "import sys, fracid, fracid.fem.path.pardiso; assert 'pypardiso' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
@@ -218,7 +218,7 @@ def test_the_peer_beam_at_its_fine_mesh_runs_and_equals_superlu():
 
 
 def test_runs_on_one_mesh_share_the_symbolic_analysis():
-    from fracid.fem.linear_solvers import linear_solver
+    from fracid.fem.path.linear_solvers import linear_solver
     from fracid.models import DamageModel
 
     bar = fracid.BarWithWeakZone(n_elements=40)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.fem.discretization import plane_stress_discretization
-from fracid.fem.dofs import Conditions
-from fracid.fem.laws import DamageLaw
-from fracid.fem.problem import GradientDamageProblem
+from fracid.fem.mesh.discretization import plane_stress_discretization
+from fracid.fem.mesh.dofs import Conditions
+from fracid.fem.material.laws import DamageLaw
+from fracid.fem.formulations.problem import GradientDamageProblem
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 from fracid.specimens.meshing import structured_quad8

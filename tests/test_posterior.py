@@ -1,4 +1,4 @@
-"""Adaptive importance sampling of the posterior (fracid.inverse.posterior) against posteriors known by quadrature:
+"""Adaptive importance sampling of the posterior (fracid.inverse.sampling.posterior) against posteriors known by quadrature:
 a curved (banana) valley, a bounded one, failed runs, reproducible draws; the floor of the effective sample size."""
 
 import json
@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.forward_operator import RunRecord
-from fracid.inverse.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior, weighted_quantile
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.forward_operator import RunRecord
+from fracid.inverse.sampling.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior, weighted_quantile
 
 BANANA_Y = np.array([0.0, 0.5, 0.3])
 BANANA_C = np.diag([0.5, 0.1, 0.6]) ** 2

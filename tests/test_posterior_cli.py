@@ -13,7 +13,7 @@ import pytest
 
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli, exits
-from fracid.inverse.posterior import PosteriorSettings, weighted_quantile
+from fracid.inverse.sampling.posterior import PosteriorSettings, weighted_quantile
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -70,7 +70,7 @@ def test_rerun_reuses_every_stored_run_and_skips_netcdf_without_arviz(run, capsy
 
 
 def test_no_finite_kalman_covariance_exits_3(run, tmp_path, monkeypatch, capsys):
-    from fracid.inverse import strategy
+    from fracid.inverse.methods import strategy
 
     config, out = run
     (tmp_path / "out").mkdir()
@@ -119,10 +119,10 @@ def test_all_runs_failed_is_a_computation_failure():
     """Every forward run of the sampler fails: a ForwardRunError, exit status 3 with the message."""
     from types import SimpleNamespace
 
-    from fracid.inverse.forward_operator import RunRecord
-    from fracid.inverse.knn import ParameterSpace
-    from fracid.inverse.sensitivity import ForwardRunError
-    from fracid.inverse.posterior import sample_posterior
+    from fracid.inverse.core.forward_operator import RunRecord
+    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.sensitivity import ForwardRunError
+    from fracid.inverse.sampling.posterior import sample_posterior
 
     def failing(x, needed=None):
         return RunRecord(np.asarray(x), np.full(2, np.nan), status="failed", error="diverged")

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.protocol import Problem, allocate_history, initial_history
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.formulations.protocol import Problem, allocate_history, initial_history
 from fracid.models import MODEL_TYPES, model_from_type, runs_on
 from fracid.specimens import DogBone, NotchedBeam
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.method import MethodResult
-from fracid.inverse.strategy import IdentificationResult
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.method import MethodResult
+from fracid.inverse.methods.strategy import IdentificationResult
 from fracid.provenance import collect, json_safe
 from fracid.store import RunStore
 

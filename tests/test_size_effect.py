@@ -8,7 +8,7 @@ import pytest
 from scipy.optimize import curve_fit
 
 import fracid
-from fracid.inverse.size_effect import (
+from fracid.inverse.studies.size_effect import (
     SizeEffectFit,
     bazant_law,
     fit_size_effect,
@@ -16,7 +16,7 @@ from fracid.inverse.size_effect import (
     size_effect_series,
     specimen_size,
 )
-from fracid.fem.path_following import ConvergenceError, PathResult
+from fracid.fem.path.path_following import ConvergenceError, PathResult
 from fracid.parallel import make_executor
 from fracid.report.figures import size_effect_figure, to_png
 from fracid.specimens.beam import NotchedBeam

@@ -14,8 +14,8 @@ import pytest
 from fracid import cli
 from fracid.config import ConfigError, load_config
 from fracid.config.sections import _specimen_error_key
-from fracid.fem.laws import HordijkLaw
-from fracid.fem.path_following import StepOptions
+from fracid.fem.material.laws import HordijkLaw
+from fracid.fem.path.path_following import StepOptions
 from fracid.field_error import FieldError
 from fracid.models import (MODEL_TYPES, CohesiveCrackModel, CrackBandModel, DamageModel, ForwardModel, declared,
                            runs_on)

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.knn import ParameterSpace, knn_from_population
-from fracid.inverse.stability import noisy_replicates, stability
-from fracid.inverse.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_level
-from fracid.inverse.verdict import DataDescription, parameter_verdicts
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.knn import ParameterSpace, knn_from_population
+from fracid.inverse.studies.stability import noisy_replicates, stability
+from fracid.inverse.studies.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_level
+from fracid.inverse.studies.verdict import DataDescription, parameter_verdicts
 
 TRUTH = np.array([2.0, 250.0])
 SPACE = ParameterSpace(("c", "beta"), [0.5, 100.0], [5.0, 600.0])
@@ -106,7 +106,7 @@ def test_multi_start_ends_agree_when_the_data_identify(executor):
 
 
 def test_valley_figure_places_multi_start_ends_in_each_pairs_columns():
-    from fracid.inverse.uniqueness import MultiStart
+    from fracid.inverse.studies.uniqueness import MultiStart
     from fracid.report.study import valley_figure
 
     space = ParameterSpace(("a", "b", "c"), [0.0, 0.0, 0.0], [1.0, 2.0, 3.0])
@@ -124,8 +124,8 @@ def test_study_valley_is_centred_on_the_estimate():
     """A twin (bar, noisy data): the objective maps and the valley are measured from the identification's
     estimate and its objective, not from the best population point (which fits worse)."""
     from fracid.data import ExperimentalData
-    from fracid.inverse.knn import objective
-    from fracid.inverse.study import StudySettings, run_study
+    from fracid.inverse.methods.knn import objective
+    from fracid.inverse.studies.study import StudySettings, run_study
 
     operator = _bar_operator([100.0])
     y = operator(TRUTH).y

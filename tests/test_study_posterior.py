@@ -10,8 +10,8 @@ import pytest
 
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli, exits
-from fracid.inverse.posterior import PosteriorResult
-from fracid.inverse.verdict import GAUSSIAN_MEASURE, POSTERIOR_MEASURE, Z_90, DataDescription, parameter_verdicts
+from fracid.inverse.sampling.posterior import PosteriorResult
+from fracid.inverse.studies.verdict import GAUSSIAN_MEASURE, POSTERIOR_MEASURE, Z_90, DataDescription, parameter_verdicts
 
 STUDY = "\n[study]\nstarts = 2\nreplicates = 2\nposterior = true\n"
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.fem.assembly import SparsePattern
+from fracid.fem.mesh.assembly import SparsePattern
 from fracid.models import DamageModel
 
 

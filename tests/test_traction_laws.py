@@ -1,4 +1,4 @@
-"""Traction-separation laws as objects (fracid.fem.tsl, fracid.fem.laws): Hordijk's, linear and bilinear
+"""Traction-separation laws as objects (fracid.fem.material.tsl, fracid.fem.material.laws): Hordijk's, linear and bilinear
 softening; the secant unloading and the scaled law built on any law; composed parameter classes; the
 cohesive crack and the crack band running the new laws, with their exact sensitivities."""
 
@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from fracid.fem.cohesive import CohesiveParameters, hordijk_stress, hordijk_tangent
-from fracid.fem.laws import (TRACTION_SEPARATION_LAWS, BilinearSoftening, BilinearSofteningParameters, HordijkLaw,
+from fracid.fem.material.cohesive import CohesiveParameters, hordijk_stress, hordijk_tangent
+from fracid.fem.material.laws import (TRACTION_SEPARATION_LAWS, BilinearSoftening, BilinearSofteningParameters, HordijkLaw,
                              LinearSoftening, LinearSofteningParameters)
-from fracid.fem.ranges import ELASTIC, Field, ParameterRange, compose
-from fracid.fem.tsl import ScaledLaw, secant_unloading, secant_unloading_parameter_derivatives
+from fracid.fem.material.ranges import ELASTIC, Field, ParameterRange, compose
+from fracid.fem.material.tsl import ScaledLaw, secant_unloading, secant_unloading_parameter_derivatives
 from fracid.models import CohesiveCrackModel, CrackBandModel
 from fracid.specimens.strip import TensionStrip
 
@@ -175,7 +175,7 @@ def test_composed_parameter_classes_have_fields_ranges_units_and_docstrings_in_o
         assert cls.names() == names and cls.units()["Gf"] == "N/mm" and cls.units()["E"] == "MPa"
         p = cls()
         assert pickle.loads(pickle.dumps(p)) == p  # found again by module and name (process pools, the run store)
-        assert cls.__module__ == "fracid.fem.laws" and cls.__qualname__ == cls.__name__
+        assert cls.__module__ == "fracid.fem.material.laws" and cls.__qualname__ == cls.__name__
         assert "Parameters\n----------\nE : float\n    Young's modulus of the bulk [MPa], 0 < E." in cls.__doc__
         with pytest.raises(ValueError, match=r"parameter 'ft' = -1.0 is out of range; valid range: 0 < ft"):
             p.replace(ft=-1.0)
@@ -228,7 +228,7 @@ def test_crack_band_dissipates_the_energy_of_its_law(name):
     """The tension strip opened to 0.99 wc of its weak column (strength and openings scaled by 0.98):
     the dissipated energy is the area under the law up to that opening less the triangle the crack
     would give back on secant unloading, 1 % of Gf for the linear law, whatever the element size."""
-    from fracid.fem.path_following import follow_path
+    from fracid.fem.path.path_following import follow_path
 
     law, params = LAWS[name]
     model = CrackBandModel(law=law)

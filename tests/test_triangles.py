@@ -10,11 +10,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 import fracid
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.fem.discretization import plane_stress_discretization
-from fracid.fem.elasticity import plane_stress_matrix
-from fracid.fem.elements import gauss_triangle, triangle_linear, triangle_quadratic
-from fracid.fem.path_following import StepOptions
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.fem.mesh.discretization import plane_stress_discretization
+from fracid.fem.material.elasticity import plane_stress_matrix
+from fracid.fem.mesh.elements import gauss_triangle, triangle_linear, triangle_quadratic
+from fracid.fem.path.path_following import StepOptions
 from fracid.models import CrackBandModel, DamageModel
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import structured_quad8, structured_tri6

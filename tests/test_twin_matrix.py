@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.knn import ParameterSpace
-from fracid.inverse.twin import dogbone_cases, twin_matrix
+from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.studies.twin import dogbone_cases, twin_matrix
 
 pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
 

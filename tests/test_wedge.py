@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.fem.cohesive import CohesiveParameters
-from fracid.inverse.forward_operator import ForwardOperator, Observation
-from fracid.inverse.gauss_newton import gauss_newton
+from fracid.fem.material.cohesive import CohesiveParameters
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.methods.gauss_newton import gauss_newton
 from fracid.models import CohesiveCrackModel, DamageModel
 from fracid.specimens import SPECIMENS
 from fracid.specimens.wedge import WedgeSplitting

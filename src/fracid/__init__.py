@@ -9,12 +9,12 @@ import importlib
 # while it starts finds the command's handler, not a half-imported scipy
 _EXPORTS = {
     "BarWithWeakZone": "fracid.specimens.bar",
-    "ConvergenceError": "fracid.fem.path_following",
-    "DamageParameters": "fracid.fem.parameters",
-    "NewtonOptions": "fracid.fem.solver",
-    "PathResult": "fracid.fem.path_following",
-    "StepOptions": "fracid.fem.path_following",
-    "follow_path": "fracid.fem.path_following",
+    "ConvergenceError": "fracid.fem.path.path_following",
+    "DamageParameters": "fracid.fem.material.parameters",
+    "NewtonOptions": "fracid.fem.path.solver",
+    "PathResult": "fracid.fem.path.path_following",
+    "StepOptions": "fracid.fem.path.path_following",
+    "follow_path": "fracid.fem.path.path_following",
     "simulate": "fracid.forward",
 }
 

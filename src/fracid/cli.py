@@ -123,12 +123,12 @@ def _identify_job(args, config_path):
     cfg = load(args, config_path, "identify")
     data = build_data(cfg)
     return SimpleNamespace(cfg=cfg, data=data, operator=build_operator(cfg, data), space=build_space(cfg),
-                           method=build_method(cfg))  # [identify] method, from fracid.inverse.methods.METHODS
+                           method=build_method(cfg))  # [identify] method, from fracid.inverse.methods.registry.METHODS
 
 
 def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
-    from fracid.inverse.strategy import identify_data
+    from fracid.inverse.methods.strategy import identify_data
 
     for line in _stage_plans(job.method, job.operator, job.data.n_y, len(job.space.names)):
         say(args, line)
@@ -183,8 +183,8 @@ def run_posterior_command(args) -> int:
     """``fracid identify``, then the posterior of the parameters sampled from its Gaussian on the exact model."""
     from fracid.config import posterior_settings
     from fracid.exits import FAILED
-    from fracid.inverse.runs import StoredOperator
-    from fracid.inverse.posterior import sample_posterior
+    from fracid.inverse.core.runs import StoredOperator
+    from fracid.inverse.sampling.posterior import sample_posterior
     from fracid.report.posterior import write_posterior
 
     job = _identify_job(args, args.config)
@@ -216,7 +216,7 @@ def run_posterior_command(args) -> int:
 
 
 def _stage_plans(method, operator, n_y: int, p: int) -> list[str]:
-    """What the method's stages will cost (its ``plan``, :class:`~fracid.inverse.plans.StagePlan`), said before
+    """What the method's stages will cost (its ``plan``, :class:`~fracid.inverse.core.plans.StagePlan`), said before
     the work starts; its stages' names for a method that has no plan."""
     plan = getattr(method, "plan", None)  # an optional capability of an inverse method
     if plan is None:

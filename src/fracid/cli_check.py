@@ -89,7 +89,7 @@ def identify_lines(cfg) -> list:
 
 def identify_plan(method, operator, n_y: int, p: int) -> list:
     """The stages of the configured inverse method and their forward runs (its ``plan``:
-    :class:`~fracid.inverse.plans.StagePlan` per stage; empty for a method without one)."""
+    :class:`~fracid.inverse.core.plans.StagePlan` per stage; empty for a method without one)."""
     plan = getattr(method, "plan", None)  # an optional capability of an inverse method
     return [] if plan is None else list(plan(operator, n_y, p))
 

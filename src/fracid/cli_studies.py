@@ -25,12 +25,12 @@ def run(args) -> int:
 
 
 def _size_effect(cfg, params, executor, sizes=(), quiet=True):
-    """:func:`~fracid.inverse.size_effect.compare_size_effect` over the sizes of the force experiments
+    """:func:`~fracid.inverse.studies.size_effect.compare_size_effect` over the sizes of the force experiments
     (and ``sizes``) with the measured nominal strength of those experiments; None below three sizes."""
     from dataclasses import replace
 
     from fracid.config import build_experiment_data, build_model, build_specimen
-    from fracid.inverse.size_effect import compare_size_effect, nominal_strength, specimen_size
+    from fracid.inverse.studies.size_effect import compare_size_effect, nominal_strength, specimen_size
 
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
@@ -62,7 +62,7 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
 
 def _has_size(cfg) -> bool:
     from fracid.config import build_specimen
-    from fracid.inverse.size_effect import has_nominal_strength
+    from fracid.inverse.studies.size_effect import has_nominal_strength
 
     return has_nominal_strength(build_specimen(cfg))
 
@@ -74,24 +74,24 @@ _STUDY_PARTS = {"study": {}, "uniqueness": {"replicates": 0, "posterior": None},
 
 
 def _study_settings(cfg, command):
-    """The :class:`~fracid.inverse.study.StudySettings` of ``[study]`` with the configured inverse method; a
+    """The :class:`~fracid.inverse.studies.study.StudySettings` of ``[study]`` with the configured inverse method; a
     method that cannot run the study's stages is the configuration's error (exit 2)."""
     from fracid.config import ConfigError, build_method, study_settings
-    from fracid.inverse.methods import StudyMethod
-    from fracid.inverse.study import StudySettings
+    from fracid.inverse.methods.registry import StudyMethod
+    from fracid.inverse.studies.study import StudySettings
 
     method = build_method(cfg)
     if not isinstance(method, StudyMethod):
         raise ConfigError(f"{cfg.path}: identify.method = {method.name!r}: `fracid {command}` runs the stages of an "
                           "inverse method (a search over a population, a refinement, a local fit from a point: "
-                          "fracid.inverse.methods.StudyMethod), which this method does not declare; use it with "
+                          "fracid.inverse.methods.registry.StudyMethod), which this method does not declare; use it with "
                           "`fracid identify`")
     return StudySettings(method=method).replace(**{**study_settings(cfg), **_STUDY_PARTS[command]})
 
 
 def run_study_command(args) -> int:
     from fracid.config import build_data, build_held_out, build_operator, build_space
-    from fracid.inverse.study import run_study
+    from fracid.inverse.studies.study import run_study
     from fracid.report.study import write_study
 
     cfg = load(args, args.config, "identify")
@@ -130,9 +130,9 @@ def run_study_command(args) -> int:
 
 def run_sensitivity_command(args) -> int:
     from fracid.config import build_data, build_operator, build_parameters, build_space
-    from fracid.inverse.sensitivity import sensitivity_history
-    from fracid.inverse.runs import StoredOperator
-    from fracid.inverse.uniqueness import bounds_covariance
+    from fracid.inverse.core.sensitivity import sensitivity_history
+    from fracid.inverse.core.runs import StoredOperator
+    from fracid.inverse.studies.uniqueness import bounds_covariance
     from fracid.report.figures import sensitivity_figure, to_png
 
     cfg = load(args, args.config, "identify")

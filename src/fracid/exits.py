@@ -106,9 +106,9 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     config_error = _loaded("fracid.config.schema", "ConfigError")
     data_error = _loaded("fracid.data.errors", "DataError")
     mesh_error = _loaded("fracid.specimens.mesh_reading", "MeshError")
-    all_failed = _loaded("fracid.inverse.knn", "AllRunsFailed")
-    run_error = _loaded("fracid.inverse.sensitivity", "ForwardRunError")
-    no_convergence = _loaded("fracid.fem.path_following", "ConvergenceError")
+    all_failed = _loaded("fracid.inverse.methods.knn", "AllRunsFailed")
+    run_error = _loaded("fracid.inverse.core.sensitivity", "ForwardRunError")
+    no_convergence = _loaded("fracid.fem.path.path_following", "ConvergenceError")
     resume = f"Finished runs are stored in {store_path}; run the same command again to resume." if store_path else ""
     if isinstance(err, HungUp):
         return HUNG_UP, f"hang-up (SIGHUP: the terminal closed). {resume}".strip()

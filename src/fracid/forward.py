@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fracid.fem.path_following import PathResult
+from fracid.fem.path.path_following import PathResult
 
 
 def _specimen_names() -> str:
@@ -49,7 +49,7 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
     specimen
         A specimen object (e.g. :class:`~fracid.specimens.bar.BarWithWeakZone`) or its description.
     params
-        The model's parameters (:class:`~fracid.fem.parameters.DamageParameters` for the damage models).
+        The model's parameters (:class:`~fracid.fem.material.parameters.DamageParameters` for the damage models).
     model : forward model, optional
         A model of :mod:`fracid.models`; the gradient damage model if None.
     regularization : {"gradient", "local", "integral"}, optional
@@ -60,7 +60,7 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
         (stop when the force falls below this fraction of its peak; None: run to ``target``),
         ``damage_threshold`` (damage above which a point counts in the damaged-zone width [-]),
         ``observables`` (names to record; all if None), ``steps`` (:class:`StepOptions`; the
-        specimen's default if None) and the options of :func:`~fracid.fem.path_following.follow_path`.
+        specimen's default if None) and the options of :func:`~fracid.fem.path.path_following.follow_path`.
 
     Raises
     ------

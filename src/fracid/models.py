@@ -12,7 +12,7 @@ A forward model declares
 damage_threshold, observables, sensitivities)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
-    :class:`~fracid.fem.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
+    :class:`~fracid.fem.path.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.
 ``runs_on(specimen)`` / ``why_not(specimen)``
     Whether it runs on a specimen, and why not (None when it does).
 ``differentiable`` : tuple of str
@@ -33,7 +33,7 @@ importable from here).
 The models below build their problem from the specimen's
 :class:`~fracid.specimens.description.Description` (``specimen.describe()``): a formulation (gradient,
 local or integral damage; cohesive interface; crack band) with a material law
-(:mod:`fracid.fem.laws`). :data:`MODEL_TYPES` is the registry the configuration reads.
+(:mod:`fracid.fem.material.laws`). :data:`MODEL_TYPES` is the registry the configuration reads.
 """
 
 from __future__ import annotations
@@ -44,14 +44,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from fracid.fem.crack_band_problem import CrackBandProblem, element_extent
-from fracid.fem.cohesive_problem import CohesiveCrackProblem, crack_edges
-from fracid.fem.fpz import zone_width_observer
-from fracid.fem.laws import DamageLaw, HordijkLaw
-from fracid.fem.probes import probe_matrix
-from fracid.fem.tsl import differentiable as gives_derivatives
-from fracid.fem.path_following import ConvergenceError, PathResult, StepOptions, follow_path
-from fracid.fem.problem import FORMULATIONS
+from fracid.fem.formulations.crack_band_problem import CrackBandProblem, element_extent
+from fracid.fem.formulations.cohesive_problem import CohesiveCrackProblem, crack_edges
+from fracid.fem.formulations.fpz import zone_width_observer
+from fracid.fem.material.laws import DamageLaw, HordijkLaw
+from fracid.fem.mesh.probes import probe_matrix
+from fracid.fem.material.tsl import differentiable as gives_derivatives
+from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOptions, follow_path
+from fracid.fem.formulations.problem import FORMULATIONS
 from fracid.model_protocol import ForwardModel, ModelDefaults, declared, runs_on
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
@@ -158,7 +158,7 @@ class DamageModel(_PathFollowing):
 
 
 class _CrackModel(_PathFollowing):
-    """The models of one crack with a traction-separation law (:class:`~fracid.fem.tsl.TractionSeparationLaw`,
+    """The models of one crack with a traction-separation law (:class:`~fracid.fem.material.tsl.TractionSeparationLaw`,
     Hordijk's by default): plane stress, where the specimen says the crack runs."""
 
     #: observers whose values the runs do not differentiate (a count of cracked points: a staircase)

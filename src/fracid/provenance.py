@@ -123,7 +123,7 @@ def specimen_record(specimen) -> dict | None:
 
 def bounds_record(bounds) -> dict | None:
     """Bounds as ``{name: [lower, upper]}``: from such a mapping, or from an object with ``names``,
-    ``lower`` and ``upper`` (a :class:`~fracid.inverse.space.ParameterSpace`)."""
+    ``lower`` and ``upper`` (a :class:`~fracid.inverse.core.space.ParameterSpace`)."""
     if bounds is None:
         return None
     if isinstance(bounds, Mapping):

@@ -32,7 +32,7 @@ dataclasses), :mod:`~fracid.config.checker` (TOML reading and value checks),
 Example
 -------
 >>> from fracid.config import load_config, build_data, build_operator, build_space, build_method
->>> from fracid.inverse.strategy import identify_data
+>>> from fracid.inverse.methods.strategy import identify_data
 >>> cfg = load_config("study.toml")                                   # doctest: +SKIP
 >>> data = build_data(cfg)                                            # doctest: +SKIP
 >>> result = identify_data(build_operator(cfg, data), data, build_space(cfg),

@@ -170,7 +170,7 @@ def build_data(cfg: Config):
 
 
 def _operator(cfg: Config, experiments, data):
-    from fracid.inverse.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 
     identify = _require(cfg, "identify")
     if len(data.blocks) != len(experiments):
@@ -209,7 +209,7 @@ def build_held_out(cfg: Config) -> list:
 
 
 def study_settings(cfg: Config) -> dict:
-    """The checks of ``[study]`` as keyword arguments of :meth:`fracid.inverse.study.StudySettings.replace`
+    """The checks of ``[study]`` as keyword arguments of :meth:`fracid.inverse.studies.study.StudySettings.replace`
     (``starts``, ``replicates``, ``noise_seed``, ``tolerance``, ``prior``; ``posterior``: the
     :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``, None otherwise). The
     inverse method is :func:`build_method`'s: ``StudySettings(method=build_method(cfg)).replace(**study_settings(cfg))``."""
@@ -220,14 +220,14 @@ def study_settings(cfg: Config) -> dict:
 
 
 def posterior_settings(cfg: Config):
-    """The :class:`~fracid.inverse.posterior.PosteriorSettings` of ``[posterior]`` (its defaults when the
+    """The :class:`~fracid.inverse.sampling.posterior.PosteriorSettings` of ``[posterior]`` (its defaults when the
     section is absent)."""
     return cfg.posterior
 
 
 def build_space(cfg: Config):
     """The parameter space of the KNN population: identified names, bounds, log flags."""
-    from fracid.inverse.space import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
 
     identify = _require(cfg, "identify")
     return ParameterSpace(identify.parameters, lower=list(identify.lower), upper=list(identify.upper),
@@ -236,9 +236,9 @@ def build_space(cfg: Config):
 
 def build_method(cfg: Config):
     """The configured inverse method: the class that ``[identify] method`` names in
-    :data:`fracid.inverse.methods.METHODS`, built by its ``from_config(identify, n_y)`` from the validated
+    :data:`fracid.inverse.methods.registry.METHODS`, built by its ``from_config(identify, n_y)`` from the validated
     ``[identify]`` (the sections of its settings; a method's own ``[identify.<name>]`` table is in
-    ``identify.methods``). Give it to :func:`fracid.inverse.strategy.identify_data` as ``method=``.
+    ``identify.methods``). Give it to :func:`fracid.inverse.methods.strategy.identify_data` as ``method=``.
 
     Raises
     ------

@@ -46,7 +46,7 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
         if needed:
             ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
         return None
-    from fracid.inverse.methods import METHODS
+    from fracid.inverse.methods.registry import METHODS
 
     ck.table("identify", raw, (*_IDENTIFY_KEYS, *(name for name in METHODS if name not in _IDENTIFY_KEYS)))
     cls = _model_of(model.type).parameters
@@ -183,7 +183,7 @@ def _gauss_newton(ck: _Checker, raw, inverse: str) -> GaussNewtonConfig:
 def _method_tables(ck: _Checker, raw, inverse: str) -> dict:
     """The registered methods' own tables ``[identify.<name>]``, as read (the method's ``from_config``
     checks its own); a warning for one of a method not chosen."""
-    from fracid.inverse.methods import METHODS
+    from fracid.inverse.methods.registry import METHODS
 
     methods = {}
     for name in (name for name in METHODS if name in raw):
@@ -205,7 +205,7 @@ def method_from_config(identify: IdentifyConfig, n_y: int | None):
     ValueError, TypeError
         The method's refusal of its settings (the message names the setting and what is allowed).
     """
-    from fracid.inverse.methods import METHODS
+    from fracid.inverse.methods.registry import METHODS
 
     cls = METHODS[identify.method]
     from_config = getattr(cls, "from_config", None)  # an optional hook of the method

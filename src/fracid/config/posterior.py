@@ -1,11 +1,11 @@
 """Validation of the ``[posterior]`` section: the settings of the sampler of ``fracid posterior``
-(:class:`~fracid.inverse.posterior.PosteriorSettings`); every key is optional."""
+(:class:`~fracid.inverse.sampling.posterior.PosteriorSettings`); every key is optional."""
 
 from __future__ import annotations
 
 from fracid.config.checker import _Checker
 from fracid.config.schema import _POSTERIOR_KEYS, PosteriorConfig
-from fracid.inverse.posterior import MIN_ESS, ess_floor
+from fracid.inverse.sampling.posterior import MIN_ESS, ess_floor
 
 
 def _posterior(ck: _Checker, raw) -> PosteriorConfig:

@@ -89,7 +89,7 @@ present they are always validated. Every other key is optional unless marked *re
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
                                             #   no duplicates
-    method = "knn-kalman"               # inverse method (fracid.inverse.methods.METHODS): "knn-kalman"
+    method = "knn-kalman"               # inverse method (fracid.inverse.methods.registry.METHODS): "knn-kalman"
                                         #   (default: KNN population, then the Kalman filter) |
                                         #   "knn-gauss-newton" (KNN, then bounded Gauss-Newton on the same
                                         #   objective; settings in [identify.gauss-newton])
@@ -155,7 +155,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fracid.config.registry import _model_of
-from fracid.inverse.posterior import PosteriorSettings
+from fracid.inverse.sampling.posterior import PosteriorSettings
 from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
     BAR_BYTES_PER_ELEMENT,
     BYTES_PER_UNKNOWN,
@@ -196,7 +196,7 @@ _IDENTIFY_KEYS = ("parameters", "method", "bounds", "knn", "kalman", "gauss-newt
 _KNN_KEYS = ("n", "method", "k", "seed")
 _KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
 _GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
-#: the default of [identify] method (a key of fracid.inverse.methods.METHODS)
+#: the default of [identify] method (a key of fracid.inverse.methods.registry.METHODS)
 DEFAULT_INVERSE_METHOD = "knn-kalman"
 _OUTPUT_KEYS = ("directory", "vtk_steps")
 _SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
@@ -336,7 +336,7 @@ class GaussNewtonConfig:
 @dataclass(frozen=True)
 class IdentifyConfig:
     """``[identify]``: identified parameters, their bounds and log flags, the inverse method (a key of
-    :data:`fracid.inverse.methods.METHODS`) and the sections of the registered methods' settings."""
+    :data:`fracid.inverse.methods.registry.METHODS`) and the sections of the registered methods' settings."""
 
     parameters: tuple
     lower: tuple

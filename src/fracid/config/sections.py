@@ -30,7 +30,7 @@ from fracid.config.schema import (
 
 def _range_text(cls, name: str) -> str:
     """The valid range of parameter ``name`` of the parameter class ``cls`` in words (e.g. ``"0 < c"``,
-    ``"-1 < nu < 0.5"``): from its :class:`~fracid.fem.ranges.ParameterRange` when it declares
+    ``"-1 < nu < 0.5"``): from its :class:`~fracid.fem.material.ranges.ParameterRange` when it declares
     ``ranges``, else the limits of ``valid_bounds`` (the interface every model's class has)."""
     rng = getattr(cls, "ranges", {}).get(name)
     if rng is not None:

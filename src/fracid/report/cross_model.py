@@ -1,6 +1,6 @@
 """Tables, figure and HTML report of cross-model calibrations and comparisons.
 
-Inputs are the results of :mod:`fracid.inverse.cross_model`: :class:`CrossCalibration` (model B
+Inputs are the results of :mod:`fracid.inverse.studies.cross_model`: :class:`CrossCalibration` (model B
 fitted to a curve of model A) and :class:`ModelComparison` (models fitted to one data set).
 :func:`cross_rows` and :func:`comparison_rows` give the tables as formatted cells, written as
 Markdown by :func:`markdown_table` and as HTML by :func:`write_cross_model_report`, which also
@@ -59,14 +59,14 @@ class CurvePanel:
 
     @classmethod
     def of_cross(cls, title: str, cross) -> "CurvePanel":
-        """The panel of a :class:`~fracid.inverse.cross_model.CrossCalibration`."""
+        """The panel of a :class:`~fracid.inverse.studies.cross_model.CrossCalibration`."""
         return cls(title, cross.data.control, cross.data.y, None, (cross.fit,),
                    (f"source: {cross.source_label}", cross.source_control, cross.source_force),
                    data_label="source at the data points")
 
     @classmethod
     def of_comparison(cls, title: str, comparison, data_label: str = "measured") -> "CurvePanel":
-        """The panel of a :class:`~fracid.inverse.cross_model.ModelComparison` (data with +-2 std)."""
+        """The panel of a :class:`~fracid.inverse.studies.cross_model.ModelComparison` (data with +-2 std)."""
         data = comparison.data
         return cls(title, data.control, data.y, data.std, tuple(comparison.fits), None, data_label)
 

@@ -1,13 +1,13 @@
 """Figures of an identification result (matplotlib, Agg canvas; no pyplot global state).
 
-Every ``*_figure`` function takes an :class:`~fracid.inverse.strategy.IdentificationResult` (or any
+Every ``*_figure`` function takes an :class:`~fracid.inverse.methods.strategy.IdentificationResult` (or any
 object with the same attributes; lists from a JSON file are accepted) and returns a
 :class:`matplotlib.figure.Figure`, or ``None`` when the result holds nothing to draw (no Kalman
 history, no KNN population, a single parameter for the map). :func:`to_png` renders a figure to PNG
 bytes at :data:`DPI`.
 
 Units: control [mm], force [N], parameters in the units of
-:meth:`~fracid.fem.parameters.DamageParameters.units`.
+:meth:`~fracid.fem.material.parameters.DamageParameters.units`.
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ def parameter_label(name: str) -> str:
 def block_quantity(name: str) -> str:
     """Axis label of the measured quantity of a data block: a width [mm] if its name says so,
     else the force [N]."""
-    from fracid.inverse.diagnostics import is_force_block
+    from fracid.inverse.core.diagnostics import is_force_block
 
     return "force [N]" if is_force_block(name) else f"{name} [mm]"
 

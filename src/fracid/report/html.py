@@ -30,7 +30,7 @@ def fit_metrics(result) -> list[dict]:
         ``index_peak_measured``/``index_peak_computed`` (positions in y) and ``f`` (the block's share
         of the objective sum(((y_exp - y_fit) / std_exp)^2)).
     """
-    from fracid.inverse.diagnostics import block_peak
+    from fracid.inverse.core.diagnostics import block_peak
     from fracid.report.figures import float_array, result_blocks
 
     y_exp = float_array(result.y_exp, np.nan)
@@ -119,9 +119,9 @@ def fit_section(result, control, figures, control_label=None) -> str:
 
 
 def diagnostics_fragment(result, control) -> str:
-    """The fit diagnostics (:mod:`fracid.inverse.diagnostics`): elastic slopes and peaks per force block,
+    """The fit diagnostics (:mod:`fracid.inverse.core.diagnostics`): elastic slopes and peaks per force block,
     the worst residual, what they can see."""
-    from fracid.inverse.diagnostics import ELASTIC_FRACTION, fit_diagnostics
+    from fracid.inverse.core.diagnostics import ELASTIC_FRACTION, fit_diagnostics
     from fracid.report.figures import float_array
 
     control = getattr(result, "control", None) if control is None else control

@@ -2,8 +2,8 @@
 plot, posterior predictive band), its JSON, and a self-contained HTML page setting the identification's
 Gaussian beside the sampled posterior.
 
-The sampler itself is :func:`fracid.inverse.posterior.posterior`; here it is only started from an
-identification (:func:`fracid.inverse.posterior.sample_posterior`) and written out (:func:`write_posterior`).
+The sampler itself is :func:`fracid.inverse.sampling.posterior.posterior`; here it is only started from an
+identification (:func:`fracid.inverse.sampling.posterior.sample_posterior`) and written out (:func:`write_posterior`).
 
 Units: control [mm], force [N], parameters in the units of the result (``PosteriorResult.units``).
 """
@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from fracid.inverse.verdict import Z_90
+from fracid.inverse.studies.verdict import Z_90
 from fracid.tables import without_nan
 from fracid.report.figures import (
     COMPUTED,
@@ -75,7 +75,7 @@ def _usable(result):
 def _limits(values, weights, centre, std, lower, upper, log: bool) -> tuple[float, float]:
     """Axis range of one parameter: the weighted draws' 0.1 % to 99.9 % quantiles and the Gaussian's
     +- 3 std, within the bounds, with a margin."""
-    from fracid.inverse.posterior import weighted_quantile
+    from fracid.inverse.sampling.posterior import weighted_quantile
 
     lo, hi = weighted_quantile(values, weights, [0.001, 0.999])
     if math.isfinite(centre) and math.isfinite(std):

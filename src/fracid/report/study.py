@@ -1,4 +1,4 @@
-"""Figures and report of a study (:func:`fracid.inverse.study.run_study`).
+"""Figures and report of a study (:func:`fracid.inverse.studies.study.run_study`).
 
 :func:`write_study` writes the JSON and CSV tables of the study, its figures as PNG files and one
 HTML report: the identification report of :func:`fracid.report.html.write_report` followed by the

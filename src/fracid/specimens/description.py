@@ -16,8 +16,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from fracid.fem.discretization import MixedDiscretization, bar_discretization, plane_stress_discretization
-from fracid.fem.dofs import Conditions
+from fracid.fem.mesh.discretization import MixedDiscretization, bar_discretization, plane_stress_discretization
+from fracid.fem.mesh.dofs import Conditions
 
 
 @dataclass(frozen=True)
@@ -120,7 +120,7 @@ class Description:
     cells : ndarray of int
         The vertices of each 1D element (shape (n_el, 2)), the 8 nodes of each quadrilateral or the
         6 nodes of each triangle (corners first, see
-        :func:`~fracid.fem.discretization.plane_stress_discretization`).
+        :func:`~fracid.fem.mesh.discretization.plane_stress_discretization`).
     node_sets : mapping {name: ndarray of int}
         Named sets of nodes that the conditions below refer to.
     loads, supports : tuples of Load and Support
@@ -208,7 +208,7 @@ def discretize(description: Description) -> MixedDiscretization:
 
 
 def conditions(description: Description, *, open_crack: bool = False, discrete_crack: bool = False) -> Conditions:
-    """The :class:`~fracid.fem.dofs.Conditions` of the description.
+    """The :class:`~fracid.fem.mesh.dofs.Conditions` of the description.
 
     ``open_crack``: for a model whose crack opens fully (plates and supports as
     :class:`Load` and :class:`Support` say for that case); ``discrete_crack``: the crack path's

@@ -192,7 +192,7 @@ class SpecimenDefaults:
 
     def default_steps(self, target: float):
         """Adaptive steps capped at ``target / steps_per_target``, so the softening branch takes tens of steps."""
-        from fracid.fem.path_following import StepOptions
+        from fracid.fem.path.path_following import StepOptions
 
         return StepOptions() if self.steps_per_target is None else StepOptions(maximum=target / self.steps_per_target)
 

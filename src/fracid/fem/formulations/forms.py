@@ -1,0 +1,247 @@
+"""Element residuals and consistent tangents of the damage models, for all elements at once.
+
+Pure functions over the arrays of a :class:`~fracid.fem.mesh.discretization.MixedDiscretization`:
+the material law enters only through a :class:`~fracid.fem.material.laws.DamageLaw` (its softening law and
+equivalent strain, values and derivatives) and the history update
+:func:`~fracid.fem.material.damage.update_history`.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from fracid.fem.material.damage import update_history
+from fracid.fem.formulations.nonlocal_average import NonlocalAveraging, softening_coupling
+
+
+class ElementArrays:
+    """Element vectors and matrices of one evaluation, the trial history and the formulation's outputs.
+
+    Parameters
+    ----------
+    residual : ndarray, shape (n_el, n_dof_el)
+        Element internal forces, in the columns of the dof map (displacements first, then each
+        named field's).
+    tangent : ndarray, shape (n_el, n_dof_el, n_dof_el), or callable
+        The element tangents; a function of no argument is called at the first access (an iteration
+        of modified Newton needs only the residual; the tangent is half the cost of an evaluation).
+        It fills the problem's tangent buffer, so it must be taken before the next evaluation.
+    reference : dict {field: ndarray, shape (n_el, n_dof_el of the field)}
+        Per field, the element vectors whose assembled norm scales that field's residual.
+    history : ndarray or dict of ndarray
+        The trial history at this state, in the layout the problem declares (its ``history_spec``):
+        the solver carries it opaquely to the next step.
+    omega : ndarray, optional
+        Shorthand for ``outputs["omega"]`` (the damage of the damage formulations).
+    coupling : sparse matrix (n_free, n_free), optional
+        Tangent entries between points of different elements (the integral model) [N/mm].
+    outputs : dict {name: ndarray}, optional
+        Named point outputs the formulation derives from the state (damage, stress, ...).
+    """
+
+    __slots__ = ("residual", "_tangent", "reference", "history", "outputs", "coupling")
+
+    def __init__(self, residual, tangent, reference, history, omega=None, coupling=None, *, outputs=None):
+        self.residual, self._tangent, self.reference = residual, tangent, reference
+        self.history, self.coupling = history, coupling
+        self.outputs = dict(outputs or {})
+        if omega is not None:
+            self.outputs["omega"] = omega
+
+    @property
+    def tangent(self) -> np.ndarray:
+        if callable(self._tangent):
+            self._tangent = self._tangent()
+        return self._tangent
+
+    @property
+    def kappa(self):
+        """The history (the name of the damage formulations' history variable)."""
+        return self.history
+
+    @property
+    def omega(self) -> np.ndarray:
+        """The point output ``"omega"`` (damage) of the formulations that give one."""
+        if "omega" not in self.outputs:
+            raise AttributeError(f"these element arrays have no point output 'omega'; outputs: {sorted(self.outputs)}")
+        return self.outputs["omega"]
+
+    def _replace(self, **changes) -> "ElementArrays":
+        """A copy with some of the constructor's arguments changed (``kappa`` is ``history``)."""
+        if "kappa" in changes:
+            changes["history"] = changes.pop("kappa")
+        values = dict(residual=self.residual, tangent=self._tangent, reference=self.reference, history=self.history,
+                      coupling=self.coupling, outputs=self.outputs)
+        values.update(changes)
+        return ElementArrays(**values)
+
+
+def point_outputs(arrays) -> dict:
+    """The named point outputs of :class:`ElementArrays`, or ``{"omega": arrays}`` for a bare damage
+    array (what ``fields`` and ``elastic_energy`` were given before named outputs)."""
+    return arrays.outputs if isinstance(arrays, ElementArrays) else {"omega": arrays}
+
+
+class ModelConstants(NamedTuple):
+    """What the kernels need besides the current state: built once per problem."""
+
+    E: np.ndarray  # Young's modulus at every integration point [MPa], (n_el, n_q)
+    D: np.ndarray  # unit elastic matrix (n_strain, n_strain)
+    DB: np.ndarray  # D times the strain operator, (n_el, n_q, n_strain, n_u)
+    ebar_matrix: np.ndarray  # int N^T N + c grad N^T grad N, (n_el, n_e, n_e): constant (None without the gradient field)
+    damageable: np.ndarray  # 1 where the material can damage, 0 in elastic parts (platens), (n_el, n_q)
+
+
+def model_constants(disc, params, stiffness_factor, damageable=1.0, gradient_space=None) -> ModelConstants:
+    """Precompute the parts of the tangent that do not change during a computation (with
+    ``gradient_space``, a :class:`~fracid.fem.mesh.discretization.ScalarSpace`: also the matrix of the
+    gradient model's diffusion equation on it, which needs ``params.c``)."""
+    E = params.E * np.broadcast_to(stiffness_factor, disc.weights.shape)
+    mask = np.broadcast_to(np.asarray(damageable, dtype=float), disc.weights.shape)
+    D = disc.strain_state.unit_elastic_matrix(params.nu)
+    DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
+    M = None
+    if gradient_space is not None:
+        N, G, w = gradient_space.shape, gradient_space.gradient, disc.weights
+        M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
+    return ModelConstants(E, D, DB, M, mask)
+
+
+def _btdb(weighted_B, DB):
+    """sum over points and strain components of B^T (D B): batched matmul, 6x faster than einsum here."""
+    n_el, n_u = DB.shape[0], DB.shape[-1]
+    return np.matmul(weighted_B.reshape(n_el, -1, n_u).transpose(0, 2, 1), DB.reshape(n_el, -1, n_u))
+
+
+def _bt(vector, B):
+    """B^T v at every integration point: (n_el, n_q, n_strain) x (n_el, n_q, n_strain, n_u) -> (n_el, n_q, n_u)."""
+    return np.matmul(vector[..., None, :], B)[..., 0, :]
+
+
+def _damage(law, params, const, kappa):
+    omega, d_omega = law.damage(kappa, params)
+    return omega * const.damageable, d_omega * const.damageable
+
+
+def _secant_equilibrium(B, const, w, ue, omega):
+    """Shared by the models: B^T D eps at the points, the internal forces and the weights of the secant
+    stiffness (``_btdb(B * w_sec, DB)``)."""
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
+    w_sec = w * (1.0 - omega) * const.E
+    bt_sigma = _bt(sigma_eff, B)  # (n_el, n_q, n_u)
+    return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), w_sec
+
+
+def _secant(B, const, w_sec):
+    return _btdb(B * w_sec[..., None, None], const.DB)
+
+
+def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
+    """Implicit gradient-enhanced damage: residuals of equilibrium and of the diffusion equation.
+
+    Parameters
+    ----------
+    space : ScalarSpace
+        The interpolation of the nonlocal strain ebar.
+    law : DamageLaw
+    params
+        The law's parameters (``E``, ``nu`` and ``c`` besides the law's own).
+    ue, ee : ndarray, shape (n_el, n_u) and (n_el, n_e)
+        Element displacements [mm] and nonlocal strains [-].
+    kappa_old : ndarray, shape (n_el, n_q)
+        History variable at the end of the last converged step.
+    out_tangent : ndarray, shape (n_el, n_u + n_e, n_u + n_e)
+        Buffer for the element tangents; its ebar-ebar block must already hold ``const.ebar_matrix``.
+    """
+    B, N, w = disc.strain_operator, space.shape, disc.weights
+    nu = B.shape[-1]
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    ebar = ee @ N.T
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
+    kappa, loading = update_history(kappa_old, ebar)
+    omega, d_omega = _damage(law, params, const, kappa)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    f_eq = (w * eq) @ N
+    f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
+
+    def tangent():
+        out_tangent[:, :nu, :nu] = _secant(B, const, w_sec)
+        w_ue = -(w * const.E * d_omega * loading)
+        out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
+        out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
+        return out_tangent
+
+    return ElementArrays(np.concatenate([f_u, f_e], axis=1), tangent, {"u": f_u, "ebar": f_eq}, kappa,
+                         outputs={"omega": omega})
+
+
+def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent) -> ElementArrays:
+    """Local damage (no regularisation): kappa follows the local equivalent strain; mesh-dependent."""
+    B, w = disc.strain_operator, disc.weights
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
+    kappa, loading = update_history(kappa_old, eq)
+    omega, d_omega = _damage(law, params, const, kappa)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+
+    def tangent():
+        softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1),
+                              _bt(d_eq, B))
+        out_tangent[:] = _secant(B, const, w_sec) - softening
+        return out_tangent
+
+    return ElementArrays(f_u, tangent, {"u": f_u}, kappa, outputs={"omega": omega})
+
+
+def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_tangent, averaging: NonlocalAveraging) -> ElementArrays:
+    """Integral-type nonlocal damage: kappa follows the Gaussian average ebar = A eps_eq of the
+    local equivalent strain (see :mod:`fracid.fem.formulations.nonlocal_average`).
+
+    Parameters
+    ----------
+    ue : ndarray, shape (n_el, n_u)
+        Element displacements [mm].
+    kappa_old : ndarray, shape (n_el, n_q)
+        History variable at the end of the last converged step [-].
+    out_tangent : ndarray, shape (n_el, n_u, n_u)
+        Buffer for the element tangents.
+    averaging : NonlocalAveraging
+        The averaging matrix of the mesh and the map of the points to the free dofs.
+
+    Returns
+    -------
+    ElementArrays
+        The element tangent is the secant stiffness minus the softening of each point driven by its
+        own strain (A_ii); ``coupling`` is the rest of the consistent tangent, - G A_offdiag H over
+        the free dofs, which couples points of different elements (None while nothing softens).
+    """
+    B, w = disc.strain_operator, disc.weights
+    eps = np.einsum("eqsi,ei->eqs", B, ue)
+    eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
+    ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
+    kappa, loading = update_history(kappa_old, ebar)
+    omega, d_omega = _damage(law, params, const, kappa)
+    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    secant = _secant(B, const, w_sec)
+    g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
+    h = _bt(d_eq, B)  # d eps_eq / d u at each point
+    out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
+    coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, coupling=coupling, outputs={"omega": omega})
+
+
+def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
+    """Recoverable energy 1/2 int (1 - omega) E eps . D eps dV [N mm]."""
+    eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
+    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
+    return 0.5 * float(np.sum(disc.weights * (1.0 - omega) * const.E * np.sum(eps * sigma_eff, axis=-1)))
+
+
+def elastic_bulk(disc, const: ModelConstants, ue, out_tangent) -> ElementArrays:
+    """Linear elastic material (the bulk of a discrete-crack model): internal forces and stiffness."""
+    _, f_u, w_sec = _secant_equilibrium(disc.strain_operator, const, disc.weights, ue, np.zeros(disc.weights.shape))
+    out_tangent[:] = _secant(disc.strain_operator, const, w_sec)
+    no_history = np.zeros(disc.weights.shape)
+    return ElementArrays(f_u, out_tangent, {"u": f_u}, no_history, outputs={"omega": no_history})

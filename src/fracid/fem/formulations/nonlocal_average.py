@@ -1,0 +1,205 @@
+"""Nonlocal averaging of the integral-type damage model, built once per mesh.
+
+The nonlocal equivalent strain at integration point i is the weighted mean
+
+    ebar_i = sum_j w_j psi(|x_j - x_i|) eps_j / sum_j w_j psi(|x_j - x_i|)
+
+over the integration points j (w_j their volume weights), with the Gaussian weight
+psi(rho) = exp(-rho^2 / (2 l^2)). Dividing by the sum of the weights is the boundary correction: a
+uniform field is reproduced everywhere, also where the support of psi sticks out of the body. The
+averaging is linear, so it is one sparse matrix A with ebar = A eps (rows sum to 1).
+
+The internal length follows from the gradient model's parameter by the Taylor expansion of the
+average (Peerlings et al. 1996): ebar = eps + l^2 / 2 lap(eps) + ..., so c = l^2 / 2 and the integral
+model uses the same :class:`~fracid.fem.material.parameters.DamageParameters` as the gradient model.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+
+def internal_length(c: float) -> float:
+    """Internal length l = sqrt(2 c) [mm] of the Gaussian weight from the gradient parameter c [mm^2].
+
+    Raises ValueError unless c is positive and finite.
+    """
+    if not (isinstance(c, (int, float, np.number)) and math.isfinite(c) and c > 0):
+        raise ValueError(f"c = {c!r} mm^2; the integral damage model needs c > 0 (internal length l = sqrt(2 c))")
+    return math.sqrt(2.0 * c)
+
+
+def averaging_matrix(points, weights, length: float, cutoff: float = 4.0, mirror=()) -> sp.csr_matrix:
+    """Row-normalised Gaussian averaging matrix A over the integration points: ebar = A @ eps.
+
+    Parameters
+    ----------
+    points : array_like, shape (n_pts, dim)
+        Coordinates of the integration points [mm], dim 1 or 2 (or 3); e.g.
+        ``disc.points.reshape(-1, disc.points.shape[-1])``.
+    weights : array_like, shape (n_pts,)
+        Their integration weights (volume, with the cross-section or the thickness) [mm^3]; > 0.
+    length : float
+        Internal length l of psi(rho) = exp(-rho^2 / (2 l^2)) [mm], > 0.
+    cutoff : float
+        Truncation radius in units of l [-]. The default 4 l drops weights below
+        exp(-8) = 3.4e-4 of the central one, which keeps A sparse.
+    mirror : sequence of (axis, coordinate)
+        Symmetry planes x[axis] = coordinate [mm] of a half or quarter model: the mirror images of
+        the points across every plane and every combination of planes contribute with their own
+        weight, so the average equals that of the whole specimen for a symmetric field. Points must
+        not lie on a plane (integration points never do); without planes the cut is treated as a
+        free boundary (boundary correction).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n_pts, n_pts)
+        A_ij = w_j psi_ij / sum_k w_k psi_ik [-]: each row sums to 1.
+
+    Notes
+    -----
+    The neighbour lists come from one :class:`scipy.spatial.cKDTree` query per image (one without
+    planes), not from a loop over points.
+    """
+    rows, cols, values, _ = _gaussian_pairs(points, weights, length, cutoff, mirror)
+    matrix = sp.csr_matrix((values, (rows, cols)), shape=(len(weights),) * 2)  # sums the images of a pair
+    return (sp.diags(1.0 / np.asarray(matrix.sum(axis=1)).ravel()) @ matrix).tocsr()
+
+
+def averaging_length_derivative(points, weights, length: float, cutoff: float = 4.0, mirror=()) -> sp.csr_matrix:
+    """d A / d l of :func:`averaging_matrix` [1/mm] (same arguments), for the direct differentiation.
+
+    With W_ij = w_j psi_ij and s_i = sum_j W_ij, A = diag(1/s) W and d psi / d l = psi rho^2 / l^3, so
+    dA/dl = diag(1/s) (W' - diag(s'/s) W). The truncation radius moves with l, but the weights it
+    drops are exp(-cutoff^2 / 2) of the central one: their derivative is left out.
+    """
+    rows, cols, values, rho = _gaussian_pairs(points, weights, length, cutoff, mirror)
+    n = len(weights)
+    W = sp.csr_matrix((values, (rows, cols)), shape=(n, n))
+    dW = sp.csr_matrix((values * rho**2 / length**3, (rows, cols)), shape=(n, n))
+    s, ds = np.asarray(W.sum(axis=1)).ravel(), np.asarray(dW.sum(axis=1)).ravel()
+    return (sp.diags(1.0 / s) @ (dW - sp.diags(ds / s) @ W)).tocsr()
+
+
+def _gaussian_pairs(points, weights, length, cutoff, mirror):
+    """Pairs (i, j) within ``cutoff`` l of each other (images across the planes included): rows, cols,
+    the unnormalised weights w_j psi_ij and the distances rho_ij [mm]."""
+    points = np.asarray(points, dtype=float)
+    weights = np.asarray(weights, dtype=float)
+    if points.ndim != 2 or weights.shape != (points.shape[0],):
+        raise ValueError(f"points must be (n_pts, dim) and weights (n_pts,); got {points.shape} and {weights.shape}")
+    if not (math.isfinite(length) and length > 0):
+        raise ValueError(f"length = {length!r} mm; the internal length must be positive and finite")
+    if not (math.isfinite(cutoff) and cutoff > 0):
+        raise ValueError(f"cutoff = {cutoff!r}; it must be a positive number of internal lengths")
+    if np.any(~np.isfinite(weights)) or np.any(weights <= 0):
+        raise ValueError("every integration weight must be positive and finite")
+    planes = [(int(axis), float(coordinate)) for axis, coordinate in mirror]
+    if any(not 0 <= axis < points.shape[1] for axis, _ in planes):
+        raise ValueError(f"mirror planes {planes}: the axis must be in [0, {points.shape[1]})")
+    tree = cKDTree(points)
+    rows, cols, distances = [], [], []
+    for flips in itertools.product((False, True), repeat=len(planes)):
+        image = points.copy()
+        for (axis, coordinate), flip in zip(planes, flips):
+            if flip:
+                image[:, axis] = 2.0 * coordinate - image[:, axis]
+        pairs = tree.sparse_distance_matrix(cKDTree(image), cutoff * length, output_type="ndarray")
+        rows.append(pairs["i"])
+        cols.append(pairs["j"])
+        distances.append(pairs["v"])
+    rows, cols, rho = (np.concatenate(a) for a in (rows, cols, distances))
+    return rows, cols, weights[cols] * np.exp(-0.5 * (rho / length) ** 2), rho
+
+
+class NonlocalAveraging(NamedTuple):
+    """The averaging of one problem and the map of its integration points to the free dofs.
+
+    Attributes
+    ----------
+    matrix : scipy.sparse.csr_matrix, shape (n_pts, n_pts)
+        A of :func:`averaging_matrix`, over the points flattened in (element, point) order.
+    self_weight : ndarray, shape (n_el, n_q)
+        Its diagonal A_ii: the local part of the softening tangent, which fits the element matrices.
+    off_diagonal : scipy.sparse.csr_matrix, shape (n_pts, n_pts)
+        A without its diagonal: the part that couples different points.
+    point_dofs : ndarray of int, shape (n_pts, n_u)
+        Free-dof number of each element displacement dof, repeated for the points of the element
+        (-1: eliminated dof).
+    n_free : int
+        Number of free dofs.
+    """
+
+    matrix: sp.csr_matrix
+    self_weight: np.ndarray
+    off_diagonal: sp.csr_matrix
+    point_dofs: np.ndarray
+    n_free: int
+
+
+def nonlocal_averaging(disc, length: float, element_dofs, n_free: int, cutoff: float = 4.0, mirror=()) -> NonlocalAveraging:
+    """Build the :class:`NonlocalAveraging` of a discretisation (once per mesh and internal length).
+
+    Parameters
+    ----------
+    disc : MixedDiscretization
+    length : float
+        Internal length l [mm].
+    element_dofs : ndarray of int, shape (n_el, n_u)
+        Free-dof number of the element displacement dofs (-1: eliminated).
+    n_free : int
+        Number of free dofs.
+    cutoff, mirror
+        See :func:`averaging_matrix`.
+    """
+    n_el, n_q = disc.weights.shape
+    A = averaging_matrix(disc.points.reshape(n_el * n_q, -1), disc.weights.ravel(), length, cutoff, mirror)
+    diagonal = A.diagonal()
+    off = (A - sp.diags(diagonal)).tocsr()
+    off.eliminate_zeros()
+    return NonlocalAveraging(A, diagonal.reshape(n_el, n_q), off, np.repeat(np.asarray(element_dofs), n_q, axis=0), int(n_free))
+
+
+def softening_coupling(averaging: NonlocalAveraging, g, h, active) -> sp.csc_matrix | None:
+    """Tangent of the nonlocal softening between different points: K_nl = - G A_L H over the free dofs.
+
+    Parameters
+    ----------
+    averaging : NonlocalAveraging
+    g : ndarray, shape (n_el, n_q, n_u)
+        w_i E_i d omega_i / d kappa_i B_i^T sigma_eff_i: internal forces per unit nonlocal strain
+        at each point [N] (sigma_eff = D eps per unit E).
+    h : ndarray, shape (n_el, n_q, n_u)
+        d eps_eq_j / d u = B_j^T d_eq_j: the local equivalent strain per unit element dof [1/mm].
+    active : ndarray of bool, shape (n_el, n_q)
+        Points that are loading and damaging; only their rows of A enter (others have g = 0).
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix, shape (n_free, n_free), or None when no point is active
+        [N/mm]; add it to the assembled element tangents.
+    """
+    points = np.flatnonzero(np.ravel(active))
+    if points.size == 0:
+        return None
+    n_u, n = g.shape[-1], averaging.n_free
+    A_L = averaging.off_diagonal[points]
+    # H only at the points the active ones average over: a small part of the mesh while damage is local
+    used = np.unique(A_L.indices)
+    G = _point_columns(averaging.point_dofs[points], g.reshape(-1, n_u)[points], n, np.arange(points.size), points.size)
+    H = _point_columns(averaging.point_dofs[used], h.reshape(-1, n_u)[used], n, used, A_L.shape[1]).T
+    return (-(G @ (A_L @ H))).tocsc()
+
+
+def _point_columns(dofs, values, n, columns, n_columns) -> sp.csc_matrix:
+    """Sparse (n, n_columns) matrix whose column ``columns[k]`` holds the element vector ``values[k]``
+    at the rows ``dofs[k]`` (negative dofs dropped, repeated dofs of tied groups summed)."""
+    keep = dofs >= 0
+    cols = np.broadcast_to(np.asarray(columns)[:, None], dofs.shape)
+    return sp.csc_matrix((values[keep], (dofs[keep], cols[keep])), shape=(n, n_columns))

@@ -1,0 +1,249 @@
+"""The forward operator h(x): a vector of identified parameters -> computed observations.
+
+An observation kind (:mod:`fracid.inverse.core.observations`) says what is measured on which specimen and
+how it is sampled from a run: a curve quantity at control points (:class:`Observation`), a
+displacement field at points and frames (:class:`FieldObservation`), or any object with the members
+of :class:`ObservationKind`. :class:`ForwardOperator` maps a vector x of the identified parameters (a named subset of the model
+parameters; the others fixed) to the concatenated computed values ``y_comp``, in the order of the
+observations. A forward run that does not converge is retried once with smaller steps; if it still
+fails, the result records the failure (reason, how far it got) instead of raising, so a study goes on.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from fracid.inverse.core.observations import FieldObservation, Observation, ObservationKind, check_control_points
+from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
+from fracid.models import ConvergenceError, DamageModel, StepOptions, declared
+
+__all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RunRecord"]
+_control_points = check_control_points  # the old private name
+
+
+@dataclass
+class RunRecord:
+    """Outcome of one evaluation of the forward operator.
+
+    ``y`` holds the computed values (NaN where not computed); ``status`` is ``"ok"`` or ``"failed"``;
+    ``error`` the reason of a failure and ``reached`` the control value reached per observation.
+    ``S`` is d y / d x (n_outputs x n_parameters) when the run computed it by direct differentiation
+    (an operator with ``sensitivities=True``), else None.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    status: str = "ok"
+    error: str = ""
+    reached: list = field(default_factory=list)
+    seconds: float = 0.0
+    retried: bool = False
+    S: np.ndarray | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def as_dict(self) -> dict:
+        out = {"x": self.x, "y": self.y, "status": self.status, "error": self.error, "reached": list(self.reached),
+               "seconds": self.seconds, "retried": self.retried}
+        if self.S is not None:
+            out["S"] = self.S
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "RunRecord":
+        S = d.get("S")
+        return cls(np.asarray(d["x"], float), np.asarray(d["y"], float), d["status"], d["error"], list(d["reached"]),
+                   float(d["seconds"]), bool(d["retried"]), None if S is None else np.asarray(S, float))
+
+
+@dataclass(frozen=True, eq=False)
+class ForwardOperator:
+    """h(x) for a set of observations, x being the parameters ``names`` (the rest from ``base``).
+
+    Parameters
+    ----------
+    observations : sequence of observation kinds
+        :class:`Observation`, :class:`FieldObservation` or any :class:`ObservationKind`; y is their
+        values concatenated in this order.
+    base : parameter object
+        Values of the parameters that are not identified (an instance of ``model.parameters``).
+    names : sequence of str
+        Identified parameters, in the order of x.
+    regularization : str, optional
+        ``"gradient"``, ``"local"`` or ``"integral"``: shorthand for ``model=DamageModel(regularization)``
+        (not with ``model``). After construction it is the model's regularization (None for models
+        without one).
+    steps : StepOptions or None
+        Step rule (the specimen's default if None); the retry divides its increments by 4.
+    model : ForwardModel, optional
+        The forward model (see :mod:`fracid.models`); :class:`~fracid.models.DamageModel` by default.
+    sensitivities : bool
+        Every run also returns S = d y / d x (``RunRecord.S``) by direct differentiation inside the
+        analysis (:mod:`fracid.fem.path.ddm`), where the model and the observed quantities allow it (see
+        :meth:`differentiated`); None for a quantity without derivatives (a local width).
+    """
+
+    observations: tuple
+    base: object
+    names: tuple
+    regularization: str | None = None
+    steps: StepOptions | None = None
+    model: object = None
+    sensitivities: bool = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "observations", tuple(self.observations))
+        if isinstance(self.names, str):
+            raise TypeError(f"names = {self.names!r} is a string; give a sequence of parameter names, e.g. "
+                            f"({self.names!r},)")
+        object.__setattr__(self, "names", tuple(self.names))
+        strangers = [type(o).__name__ for o in self.observations if not isinstance(o, ObservationKind)]
+        if strangers or not self.observations:
+            raise TypeError(f"observations must be a non-empty sequence of Observation (or FieldObservation, or an "
+                            f"object with the members of ObservationKind), got {strangers or 'none'}")
+        if self.model is None:
+            object.__setattr__(self, "model", DamageModel(self.regularization or "gradient"))
+        elif self.regularization is not None and self.regularization != declared(self.model).regularization:
+            raise ValueError(f"regularization = {self.regularization!r} contradicts the model {self.model.key!r}; "
+                             "give one of them")
+        object.__setattr__(self, "regularization", declared(self.model).regularization)
+        if not isinstance(self.base, self.model.parameters):
+            raise TypeError(f"base is a {type(self.base).__name__}; the model {self.model.key!r} takes "
+                            f"{self.model.parameters.__name__}")
+        known = self.model.parameters.names()
+        unknown = set(self.names) - set(known)
+        if unknown or not self.names:
+            raise ValueError(f"identified parameters {sorted(unknown) or '[]'} are not among {known}")
+        sizes = [int(o.size) for o in self.observations]
+        object.__setattr__(self, "_offsets", np.concatenate([[0], np.cumsum(sizes)]))
+
+    @property
+    def differentiable(self) -> bool:
+        """Whether the model differentiates its runs with respect to every identified parameter and
+        every observation has derivatives (its ``differentiable_with(model)``: the force, the
+        functionals, energies and probes do; the specimen's ``observables`` and the model's
+        ``observer_names`` (zone widths, crack lengths, from observers) only with a model whose
+        ``differentiates_observers`` is true)."""
+        names = set(declared(self.model).differentiable)
+        return set(self.names) <= names and all(o.differentiable_with(self.model) for o in self.observations)
+
+    def differentiated(self) -> "ForwardOperator":
+        """This operator with ``sensitivities=True`` if it is :attr:`differentiable`, else itself."""
+        return replace(self, sensitivities=True) if self.differentiable and not self.sensitivities else self
+
+    @property
+    def n_outputs(self) -> int:
+        return int(self._offsets[-1])
+
+    def valid_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Valid ranges of the identified parameters (the model's), for clipping estimates."""
+        return self.model.parameters.valid_bounds(self.names)
+
+    @property
+    def units(self) -> dict:
+        """Units of the identified parameters."""
+        units = self.model.parameters.units()
+        return {name: units.get(name, "") for name in self.names}
+
+    def parameters(self, x):
+        """The full parameter set for the vector x (raises ValueError for invalid values)."""
+        x = np.asarray(x, dtype=float)
+        if x.shape != (len(self.names),):
+            raise ValueError(f"x must have {len(self.names)} entries {self.names}, got shape {x.shape}")
+        return self.base.replace(**dict(zip(self.names, x.tolist())))
+
+    def slices(self) -> list[slice]:
+        """Position of each observation block in y."""
+        return [slice(int(a), int(b)) for a, b in zip(self._offsets[:-1], self._offsets[1:])]
+
+    def __call__(self, x, needed: int | None = None) -> RunRecord:
+        """Evaluate h(x); only the first ``needed`` outputs are guaranteed (runs stop early)."""
+        start = time.perf_counter()
+        x = np.asarray(x, dtype=float)
+        record = RunRecord(x=x, y=np.full(self.n_outputs, np.nan))
+        try:
+            params = self.parameters(x)
+        except ValueError as err:
+            record.status, record.error = "failed", f"invalid parameters: {err}"
+            return record
+        limit = self.n_outputs if needed is None else int(needed)
+        if self.sensitivities:
+            record.S = np.full((self.n_outputs, len(self.names)), np.nan)
+        for threshold, group in self._run_groups(limit):
+            if not self._fill(record, group, params, limit, threshold):
+                break
+        record.seconds = time.perf_counter() - start
+        return record
+
+    def _run_groups(self, limit):
+        """Needed observations (obs, slice) grouped by shared run, in order of first appearance."""
+        groups = []  # [(specimen, control), threshold or None, members]
+        for obs, part in zip(self.observations, self.slices()):
+            if part.start >= limit:
+                continue
+            *test, threshold = obs.run_key
+            for group in groups:
+                if group[0] == test and (group[1] == threshold or None in (group[1], threshold)):
+                    group[1] = threshold if group[1] is None else group[1]
+                    group[2].append((obs, part))
+                    break
+            else:
+                groups.append([test, threshold, [(obs, part)]])
+        return [(threshold or 0.0, members) for _, threshold, members in groups]
+
+    def _fill(self, record, group, params, limit, threshold) -> bool:
+        """Run one group's analysis to its largest needed control value and sample its blocks."""
+        counts = [min(part.stop, limit) - part.start for _, part in group]
+        checkpoints = np.unique(np.concatenate([obs.controls[:n] for (obs, _), n in zip(group, counts)]))
+        observables = sorted({name for obs, _ in group for name in obs.observables})
+        probes = merge_probes(obs for obs, _ in group)
+        run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold,
+                                        observables, probes)
+        record.retried |= retried
+        if run is None:
+            record.status, record.error = "failed", error
+            record.reached.append(0.0)
+            return False
+        record.reached.append(float(run.control[-1]))
+        for (obs, part), n in zip(group, counts):
+            y, S = obs.sample(run)
+            rows = slice(part.start, part.start + n)
+            record.y[rows] = np.asarray(y, float)[:n]
+            if record.S is not None and S is None:  # a quantity the run did not differentiate: no S
+                record.S = None
+            elif record.S is not None:  # the checkpoints are steps: the samples are the steps' values
+                record.S[rows] = np.asarray(S, float)[:n]
+        return True
+
+    def _run(self, obs, params, target, checkpoints, threshold, observables, probes):
+        """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
+        error = ""
+        specimen = ProbedSpecimen(obs.specimen, probes) if probes else obs.specimen
+        for attempt, steps in enumerate(self._step_rules(obs, target)):
+            try:
+                result = self.model.simulate(specimen, params, control=obs.control, target=target,
+                                             stop_force_fraction=None, steps=steps, field_steps=None,
+                                             checkpoints=checkpoints, damage_threshold=threshold,
+                                             observables=observables,
+                                             **({"sensitivities": self.names} if self.sensitivities else {}))
+                return result, "", attempt > 0
+            except ConvergenceError as err:
+                error = str(err)
+                partial = err.partial
+        reached = partial.control[-1] if partial.n_steps else 0.0
+        return None, f"forward run failed at control {reached:.6g} of {target:.6g} mm: {error}", True
+
+    def _step_rules(self, obs, target):
+        first = self.steps
+        if first is None:
+            first = obs.specimen.default_steps(target) if hasattr(obs.specimen, "default_steps") else StepOptions()
+        quarter = (lambda v: None if v is None else v / 4)  # noqa: E731
+        smaller = replace(first, initial=quarter(first.initial), maximum=quarter(first.maximum),
+                          max_factor=first.max_factor / 4, onset_fraction=first.onset_fraction / 4)
+        return (first, smaller)
+

@@ -1,0 +1,330 @@
+"""Observation kinds: what is measured, and how it is sampled from a forward run.
+
+An observation kind is any object with the members of :class:`ObservationKind`; the
+:class:`~fracid.inverse.core.forward_operator.ForwardOperator` sees nothing else. A kind says which run it
+needs (``run_key``: specimen, control, damage threshold; kinds with equal keys share one run), what the
+run must record (``observables``: observers of the model; ``probes``: linear functionals of the nodal
+displacements, which the run records and differentiates like the specimen's own functionals), its
+size and the control value of each entry (``controls``, non-decreasing: the first k entries need the
+run up to ``controls[k - 1]``), the coordinates of its entries, and ``sample(run) -> (y, S)``.
+
+Two kinds are built in:
+
+- :class:`Observation`: a curve quantity (the force, or an observable of the run such as the FPZ
+  width) interpolated at control points;
+- :class:`FieldObservation`: a nodal displacement component sampled at given points (a sensor, the
+  pixels a camera follows) at given control values (frames), through the point-probe operator
+  :func:`~fracid.fem.mesh.probes.probe_matrix` (through :mod:`fracid.models`, the inverse code's window on the model).
+
+A test file or a user module adds its own kind by writing a class with these members
+(``tests/test_extension_observation.py``: the crack-opening profile along the ligament).
+
+Notes
+-----
+The probes become functionals of the run's problem: each is a dense vector over the unknowns, dotted
+with the state (and, with sensitivities, with its derivatives) at every step. That is exact and cheap
+for tens to hundreds of points; full-field data (thousands of points, digital image correlation) need
+the run to apply the sparse probe matrix to the nodal field at the frames only (a change of the
+path follower, not of the kinds: ``sample`` stays as it is).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from fracid.inverse.core.probed import describe, specimen_key
+
+
+@runtime_checkable
+class ObservationKind(Protocol):
+    """The contract of an observation kind (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Label of the data block.
+    specimen : object
+        The specimen the run is made on.
+    control : str or None
+        The run's control quantity (the specimen's default if None).
+    """
+
+    name: str
+    specimen: object
+    control: str | None
+
+    @property
+    def run_key(self) -> tuple:
+        """(specimen key, control, damage threshold or None): kinds with compatible keys share a run."""
+
+    @property
+    def size(self) -> int:
+        """Number of values of the block."""
+
+    @property
+    def controls(self) -> np.ndarray:
+        """Control value of every entry [mm], non-decreasing."""
+
+    @property
+    def observables(self) -> tuple:
+        """Names of the observers the run must record."""
+
+    @property
+    def probes(self) -> dict:
+        """``{name: ((node, component, weight), ...)}``: displacement functionals the run must record."""
+
+    def coordinates(self) -> dict:
+        """``{name: ndarray (size,)}``: ``control`` [mm] and what else locates each entry."""
+
+    def differentiable_with(self, model) -> bool:
+        """Whether the runs of ``model`` differentiate what this kind samples."""
+
+    def key(self) -> dict:
+        """What defines the observation, for the run store's keys."""
+
+    def sample(self, run) -> tuple:
+        """``(y, S)``: the values (size,) from ``run``, and d y / d x (size, p) when the run carries
+        its derivatives (``run.derivatives``), else None."""
+
+
+def interpolate(run, name: str, points: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """The run's curve ``name`` (``"force"``, an observable or a probe) at the control values ``points``,
+    and its derivatives there ((n, p), None if the run has none for it). Points that are steps of the
+    run (checkpoints) take the step's value exactly."""
+    values = run.force if name == "force" else run.observables[name]
+    y = np.interp(points, run.control, values)
+    derivative = (getattr(run, "derivatives", None) or {}).get(name)
+    if derivative is None:
+        return y, None
+    return y, np.column_stack([np.interp(points, run.control, d) for d in np.asarray(derivative).T])
+
+
+def check_control_points(values, what: str = "control_points") -> np.ndarray:
+    """``values`` as a 1-D float array of finite, strictly increasing control values, or a ValueError."""
+    try:
+        points = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{what} is a {type(values).__name__} that is not an array of numbers") from None
+    if points.ndim != 1 or points.size == 0:
+        raise ValueError(f"{what} has shape {points.shape}; give a non-empty 1-D array of control values [mm] "
+                         "(the data's control, e.g. ExperimentalData.control of one block)")
+    if not np.all(np.isfinite(points)):
+        raise ValueError(f"{what} holds NaN or infinite values; every control value must be a finite number")
+    steps = np.diff(points)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0))
+        raise ValueError(f"{what} must increase strictly, but point {i + 1} ({points[i + 1]:.6g} mm) does not "
+                         f"exceed point {i} ({points[i]:.6g} mm)")
+    return points
+
+
+@dataclass(frozen=True, eq=False)
+class Observation:
+    """A curve quantity at control points: the computed counterpart of one measured curve.
+
+    Parameters
+    ----------
+    specimen
+        Specimen object (bar, beam, dog-bone).
+    control_points : array_like
+        Increasing values of the control quantity at which the data are sampled [mm].
+    quantity : str
+        ``"force"`` [N] or the name of an observable of the forward run (e.g. ``"fpz_width"`` [mm]).
+    control : str or None
+        The specimen's control quantity (its default if None).
+    name : str
+        Label of the block.
+    damage_threshold : float
+        Damage above which a point counts in a local width observable [-] (0: any damage).
+
+    Observations of the same specimen object, control and threshold share one forward run (the
+    force curve and the FPZ width of one test come from the same analysis).
+    """
+
+    specimen: object
+    control_points: np.ndarray
+    quantity: str = "force"
+    control: str | None = None
+    name: str = "global"
+    damage_threshold: float = 0.0
+
+    def __post_init__(self):
+        from fracid.forward import check_specimen
+
+        check_specimen(self.specimen)
+        object.__setattr__(self, "control_points", check_control_points(self.control_points))
+        if not isinstance(self.quantity, str) or not self.quantity:
+            raise TypeError(f"quantity = {self.quantity!r}; give 'force' or the name of an observable of the "
+                            "forward run (e.g. 'fpz_width')")
+
+    @property
+    def run_key(self) -> tuple:
+        """(specimen, control, threshold): observations with compatible keys share one forward run.
+
+        The force does not depend on the threshold, so a force observation has threshold None.
+        """
+        return (specimen_key(self.specimen), self.control, None if self.quantity == "force" else self.damage_threshold)
+
+    @property
+    def size(self) -> int:
+        return int(self.control_points.size)
+
+    @property
+    def controls(self) -> np.ndarray:
+        return self.control_points
+
+    @property
+    def observables(self) -> tuple:
+        return () if self.quantity == "force" else (self.quantity,)  # observers cost time at every step
+
+    @property
+    def probes(self) -> dict:
+        return {}
+
+    def coordinates(self) -> dict:
+        return {"control": self.control_points}
+
+    def differentiable_with(self, model) -> bool:
+        """The force, functionals and energies are; the specimen's ``observables`` and the model's
+        ``observer_names`` only with a model whose ``differentiates_observers`` is true."""
+        observers = {*getattr(self.specimen, "observables", ()), *getattr(model, "observer_names", ())}
+        return bool(getattr(model, "differentiates_observers", False)) or self.quantity not in observers
+
+    def key(self) -> dict:
+        return {"specimen": self.specimen, "points": self.control_points.tolist(), "quantity": self.quantity,
+                "control": self.control, "damage_threshold": self.damage_threshold}
+
+    def sample(self, run) -> tuple:
+        return interpolate(run, self.quantity, self.control_points)
+
+
+def _components(components) -> tuple:
+    values = (components,) if isinstance(components, (int, np.integer)) else tuple(components)
+    if not values or len(set(values)) != len(values) or any(c not in (0, 1) for c in values):
+        raise ValueError(f"components = {components!r}; give 0 (x), 1 (y) or both, e.g. (0, 1)")
+    return tuple(int(c) for c in values)
+
+
+def _positions(points) -> np.ndarray:
+    positions = np.asarray(points, dtype=float)
+    if positions.ndim != 2 or positions.shape[1] != 2 or len(positions) == 0 or not np.all(np.isfinite(positions)):
+        raise ValueError(f"points has shape {positions.shape}; give (n_points, 2) finite coordinates [mm] in the "
+                         "plane of the specimen's mesh")
+    return positions
+
+
+@dataclass(frozen=True, eq=False)
+class FieldObservation:
+    """Displacement components at given points and control values (frames): a block of size
+    n_frames x n_components x n_points, in that order (frame slowest, point fastest).
+
+    Parameters
+    ----------
+    specimen
+        A plane specimen object (with ``describe()``) or a description.
+    points : array_like, shape (n_points, 2)
+        Positions [mm] in the modelled part of the specimen (a symmetric half or quarter).
+    frames : array_like
+        Increasing control values of the frames [mm].
+    components : int or tuple of int
+        0 (u_x), 1 (u_y) or both (default).
+    control : str or None
+        The specimen's control quantity (its default if None).
+    name : str
+        Label of the block (and prefix of its probes' names in the run).
+
+    Raises
+    ------
+    ValueError
+        For points outside the mesh (named), bad frames or components.
+
+    Notes
+    -----
+    The probes (one displacement functional per point and component, the shape functions of the
+    point's element as weights: the rows of the probe matrix) are recorded and differentiated by the
+    run like the specimen's functionals, so ``sample`` gives exact sensitivities with a model that
+    differentiates its runs. Each probe is a dense vector of the unknowns in the run: meant for up to
+    a few hundred points (see the module's notes on full-field data).
+    """
+
+    specimen: object
+    points: np.ndarray
+    frames: np.ndarray
+    components: tuple = (0, 1)
+    control: str | None = None
+    name: str = "field"
+    _probes: dict = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self):
+        from fracid.models import probe_matrix
+        from fracid.forward import check_specimen
+
+        check_specimen(self.specimen)
+        object.__setattr__(self, "points", _positions(self.points))
+        object.__setattr__(self, "frames", check_control_points(self.frames, "frames"))
+        object.__setattr__(self, "components", _components(self.components))
+        d = describe(self.specimen)
+        if d.dim != 2:
+            raise ValueError(f"a field observation needs a plane specimen; {type(self.specimen).__name__} is {d.dim}D")
+        P = probe_matrix(d.nodes, d.cells, self.points).tocsr()
+        for c in self.components:
+            for i in range(len(self.points)):
+                row = slice(P.indptr[i], P.indptr[i + 1])
+                self._probes[self.probe_name(c, i)] = tuple(
+                    (int(n), c, float(w)) for n, w in zip(P.indices[row], P.data[row]))
+
+    def probe_name(self, component: int, point: int) -> str:
+        """Name of the run's functional of ``component`` at point ``point``."""
+        return f"{self.name}:u{'xy'[component]}[{point}]"
+
+    quantity = property(lambda self: "u")  # what the block measures, as a curve kind's ``quantity``
+
+    @property
+    def run_key(self) -> tuple:
+        return (specimen_key(self.specimen), self.control, None)
+
+    @property
+    def size(self) -> int:
+        return len(self.frames) * len(self.components) * len(self.points)
+
+    @property
+    def controls(self) -> np.ndarray:
+        return np.repeat(self.frames, len(self.components) * len(self.points))
+
+    control_points = controls  # the control value of every entry, as a curve kind's
+
+    @property
+    def observables(self) -> tuple:
+        return ()
+
+    @property
+    def probes(self) -> dict:
+        return dict(self._probes)
+
+    def coordinates(self) -> dict:
+        n_c, n_p = len(self.components), len(self.points)
+        frame = np.repeat(np.arange(len(self.frames)), n_c * n_p)
+        component = np.tile(np.repeat(self.components, n_p), len(self.frames))
+        point = np.tile(np.arange(n_p), len(self.frames) * n_c)
+        return {"control": self.frames[frame], "frame": frame, "component": component,
+                "x": self.points[point, 0], "y": self.points[point, 1]}
+
+    def differentiable_with(self, model) -> bool:
+        return True  # functionals of the displacements
+
+    def key(self) -> dict:
+        return {"kind": "field", "specimen": self.specimen, "points": self.points.tolist(),
+                "frames": self.frames.tolist(), "components": list(self.components), "control": self.control,
+                "name": self.name}
+
+    def sample(self, run) -> tuple:
+        names = [self.probe_name(c, i) for c in self.components for i in range(len(self.points))]
+        parts = [interpolate(run, name, self.frames) for name in names]  # each (n_frames,), (n_frames, p)
+        y = np.stack([value for value, _ in parts], axis=1).ravel()  # frame-major
+        if any(d is None for _, d in parts):
+            return y, None
+        S = np.stack([d for _, d in parts], axis=1)  # (n_frames, n_probes, p)
+        return y, S.reshape(y.size, -1)

@@ -1,0 +1,149 @@
+"""KNN over a population, then bounded Gauss-Newton on the Kalman filter's Bayesian objective.
+
+:class:`KnnGaussNewton` meets :class:`~fracid.inverse.core.method.InverseMethod` and the study's
+:class:`~fracid.inverse.methods.registry.StudyMethod`; it returns a :class:`GaussNewtonResult`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from fracid.inverse.methods.gauss_newton import gauss_newton
+from fracid.inverse.methods.knn_kalman import KnnSettings, knn_record, population_search
+from fracid.inverse.core.method import MethodResult, check_problem, identification_bounds, result_fields
+from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
+from fracid.inverse.core.runs import StoredOperator
+from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
+from fracid.inverse.core.space import ParameterSpace
+from fracid.parallel import BatchStats
+
+
+def _stages() -> dict:
+    return dict(KnnGaussNewton.stages)
+
+
+@dataclass
+class GaussNewtonResult(MethodResult):
+    """The result of :class:`KnnGaussNewton`: a :class:`~fracid.inverse.core.method.MethodResult` with the
+    records of its two stages.
+
+    Attributes
+    ----------
+    history : list of dict
+        Estimate and covariance at every linearisation (``iteration``, ``x``, ``C``).
+    knn : dict
+        Population, objective values, statuses, ranking, k, x0, C0 (as
+        :class:`~fracid.inverse.methods.knn_kalman.IdentificationResult`'s).
+
+    ``runs`` holds ``knn``, ``knn_failed``, ``knn_computed``, ``knn_reused``, ``gauss_newton`` (forward
+    runs of the linearisations), ``gauss_newton_failed``, ``gauss_newton_iterations``,
+    ``gauss_newton_computed``, ``gauss_newton_reused`` and ``wall_seconds`` [s].
+    """
+
+    history: list = field(default_factory=list)
+    knn: dict = field(default_factory=dict)
+    method: str = "knn-gauss-newton"
+    stages: dict = field(default_factory=_stages)
+
+
+@dataclass(frozen=True)
+class KnnGaussNewton:
+    """KNN over a population for the overview and the prior, then bounded Gauss-Newton
+    (:func:`~fracid.inverse.methods.gauss_newton.gauss_newton`: trust region with the bounds) on the same
+    Bayesian objective as the Kalman filter: the same MAP point and covariance, found with the
+    Jacobian of the runs (exact, by direct differentiation, where the model has it).
+
+    Stages ``"knn"`` and ``"gauss_newton"``.
+
+    Attributes
+    ----------
+    knn : KnnSettings
+    max_iterations : int
+        Linearisations at most.
+    tol : float
+        Convergence: the next step moves no parameter by more than ``tol`` of its standard deviation [-].
+    """
+
+    knn: KnnSettings = KnnSettings()
+    max_iterations: int = 20
+    tol: float = 0.01
+    name: ClassVar[str] = "knn-gauss-newton"
+    stages: ClassVar[dict] = {"knn": "KNN", "gauss_newton": "Gauss-Newton"}
+
+    @classmethod
+    def from_config(cls, identify, n_y: int | None) -> KnnGaussNewton:
+        """The method of a validated ``[identify]``: its ``knn`` and ``gauss_newton`` sections."""
+        if getattr(identify, "methods", {}).get(cls.name):
+            raise ValueError(f"the settings of {cls.name} are those of [identify.knn] and [identify.gauss-newton], "
+                             "not a table of its own")
+        knn, gn = identify.knn, identify.gauss_newton
+        return cls(KnnSettings(n=knn.n, method=knn.method, seed=knn.seed, k=knn.k), max_iterations=gn.max_iterations,
+                   tol=gn.tol)
+
+    def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
+        """The forward runs of both stages: the population side by side, then at most ``max_iterations``
+        linearisations one after another (each a full-curve run, or 2 p + 1 without exact sensitivities)."""
+        per_step, how = runs_per_linearisation(operator, p)
+        runs = (self.max_iterations + 1) * per_step
+        text = (f"at most {self.max_iterations} linearisations and a run at the estimate, {plural(per_step, 'run')} each "
+                f"({how}): at most {runs} full-curve runs one after another without backtracking")
+        return [population_plan(self.knn, p), StagePlan("gauss_newton", "Gauss-Newton", runs, False, float(runs), text,
+                                                        "[identify.gauss-newton] max_iterations", per_step == 1)]
+
+    def search(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
+               stats=None, retry_failed=False):
+        """The KNN stage (:func:`~fracid.inverse.methods.knn_kalman.population_search`)."""
+        return population_search(self.knn, operator, y_exp, C_exp, space, executor=executor, store=store,
+                                 progress=progress, stats=stats, retry_failed=retry_failed)
+
+    def fit_from(self, evaluate, y_exp, C_exp, x0, C0, *, bounds=None, executor=None, blocks=()):
+        """Gauss-Newton alone from the prior (x0, C0) (a multi-start fit or a noisy replicate of the
+        study): a fit with ``x``, ``C``, ``std``, ``y``, ``failed``, ``status``, ``converged``."""
+        evaluate, sensitivity = exact_sensitivity(evaluate)
+        return gauss_newton(evaluate, y_exp, C_exp, x0, C0, sensitivity=sensitivity, executor=executor, bounds=bounds,
+                            max_iterations=self.max_iterations, tol=self.tol)
+
+    def refine(self, operator, y_exp, C_exp, knn, *, C0=None, executor=None, blocks=(), notes=(), started=None,
+               progress=False) -> GaussNewtonResult:
+        """The Gauss-Newton stage from the prior of ``knn`` (``C0`` replaces its covariance when given).
+        ``operator`` may be a :class:`~fracid.inverse.core.runs.StoredOperator` (its runs are then counted)."""
+        start = time.perf_counter() if started is None else started
+        evaluate, sensitivity = exact_sensitivity(operator)
+        before = (getattr(evaluate, "computed", 0), getattr(evaluate, "reused", 0))
+        bounds = identification_bounds(operator, knn.space)
+        fit = gauss_newton(evaluate, y_exp, C_exp, knn.x0, knn.C0 if C0 is None else np.asarray(C0, float),
+                           sensitivity=sensitivity, executor=executor, bounds=bounds,
+                           max_iterations=self.max_iterations, tol=self.tol)
+        runs = {"knn": len(knn.points), "knn_failed": knn.n_failed, "gauss_newton": fit.runs,
+                "gauss_newton_failed": len(fit.failures), "gauss_newton_iterations": fit.iterations,
+                "gauss_newton_computed": getattr(evaluate, "computed", 0) - before[0],
+                "gauss_newton_reused": getattr(evaluate, "reused", 0) - before[1],
+                "wall_seconds": time.perf_counter() - start}
+        notes = list(notes) + [f"KNN: {self.knn.method} population of {len(knn.points)}, k = {knn.k}",
+                               f"Gauss-Newton (bounded trust region): {fit.iterations} linearisation(s), tol "
+                               f"{self.tol} std, sensitivities by {sensitivity_label(sensitivity)}; {fit.status}"]
+        return GaussNewtonResult(
+            x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history, knn=knn_record(knn, self.knn.method, self.knn.seed),
+            runs=runs, converged=fit.converged, status=fit.status,
+            **result_fields(operator, knn.space, fit.x, y_exp, C_exp, blocks=blocks, notes=notes))
+
+    def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
+                 retry_failed=False, blocks=(), notes=()) -> GaussNewtonResult:
+        """Both stages (see :class:`~fracid.inverse.core.method.InverseMethod`)."""
+        start = time.perf_counter()
+        y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
+        stats = BatchStats()
+        knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+                          stats=stats, retry_failed=retry_failed)
+        stored = StoredOperator(operator, store, retry_failed=retry_failed)
+        result = self.refine(stored, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes, started=start,
+                             progress=progress)
+        result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
+        return result
+
+
+__all__ = ["GaussNewtonResult", "KnnGaussNewton"]

@@ -1,0 +1,95 @@
+"""The registry of inverse methods: the names ``[identify] method`` accepts, each with its class.
+
+Every class is a frozen dataclass of its settings (``KnnKalman(knn=KnnSettings(...),
+kalman=KalmanSettings(...))``, ``KnnGaussNewton(knn=KnnSettings(...), max_iterations=..., tol=...)``)
+with a ``name`` that is its key here and the ``stages`` it runs (stage name -> label, the keys of its
+counters and records in the result, the report's sections). A method meets
+:class:`~fracid.inverse.core.method.InverseMethod` (``fracid identify``); one that also meets
+:class:`StudyMethod` runs every check of ``fracid study`` through its own stages.
+
+A new method is a class and one line here (or ``METHODS[name] = cls`` from the user's code); its
+settings come from ``[identify.<name>]`` of the configuration through its ``from_config`` class method
+(see :func:`fracid.config.build_method`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Protocol, runtime_checkable
+
+from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
+from fracid.inverse.methods.knn_kalman import KnnKalman
+
+
+@runtime_checkable
+class StudyMethod(Protocol):
+    """What :func:`~fracid.inverse.studies.study.run_study` asks of a method besides calling it.
+
+    ``search(operator, y_exp, C_exp, space, *, executor, store, progress, stats, retry_failed)``
+        The global stage: a :class:`~fracid.inverse.methods.knn.KnnResult` (population, ranking, prior x0 and
+        C0); the study's objective maps, valley and multi-start points come from it.
+    ``refine(operator, y_exp, C_exp, overview, *, C0, executor, blocks, notes, progress)``
+        The local stage from the overview's prior (covariance ``C0`` when given): the
+        :class:`~fracid.inverse.core.method.MethodResult` of the identification.
+    ``fit_from(evaluate, y_exp, C_exp, x0, C0, *, bounds, executor, blocks)``
+        The local stage alone from a prior (x0, C0): a fit with ``x``, ``std``, ``y``, ``failed`` and
+        ``status``, for the multi-start check and the noisy replicates.
+    """
+
+    name: str
+    stages: dict
+
+    def search(self, operator, y_exp, C_exp, space, **options): ...
+
+    def refine(self, operator, y_exp, C_exp, overview, **options): ...
+
+    def fit_from(self, evaluate, y_exp, C_exp, x0, C0, **options): ...
+
+
+#: inverse method name -> its class; the first is the default
+METHODS = {KnnKalman.name: KnnKalman, KnnGaussNewton.name: KnnGaussNewton}
+
+#: the default inverse method's name
+DEFAULT_METHOD = KnnKalman.name
+
+
+def with_settings(method, **changes):
+    """A copy of the inverse method ``method`` (a frozen dataclass) with ``changes`` to its fields or to the
+    fields of its settings dataclasses, by their own names: ``with_settings(KnnKalman(), n=16, groups="all")``
+    sets ``knn.n`` and ``kalman.groups``. A settings field named ``method`` (the population's design) is
+    given through its dataclass (``knn=KnnSettings(method="lhs")``).
+
+    Raises
+    ------
+    TypeError
+        For a name that is none of these (the message lists the known ones).
+    """
+    if not changes:
+        return method
+    if not dataclasses.is_dataclass(method) or isinstance(method, type):
+        raise TypeError(f"unknown setting(s) {', '.join(sorted(changes))}: the method "
+                        f"{getattr(method, 'name', method)!r} has no settings by name; give them to the method")
+    fields = {f.name: getattr(method, f.name) for f in dataclasses.fields(method)}
+    top = {name: changes.pop(name) for name in list(changes) if name in fields}
+    nested = {}
+    for part, value in {**fields, **top}.items():
+        if dataclasses.is_dataclass(value) and not isinstance(value, type):
+            names = {f.name for f in dataclasses.fields(value)} - {"method"}
+            own = {name: changes.pop(name) for name in list(changes) if name in names}
+            if own:
+                nested[part] = dataclasses.replace(value, **own)
+    if changes:
+        known = set(fields) | {f.name for v in fields.values() if dataclasses.is_dataclass(v)
+                               for f in dataclasses.fields(v)} - {"method"}
+        raise TypeError(f"unknown setting(s) {', '.join(sorted(changes))} of the method {method.name!r}; known: "
+                        f"{', '.join(sorted(known))}")
+    return dataclasses.replace(method, **{**top, **nested})
+
+
+def method_stages(name: str) -> dict:
+    """The stages (name -> label) of the registered method ``name``; empty for an unknown name."""
+    cls = METHODS.get(name)
+    return dict(getattr(cls, "stages", None) or {})
+
+
+__all__ = ["DEFAULT_METHOD", "METHODS", "KnnGaussNewton", "KnnKalman", "StudyMethod", "method_stages", "with_settings"]

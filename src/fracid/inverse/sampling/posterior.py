@@ -1,0 +1,394 @@
+"""Samples of the identified parameters given the data, on the exact forward model: adaptive importance
+sampling seeded by the Gaussian of the identification.
+
+Target: p(x | y_exp) ~ exp(-1/2 (y(x) - y_exp)^T C_exp^-1 (y(x) - y_exp)) prior(x), with the prior
+uniform between the identification bounds (log-uniform for parameters on a log scale): uniform on the
+unit cube of :class:`~fracid.inverse.core.space.ParameterSpace`, where the sampler works.
+
+Method (AMIS, Cornuet et al. 2012, with defensive mixtures, Hesterberg 1995): round 0 draws from a
+Gaussian around the estimate (its covariance inflated) plus a share of the prior; every later round
+from a Gaussian mixture fitted to all weighted samples so far (:func:`fracid.inverse.sampling.mixture.fit_mixture`),
+which follows a curved valley with several ellipses. Every draw is one independent exact forward run,
+so a round runs in parallel on the executor and goes through the run store (a rerun with the same seed
+draws the same points and reuses them). All draws are reweighted against the mixture of all
+proposals used (deterministic-mixture weights), so no run is wasted. It stops when the effective
+sample size (ESS = (sum w)^2 / sum w^2) reaches the target or after ``max_rounds``. Failed runs and
+runs without every output get weight 0 and are counted.
+
+Why not MCMC on the exact model: its samples are sequential (a chain cannot use the pool), and a
+thousand sequential runs of a beam are hours; the importance draws of one round run side by side.
+Why not MCMC on an emulator: the emulator's error enters the posterior unmeasured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from fracid.data.covariance_matrix import as_covariance
+from fracid.inverse.sampling.mixture import (
+    GaussianMixture,
+    amis_weights,
+    fit_mixture,
+    weighted_covariance,
+    weighted_quantile,
+)
+from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points
+
+__all__ = ["MIN_ESS", "MIN_ESS_FRACTION", "PosteriorResult", "PosteriorSettings", "ess_floor", "posterior",
+           "sample_posterior", "weighted_quantile"]
+
+#: Effective sample size below which the sampling has failed: the weights sit on a few draws, and
+#: quantiles of a few points are not credible intervals (at ESS 1 the interval is a point)
+MIN_ESS = 50.0
+#: ... or below this share of ``target_ess``, when that is larger
+MIN_ESS_FRACTION = 0.05
+#: What to change when the sampling failed (the status's and the configuration warning's advice)
+ESS_ADVICE = ("draw more (samples_per_round, max_rounds of [posterior]), widen the first proposal (a larger "
+              "inflation), or check the identification (a poor fit, an estimate at a bound, a std too small)")
+
+
+def ess_floor(target_ess: float) -> float:
+    """The effective sample size below which the sampling has failed: ``max(MIN_ESS, MIN_ESS_FRACTION *
+    target_ess)``, but never above ``target_ess`` itself (a lower target is the user's choice, warned
+    about when the configuration is loaded).
+
+    Examples
+    --------
+    >>> ess_floor(500.0), ess_floor(4000.0), ess_floor(30.0)
+    (50.0, 200.0, 30.0)
+    """
+    return float(min(target_ess, max(MIN_ESS, MIN_ESS_FRACTION * target_ess)))
+
+
+@dataclass(frozen=True)
+class PosteriorSettings:
+    """Settings of :func:`posterior`.
+
+    Parameters
+    ----------
+    samples_per_round : int
+        Forward runs per round (run side by side on the executor).
+    max_rounds : int
+        Rounds at most (runs at most: ``samples_per_round * max_rounds``).
+    target_ess : float
+        Stop when the effective sample size reaches this.
+    components : int
+        Gaussian components of the adapted proposals.
+    defensive : float
+        Share of the prior in every proposal (bounds the weights; covers what the Gaussian misses).
+    inflation : float
+        Standard-deviation multiplier of the first proposal around the Gaussian estimate.
+    seed : int
+        Seed of the draws (the same seed draws the same points: a rerun reuses the stored runs).
+    """
+
+    samples_per_round: int = 200
+    max_rounds: int = 10
+    target_ess: float = 500.0
+    components: int = 8
+    defensive: float = 0.1
+    inflation: float = 2.0
+    seed: int = 0
+
+    def __post_init__(self):
+        checks = [("samples_per_round", self.samples_per_round >= 2), ("max_rounds", self.max_rounds >= 1),
+                  ("target_ess", self.target_ess > 1), ("components", self.components >= 1),
+                  ("defensive", 0.0 <= self.defensive < 1.0), ("inflation", self.inflation > 0),
+                  ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0)]
+        for name, ok in checks:
+            if not ok:
+                raise ValueError(f"posterior setting {name} = {getattr(self, name)!r} is out of range")
+
+    def replace(self, **changes) -> "PosteriorSettings":
+        return replace(self, **changes)
+
+
+@dataclass
+class PosteriorResult:
+    """Weighted samples of the posterior and what they give.
+
+    Attributes
+    ----------
+    names : list of str
+    x : ndarray, shape (n, p)
+        Every draw, in the parameters' units.
+    weights : ndarray, shape (n,)
+        Normalised importance weights (sum 1; 0 for failed runs).
+    log_likelihood : ndarray, shape (n,)
+        -1/2 chi^2 of each draw (-inf for failed runs).
+    y : ndarray, shape (n, m)
+        Computed observations of each draw (NaN for failed runs).
+    y_exp, std_exp : ndarray, shape (m,)
+        Measured values and their standard deviations.
+    ess : float
+        Effective sample size of the weights.
+    rounds : int
+    failed : int
+        Draws whose forward run failed (or lacked outputs).
+    estimate, estimate_cov : ndarray
+        The Gaussian the sampler started from (the identification's estimate and covariance).
+    bounds : (ndarray, ndarray)
+    log : tuple of bool
+        Per parameter: whether its prior is log-uniform (a log axis in plots).
+    units : dict
+    status : str
+        ``"converged"`` (ESS reached), ``"ESS ... below the target ..."`` (between the floor
+        :func:`ess_floor` and the target: rough intervals) or ``"failed: effective sample size ..."``
+        (below the floor: :attr:`sampling_failed`, no credible intervals).
+    history : list of dict
+        Per round: draws, failed, ESS after the round, components of the proposal.
+    """
+
+    names: list
+    x: np.ndarray
+    weights: np.ndarray
+    log_likelihood: np.ndarray
+    y: np.ndarray
+    y_exp: np.ndarray
+    std_exp: np.ndarray
+    ess: float
+    rounds: int
+    failed: int
+    estimate: np.ndarray
+    estimate_cov: np.ndarray
+    bounds: tuple
+    log: tuple = ()
+    units: dict = field(default_factory=dict)
+    status: str = ""
+    history: list = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "converged"
+
+    @property
+    def sampling_failed(self) -> bool:
+        """Whether the effective sample size stayed below the floor (:func:`ess_floor`): the draws give no
+        credible intervals (:meth:`credible_intervals` is NaN) and ``fracid posterior`` exits 3.
+        (``failed`` is the count of failed forward runs.)"""
+        return self.status.startswith("failed")
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.weights @ self.x
+
+    @property
+    def cov(self) -> np.ndarray:
+        return weighted_covariance(self.x, self.weights)[1]
+
+    @property
+    def std(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.cov))
+
+    def quantiles(self, q) -> np.ndarray:
+        """Weighted quantiles of every parameter, shape (len(q), p)."""
+        return np.column_stack([weighted_quantile(self.x[:, j], self.weights, q) for j in range(self.x.shape[1])])
+
+    def credible_intervals(self, level: float = 0.9) -> np.ndarray:
+        """Equal-tailed credible intervals, shape (p, 2); NaN when :attr:`sampling_failed` (the quantiles of
+        a few draws are not an interval: :meth:`quantiles` still gives them)."""
+        if self.sampling_failed:
+            return np.full((len(self.names), 2), np.nan)
+        return self.quantiles([(1.0 - level) / 2.0, (1.0 + level) / 2.0]).T
+
+    def predictive_band(self, level: float = 0.9) -> np.ndarray:
+        """Weighted quantiles (lower, median, upper) of the computed observations, shape (3, m): the band
+        of the model's response over the measured points (without measurement noise)."""
+        ok = self.weights > 0
+        q = [(1.0 - level) / 2.0, 0.5, (1.0 + level) / 2.0]
+        return np.column_stack([weighted_quantile(self.y[ok, i], self.weights[ok], q) for i in range(self.y.shape[1])])
+
+    def resample(self, n: int, seed: int = 0) -> np.ndarray:
+        """``n`` equally weighted draws (systematic resampling), shape (n, p)."""
+        rng = np.random.default_rng(seed)
+        positions = (rng.random() + np.arange(n)) / n
+        index = np.minimum(np.searchsorted(np.cumsum(self.weights), positions), len(self.weights) - 1)
+        return self.x[index]
+
+    def summary(self) -> str:
+        lines = [f"posterior: {len(self.x)} draws in {self.rounds} rounds, ESS {self.ess:.0f}, "
+                 f"{self.failed} failed run{'' if self.failed == 1 else 's'}; {self.status}"]
+        if self.sampling_failed:
+            return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
+        intervals = self.credible_intervals(0.9)
+        for j, name in enumerate(self.names):
+            lines.append(f"  {name}: mean {self.mean[j]:.5g}, std {self.std[j]:.3g}, 90 % interval "
+                         f"[{intervals[j, 0]:.5g}, {intervals[j, 1]:.5g}] {self.units.get(name, '')}".rstrip())
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The statistics as plain values; ``interval_90`` holds None (JSON null) when :attr:`sampling_failed`."""
+        intervals = self.credible_intervals(0.9).astype(object)
+        intervals[~np.isfinite(intervals.astype(float))] = None
+        return {"names": list(self.names), "mean": self.mean.tolist(), "std": self.std.tolist(),
+                "cov": self.cov.tolist(), "interval_90": intervals.tolist(), "ess": self.ess, "draws": len(self.x),
+                "rounds": self.rounds, "failed": self.failed, "status": self.status,
+                "sampling_failed": self.sampling_failed,
+                "estimate": np.asarray(self.estimate).tolist(), "estimate_cov": np.asarray(self.estimate_cov).tolist(),
+                "units": dict(self.units), "history": self.history}
+
+    def save_csv(self, path) -> Path:
+        """The draws: one row each, the parameters, the weight and the log-likelihood."""
+        path = Path(path)
+        header = ",".join([*self.names, "weight", "log_likelihood"])
+        np.savetxt(path, np.column_stack([self.x, self.weights, self.log_likelihood]), delimiter=",",
+                   header=header, comments="", fmt="%.10g")
+        return path
+
+    def to_inference_data(self, draws: int = 2000, seed: int = 0):
+        """ArviZ InferenceData of ``draws`` resampled (equally weighted) draws in one chain, with the
+        weighted draws' ESS in its attributes (needs the ``arviz`` extra)."""
+        try:
+            import arviz
+        except ImportError as exc:
+            raise ImportError("to_inference_data needs ArviZ: pip install 'fracid[arviz]'") from exc
+        sample = self.resample(draws, seed)
+        data = {name: sample[None, :, j] for j, name in enumerate(self.names)}
+        return arviz.from_dict(posterior=data, attrs={"importance_ess": self.ess, "importance_draws": len(self.x),
+                                                       "method": "adaptive importance sampling (fracid)"})
+
+
+def _log_likelihood(records, y_exp, C_exp):
+    """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs;
+    chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`)."""
+    y = np.array([np.asarray(r.y, float) if r.ok else np.full(len(y_exp), np.nan) for r in records])
+    good = np.all(np.isfinite(y), axis=1)
+    chi2 = C_exp.quadratic(np.where(good[:, None], y - y_exp, 0.0).T)
+    return np.where(good, -0.5 * chi2, -np.inf), y
+
+
+def _first_proposal(space, x0, C0, settings, rng) -> GaussianMixture:
+    """The estimate's Gaussian in unit-cube coordinates (linearised map), its std times ``inflation``."""
+    u0 = np.clip(space.to_unit(x0)[0], 1e-6, 1 - 1e-6)
+    log = np.array(space.log, dtype=bool)
+    ratio = np.where(log, space.upper, 1.0) / np.where(log, space.lower, 1.0)
+    span = np.where(log, np.log(ratio), space.upper - space.lower)
+    jac = 1.0 / np.where(log, x0 * span, span)  # du/dx of ParameterSpace.to_unit
+    cov = settings.inflation**2 * (jac[:, None] * np.asarray(C0, float) * jac[None, :])
+    cov = cov + 1e-10 * np.eye(len(u0))
+    return GaussianMixture(np.ones(1), u0[None], cov[None], settings.defensive).with_mass(rng)
+
+
+def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSettings = PosteriorSettings(),
+              executor=None, progress=None, log=None) -> PosteriorResult:
+    """Weighted samples of the parameters given the data by adaptive importance sampling on the exact model.
+
+    Parameters
+    ----------
+    evaluate : callable or StoredOperator
+        The forward operator (``evaluate(x)`` gives a run record or the outputs); a
+        :class:`~fracid.inverse.core.runs.StoredOperator` stores every run and reuses stored ones.
+    y_exp : ndarray, shape (m,)
+        Measured values.
+    C_exp : ndarray, shape (m, m), or Covariance
+        Their covariance [units of y squared] (a diagonal one forms no m x m matrix).
+    space : ParameterSpace
+        Names and bounds of the parameters: the prior is uniform on its unit cube.
+    x0, C0 : ndarray
+        The Gaussian estimate to start from (an identification's ``x`` and ``C``).
+    settings : PosteriorSettings
+    executor : Executor, optional
+        Runs the draws of a round side by side.
+    progress : callable, optional
+        ``progress(done_runs, max_runs)`` after every round.
+    log : callable, optional
+        ``log(text)``: a line per round.
+
+    Returns
+    -------
+    PosteriorResult
+
+    Raises
+    ------
+    ForwardRunError
+        When every forward run failed or lacked outputs (nothing to weigh).
+    """
+    y_exp = np.asarray(y_exp, float)
+    C_exp = as_covariance(C_exp, y_exp.size, name="C_exp")
+    rng = np.random.default_rng(settings.seed)
+    proposal = _first_proposal(space, np.asarray(x0, float), C0, settings, rng)
+    proposals, densities, sizes, history = [], [], [], []
+    u_all, loglik, outputs = np.empty((0, len(space.names))), np.empty(0), np.empty((0, len(y_exp)))
+    weights, ess = np.empty(0), 0.0
+    for round_ in range(settings.max_rounds):
+        u = proposal.sample(rng, settings.samples_per_round)
+        records = evaluate_points(evaluate, space.from_unit(u), None, executor)
+        ll, y = _log_likelihood(records, y_exp, C_exp)
+        # every proposal's log density at every draw: the earlier ones at the new draws, the new one at all
+        densities = [np.concatenate([row, q.logpdf(u)]) for row, q in zip(densities, proposals)]
+        proposals.append(proposal)
+        sizes.append(len(u))
+        u_all, loglik, outputs = np.vstack([u_all, u]), np.concatenate([loglik, ll]), np.vstack([outputs, y])
+        densities.append(proposal.logpdf(u_all))
+        weights, ess = amis_weights(np.vstack(densities), loglik, sizes)
+        history.append({"round": round_, "draws": len(u), "failed": int(np.sum(~np.isfinite(ll))), "ess": ess,
+                        "components": len(proposal.weights)})
+        if progress is not None:
+            progress(len(u_all), settings.samples_per_round * settings.max_rounds)
+        if log is not None:
+            log(f"posterior round {round_ + 1}: {len(u_all)} draws, ESS {ess:.0f} (target {settings.target_ess:g})")
+        if ess >= settings.target_ess or not np.any(weights > 0):
+            break
+        proposal = fit_mixture(u_all, weights, settings.components, defensive=settings.defensive, rng=rng)
+    failed = int(np.sum(~np.isfinite(loglik)))
+    if not np.any(weights > 0):
+        raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh. "
+                              "Check the bounds of [identify.bounds] (the prior) and the forward runs of the "
+                              "identification; failed runs are stored: --retry-failed runs them again")
+    status = _status(ess, settings, len(u_all), len(proposals))
+    lower, upper = space.lower, space.upper
+    return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
+                           C_exp.std(), ess, len(proposals), failed, np.asarray(x0, float),
+                           np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
+
+
+def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
+    """The sampler's verdict on its weights: converged, rough (below the target) or failed (below the floor)."""
+    if ess >= settings.target_ess:
+        return "converged"
+    floor = ess_floor(settings.target_ess)
+    if ess < floor:
+        return (f"failed: effective sample size {ess:.3g} < {floor:g} (the floor: {MIN_ESS:g}, or "
+                f"{MIN_ESS_FRACTION:.0%} of target_ess = {settings.target_ess:g}) after {draws} draws in {rounds} "
+                f"round{'s' if rounds != 1 else ''}: the weights sit on a few draws, so there are no credible "
+                f"intervals; {ESS_ADVICE}")
+    return (f"ESS {ess:.0f} below the target {settings.target_ess:g} after {rounds} rounds: the intervals are "
+            "rough; raise max_rounds or samples_per_round")
+
+
+def sample_posterior(evaluate, data, space, identification, settings, *, executor=None, progress=None, log=None):
+    """The posterior of the identified parameters given ``data``, started from the identification's Gaussian.
+
+    Parameters
+    ----------
+    evaluate : StoredOperator or callable
+        The forward operator (through the run store: every draw is stored and reused by a rerun).
+    data : ExperimentalData
+        Measured values ``y`` and their ``covariance``.
+    space : ParameterSpace
+        Names and bounds: the prior is uniform (log-uniform where configured) between the bounds.
+    identification : IdentificationResult
+        Its ``x`` and ``C`` seed the sampler; its ``units`` label the result.
+    settings : PosteriorSettings
+    executor : Executor, optional
+    progress : bool or None
+        Progress bar: None on a terminal only, False never.
+    log : callable, optional
+        ``log(text)``: a line before the sampler starts and one per round.
+
+    Returns and raises as :func:`posterior`; the result carries the identification's units.
+    """
+    from fracid.progress import batch_progress, progress_bar
+
+    total = settings.samples_per_round * settings.max_rounds
+    if log is not None:
+        log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of {settings.samples_per_round}), "
+            f"until the effective sample size reaches {settings.target_ess:g} ([posterior] settings)")
+    with progress_bar(total, "posterior", progress) as bar:
+        result = posterior(evaluate, data.y, data.covariance, space, identification.x, identification.C,
+                           settings=settings, executor=executor, progress=batch_progress(bar), log=log)
+    result.units = dict(identification.units or {})
+    return result

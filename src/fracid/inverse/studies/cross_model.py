@@ -1,0 +1,452 @@
+"""Cross-model calibration and comparison of forward models on one data set.
+
+Two questions about models of different kinds (e.g. the gradient damage continuum and the discrete
+cohesive crack, see :mod:`fracid.models`):
+
+* :func:`cross_calibration`: how well can model B reproduce a curve produced by model A, with
+  which parameters, and does it dissipate the same energy while doing so?
+* :func:`compare_models`: fitted to the same (measured) data, what parameters, fit error, peak
+  force and dissipated energy does each model give?
+
+Both identify with :func:`fracid.inverse.methods.strategy.identify_data` (KNN population, then the Kalman
+filter) and then run each model once more at its estimate, to the last control value of the data,
+to read the energy it dissipated (``observables["dissipated_energy"]``: external work minus elastic
+energy, [N mm]) and its peak force.
+
+Units: control (CMOD) [mm], force [N], energy [N mm]; parameters in the units of their class.
+
+Example
+-------
+>>> from fracid.inverse.studies.cross_model import Candidate, compare_models
+>>> table = compare_models(data, beam, [Candidate("cohesive", CohesiveCrackModel(), CohesiveParameters(E=37000.0),
+...                                               ("ft", "Gf"), space)], n=16, k=3)   # doctest: +SKIP
+>>> table.rows()                                                                     # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fracid.data import Diagonal, ExperimentalData
+from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.core.sensitivity import ForwardRunError
+from fracid.inverse.methods.strategy import IdentificationResult, identify_data
+from fracid.models import ConvergenceError
+
+__all__ = [
+    "Candidate",
+    "CrossCalibration",
+    "ModelComparison",
+    "ModelFit",
+    "compare_models",
+    "cross_calibration",
+    "fit_model",
+    "relative_rms",
+    "run_to_end",
+]
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A model to fit: its forward model, fixed parameters, identified names and search space.
+
+    Parameters
+    ----------
+    label : str
+        Name of the row in tables and figures.
+    model : ForwardModel
+        E.g. ``DamageModel("gradient")`` or ``CohesiveCrackModel()`` (:mod:`fracid.models`).
+    base : parameter object
+        Values of the parameters that are not identified (an instance of ``model.parameters``).
+    names : sequence of str
+        Identified parameters.
+    space : ParameterSpace
+        Bounds (and log flags) of the KNN population over ``names``.
+    specimen : object, optional
+        The specimen this model runs on (e.g. its own mesh); None: the one given to the caller.
+    settings : dict, optional
+        Settings of :func:`~fracid.inverse.methods.strategy.identify` for this candidate only (``n``, ``k``,
+        ``groups``, ...), overriding the shared ones.
+    """
+
+    label: str
+    model: object
+    base: object
+    names: tuple
+    space: ParameterSpace
+    specimen: object = None
+    settings: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "names", tuple(self.names))
+        if tuple(self.space.names) != self.names:
+            raise ValueError(f"candidate {self.label!r}: the space is over {tuple(self.space.names)} but the "
+                             f"identified parameters are {self.names}")
+
+
+@dataclass
+class ModelFit:
+    """One model fitted to one data set, and its run at the estimate.
+
+    Attributes
+    ----------
+    label, model_key : str
+        The candidate's label and the model's ``key``.
+    identification : IdentificationResult
+        Estimate ``x``, covariance ``C``, the fit ``y_fit`` at the data's points, runs, ...
+    params : parameter object
+        The full parameter set at the estimate.
+    control, force : ndarray
+        Curve of the run at the estimate from 0 to the last data control value [mm], [N].
+    rms_relative : float
+        RMS of ``y_fit - y`` over the data points divided by the data's largest |y| [-].
+    peak_force : float
+        Largest force of the run at the estimate [N].
+    dissipated_energy : float
+        Energy dissipated by the run at the estimate up to the last data control value [N mm]
+        (NaN if that run stopped before it).
+    forward_runs : int
+        Forward runs of the identification: KNN population plus Kalman filter (the run at the
+        estimate is not counted).
+    seconds : float
+        Wall time of the identification and of the run at the estimate [s].
+    """
+
+    label: str
+    model_key: str
+    identification: IdentificationResult
+    params: object
+    control: np.ndarray
+    force: np.ndarray
+    rms_relative: float
+    peak_force: float
+    dissipated_energy: float
+    forward_runs: int
+    seconds: float
+
+    @property
+    def names(self) -> list:
+        return list(self.identification.names)
+
+    @property
+    def x(self) -> np.ndarray:
+        """The estimate (units of the parameters)."""
+        return np.asarray(self.identification.x, float)
+
+    @property
+    def std(self) -> np.ndarray:
+        """Standard deviations of the estimate from the Kalman filter's covariance."""
+        return np.asarray(self.identification.std, float)
+
+    @property
+    def units(self) -> dict:
+        return dict(self.identification.units)
+
+    def row(self) -> dict:
+        """A plain dict for tables and JSON: ``label``, ``model``, ``parameters`` ({name: {value, std,
+        unit}}), ``rms_percent``, ``peak_force_N``, ``dissipated_energy_Nmm``, ``forward_runs``,
+        ``converged``, ``status`` (of the Kalman filter), ``seconds``."""
+        units = self.units
+        return {
+            "label": self.label, "model": self.model_key,
+            "parameters": {n: {"value": float(v), "std": float(s), "unit": units.get(n, "")}
+                           for n, v, s in zip(self.names, self.x, self.std)},
+            "rms_percent": 100.0 * self.rms_relative, "peak_force_N": self.peak_force,
+            "dissipated_energy_Nmm": self.dissipated_energy, "forward_runs": self.forward_runs,
+            "converged": bool(self.identification.converged), "status": self.identification.status,
+            "seconds": self.seconds,
+        }
+
+
+@dataclass
+class ModelComparison:
+    """Models fitted to the same data (:func:`compare_models`)."""
+
+    data: ExperimentalData
+    fits: list
+    failures: dict = field(default_factory=dict)  # label -> why the fit failed (the other fits are kept)
+
+    def rows(self) -> list[dict]:
+        """:meth:`ModelFit.row` of every model, with the data's peak force (``peak_force_data_N``)."""
+        peak = float(np.max(np.abs(self.data.y)))
+        return [{**fit.row(), "peak_force_data_N": peak} for fit in self.fits]
+
+    def fit(self, label: str) -> ModelFit:
+        """The fit of the model labelled ``label``."""
+        for fit in self.fits:
+            if fit.label == label:
+                return fit
+        raise KeyError(f"no model labelled {label!r}; labels: {[f.label for f in self.fits]}")
+
+
+@dataclass
+class CrossCalibration:
+    """Model B fitted to a curve of model A (:func:`cross_calibration`).
+
+    Attributes
+    ----------
+    source_label : str
+    source_params : parameter object
+        Parameters of the source model A.
+    source_control, source_force : ndarray
+        The source run from 0 to the last control point [mm], [N].
+    source_energy : float
+        Energy dissipated by the source run up to the last control point [N mm].
+    data : ExperimentalData
+        The source force sampled at the control points, with the stated (noise-free) covariance.
+    fit : ModelFit
+        The target model B fitted to ``data``.
+    """
+
+    source_label: str
+    source_params: object
+    source_control: np.ndarray
+    source_force: np.ndarray
+    source_energy: float
+    data: ExperimentalData
+    fit: ModelFit
+
+    @property
+    def source_peak_force(self) -> float:
+        return float(np.max(self.source_force))
+
+    @property
+    def energy_ratio(self) -> float:
+        """Dissipated energy of the fitted model B over that of the source A [-], both to the last point."""
+        return self.fit.dissipated_energy / self.source_energy
+
+
+def relative_rms(y_fit, y) -> float:
+    """RMS of ``y_fit - y`` divided by the largest |y| [-] (NaN entries of ``y_fit`` count as missing)."""
+    y_fit, y = np.asarray(y_fit, float), np.asarray(y, float)
+    both = np.isfinite(y_fit) & np.isfinite(y)
+    if not both.any():
+        return float("nan")
+    return float(np.sqrt(np.mean((y_fit[both] - y[both]) ** 2)) / np.max(np.abs(y)))
+
+
+def run_to_end(model, specimen, params, control_points, *, control="cmod", steps=None):
+    """One run of ``model`` from 0 to the last of ``control_points``, landing on each of them.
+
+    Parameters
+    ----------
+    model : ForwardModel
+    specimen : object
+    params : parameter object
+    control_points : array_like
+        Increasing control values [mm]; the run stops at the last one (no stop on the force).
+    control : str
+        The specimen's control quantity.
+    steps : StepOptions, optional
+        Step rule (the specimen's default if None).
+
+    Returns
+    -------
+    run : PathResult
+        The run (the partial run if it stopped on a ConvergenceError).
+    dissipated_energy : float
+        ``observables["dissipated_energy"]`` at the last control point [N mm]; NaN if not reached or
+        if the model does not report it.
+    """
+    points = np.asarray(control_points, float)
+    target = float(points[-1])
+    try:
+        run = model.simulate(specimen, params, control=control, target=target, stop_force_fraction=None,
+                             steps=steps, field_steps=None, checkpoints=points)
+    except ConvergenceError as err:
+        run = err.partial
+    reached = run.control.size > 0 and run.control[-1] >= target * (1.0 - 1e-9)
+    dissipated = run.observables.get("dissipated_energy")
+    energy = float(np.interp(target, run.control, dissipated)) if reached and dissipated is not None else float("nan")
+    return run, energy
+
+
+def fit_model(data: ExperimentalData, candidate: Candidate, specimen=None, *, control="cmod", steps=None,
+              **settings) -> ModelFit:
+    """Identify one candidate model on force data, then run it at the estimate.
+
+    Parameters
+    ----------
+    data : ExperimentalData
+        Force blocks [N] at control values [mm] of one specimen (every block is a force curve).
+    candidate : Candidate
+    specimen : object, optional
+        Used when ``candidate.specimen`` is None.
+    control : str
+        Control quantity of the data (``"cmod"`` for the notched beam).
+    steps : StepOptions, optional
+        Step rule of every forward run (the specimen's default if None): the data's control
+        values are landed on exactly whatever the rule, so a coarser rule than the default
+        changes the computed points little and saves time.
+    **settings
+        Passed to :func:`~fracid.inverse.methods.strategy.identify_data` (``n``, ``k``, ``groups``,
+        ``executor``, ``store``, ``progress``, ...); ``candidate.settings`` override them.
+
+    Returns
+    -------
+    ModelFit
+    """
+    start = time.perf_counter()
+    specimen = candidate.specimen if candidate.specimen is not None else specimen
+    if specimen is None:
+        raise ValueError(f"candidate {candidate.label!r} has no specimen and none was given")
+    observations = [Observation(specimen, data.control[a:b], quantity="force", control=control, name=name)
+                    for name, a, b in data.blocks]
+    operator = ForwardOperator(observations, candidate.base, candidate.names, model=candidate.model, steps=steps)
+    result = identify_data(operator, data, candidate.space, **{**settings, **candidate.settings})
+    params = operator.parameters(result.x)
+    run, energy = run_to_end(candidate.model, specimen, params, data.control, control=control, steps=steps)
+    return ModelFit(
+        label=candidate.label, model_key=candidate.model.key, identification=result, params=params,
+        control=np.asarray(run.control, float), force=np.asarray(run.force, float),
+        rms_relative=relative_rms(result.y_fit, data.y), peak_force=float(np.max(run.force)),
+        dissipated_energy=energy, forward_runs=result.forward_runs,
+        seconds=time.perf_counter() - start,
+    )
+
+
+def compare_models(data: ExperimentalData, specimen, candidates, *, control="cmod", steps=None, log=None,
+                   **settings) -> ModelComparison:
+    """Fit every candidate model to the same data; a table of parameters, fit error and energies.
+
+    Parameters
+    ----------
+    data : ExperimentalData
+        Force data [N] at control values [mm] (e.g. :func:`fracid.data.gregoire2013_beam4`).
+    specimen : object
+        The specimen of the data (candidates may carry their own, e.g. another mesh).
+    candidates : sequence of Candidate or of tuples
+        ``(label, model, base_params, names, space[, specimen[, settings]])``.
+    control : str
+        Control quantity of the data.
+    steps : StepOptions, optional
+        Step rule of every forward run (see :func:`fit_model`).
+    log : callable, optional
+        Called with a line of text before and after each fit (progress of a long comparison).
+    **settings
+        Shared settings of :func:`~fracid.inverse.methods.strategy.identify_data`.
+
+    Returns
+    -------
+    ModelComparison
+        One :class:`ModelFit` per candidate that could be fitted, in order; :meth:`ModelComparison.rows`
+        gives the table: fitted parameters +- std, relative RMS fit error, peak force, dissipated
+        energy to the last data control value [N mm], number of forward runs. A candidate whose fit
+        stops on a failed forward run (e.g. at the Kalman filter's estimate) is recorded in
+        ``failures`` with the reason, and the comparison goes on.
+    """
+    fits, failures = [], {}
+    candidates = [c if isinstance(c, Candidate) else Candidate(*c) for c in candidates]
+    for i, candidate in enumerate(candidates, start=1):
+        if log is not None:
+            log(f"[{i}/{len(candidates)}] fitting {candidate.label} ({candidate.model.key}): "
+                f"{', '.join(candidate.names)}")
+        try:
+            fit = fit_model(data, candidate, specimen, control=control, steps=steps, **settings)
+        except (ForwardRunError, ConvergenceError) as err:
+            failures[candidate.label] = f"{type(err).__name__}: {err}"
+            if log is not None:
+                log(f"[{i}/{len(candidates)}] {candidate.label}: failed ({failures[candidate.label]})")
+            continue
+        if log is not None:
+            log(f"[{i}/{len(candidates)}] {candidate.label}: " + _fit_line(fit))
+        fits.append(fit)
+    return ModelComparison(data=data, fits=fits, failures=failures)
+
+
+def _fit_line(fit: ModelFit) -> str:
+    units = fit.units
+    values = ", ".join(f"{n} = {v:.4g} +- {s:.2g} {units.get(n, '')}".rstrip()
+                       for n, v, s in zip(fit.names, fit.x, fit.std))
+    return (f"{values}; RMS {100 * fit.rms_relative:.2f} % of the peak; peak {fit.peak_force:.4g} N; "
+            f"dissipated {fit.dissipated_energy:.4g} N mm; {fit.forward_runs} runs, {fit.seconds:.0f} s")
+
+
+def cross_calibration(source_model, source_params, target_model, target_base, target_names, space: ParameterSpace,
+                      specimen, cmod_points, *, target_specimen=None, relative_std=0.065, control="cmod", steps=None,
+                      source_label=None, target_label=None, log=None, **settings) -> CrossCalibration:
+    """Calibrate a target model B on the curve of a source model A.
+
+    Model A runs with ``source_params`` on ``specimen`` to the last of ``cmod_points``; its force at
+    those points is the data (no noise added), with the standard deviation ``relative_std`` times
+    its peak force at every point. Model B is identified on these data over ``target_names``
+    within ``space`` (the other parameters from ``target_base``), then run at its estimate.
+
+    Parameters
+    ----------
+    source_model, target_model : ForwardModel
+    source_params : parameter object
+        All parameters of the source model (an instance of ``source_model.parameters``).
+    target_base : parameter object
+        Fixed parameters of the target model (an instance of ``target_model.parameters``).
+    target_names : sequence of str
+        Identified parameters of the target model.
+    space : ParameterSpace
+        KNN population bounds over ``target_names``.
+    specimen : object
+        The specimen (and mesh) of the source run; the target's too unless ``target_specimen``.
+    cmod_points : array_like
+        Increasing control values of the data [mm].
+    target_specimen : object, optional
+        The target model's specimen (e.g. another mesh).
+    relative_std : float
+        Standard deviation of the data as a fraction of the source's peak force [-]: the weight
+        of the data against the KNN prior in the Kalman filter. A mismatch of models is not noise,
+        and a small std makes the filter's undamped steps overshoot: fitting gradient damage to
+        the cohesive curve of the Gregoire beam (24 points, 4 mm mesh), 3 % left the bounds where
+        6.5 % (the default; about the scatter of the measured curves of that beam past the peak)
+        settled. The covariance of the estimate is to be read as its sensitivity to the data, not
+        as an error bar.
+    control : str
+        Control quantity (``"cmod"`` for the notched beam).
+    steps : StepOptions, optional
+        Step rule of every forward run, the source's included (see :func:`fit_model`).
+    source_label, target_label : str, optional
+        Labels (default: the models' keys).
+    log : callable, optional
+        Called with a line of text at each stage.
+    **settings
+        Passed to :func:`~fracid.inverse.methods.strategy.identify_data` (``n``, ``k``, ``groups``,
+        ``executor``, ``store``, ``progress``, ...).
+
+    Returns
+    -------
+    CrossCalibration
+        With the target's estimate and covariance (``fit.identification``), ``fit.std``, the fit
+        error ``fit.rms_relative`` (RMS of the force residual / the source's peak force) and the
+        dissipated energies of both runs to the last point (``source_energy``,
+        ``fit.dissipated_energy``) [N mm].
+
+    Raises
+    ------
+    RuntimeError
+        If the source run does not reach the last control point.
+    """
+    source_label = source_label or source_model.key
+    target_label = target_label or target_model.key
+    points = np.asarray(cmod_points, float)
+    if log is not None:
+        log(f"source: {source_label} to {control} = {points[-1]:g} mm")
+    run, energy = run_to_end(source_model, specimen, source_params, points, control=control, steps=steps)
+    if not np.isfinite(energy):
+        raise RuntimeError(f"the source run ({source_label}, {source_params}) stopped at {control} = "
+                           f"{run.control[-1]:.6g} mm, before the last point {points[-1]:.6g} mm")
+    y = np.interp(points, run.control, run.force)
+    std = relative_std * float(np.max(np.abs(y)))
+    notes = (f"cross-calibration data: force of {source_label} at {source_params}, {points.size} {control} points "
+             f"from {points[0]:g} to {points[-1]:g} mm, no noise added; std {std:.4g} N "
+             f"({relative_std:g} of its peak) at every point",)
+    data = ExperimentalData(points, y, Diagonal(np.full(points.size, std**2)), (("global", 0, points.size),), notes)
+    candidate = Candidate(target_label, target_model, target_base, target_names, space, target_specimen)
+    if log is not None:
+        log(f"target: fitting {target_label} ({', '.join(candidate.names)})")
+    fit = fit_model(data, candidate, specimen, control=control, steps=steps, **settings)
+    if log is not None:
+        log(f"target: {target_label}: {_fit_line(fit)}; source dissipated {energy:.4g} N mm")
+    return CrossCalibration(source_label=source_label, source_params=source_params,
+                            source_control=np.asarray(run.control, float), source_force=np.asarray(run.force, float),
+                            source_energy=energy, data=data, fit=fit)
