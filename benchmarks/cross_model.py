@@ -27,8 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from fracid.cli import demo_config_path
-from fracid.config import build_data, build_parameters, build_space, build_specimen, identify_settings, load_config
-from fracid.inverse.studies.cross_model import Candidate, compare_models, cross_calibration
+from fracid.config import build_data, build_method, build_parameters, build_space, build_specimen, load_config
+from fracid.inverse.studies.cross_model import compare_models, cross_calibration
+from fracid.inverse.studies.model_fit import Candidate
 from fracid.inverse.methods.knn import ParameterSpace
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.material.parameters import DamageParameters
@@ -75,7 +76,7 @@ def main(argv=None) -> int:
     gradient_source = demo_gradient_parameters(cfg)
     gradient_space = build_space(cfg)
     assert gradient_space.names == GRADIENT_NAMES, gradient_space.names
-    groups = identify_settings(cfg)["groups"]  # the demo's 4 consecutive groups
+    groups = build_method(cfg).kalman.groups  # the demo's 4 consecutive groups
     gradient_settings = {"n": 24, "k": 4, "groups": groups, "max_iterations": 5}
     cohesive_settings = {"n": 16, "k": 3, "groups": groups, "max_iterations": 5}
     if args.quick:

@@ -13,7 +13,8 @@ import time
 
 import numpy as np
 
-from fracid.parallel import make_executor, run_batch
+from fracid.batch import run_batch
+from fracid.parallel import make_executor
 from fracid.store import RunStore, key_for
 
 NONDETERMINISTIC = ("pid", "time")

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from fracid.fem.material.cohesive import CohesiveParameters, dissipated_energy_density
-from fracid.fem.formulations.cohesive_problem import crack_traction
+from fracid.fem.formulations.cohesive_problem import law_crack_traction
+from fracid.fem.material.laws import HordijkLaw
 from fracid.models import CohesiveCrackModel
 from fracid.specimens.beam import NotchedBeam
 
@@ -17,10 +18,10 @@ def test_crack_traction_tangent_matches_finite_differences():
     w0 = ft / penalty
     w = np.array([-1e-5, 0.5 * w0, 0.3 * wc, 0.6 * wc, 0.2 * wc, 1.2 * wc])
     w_max = np.array([0.0, 0.0, 0.25 * wc, 0.7 * wc, 0.4 * wc, 0.0])  # closed, uncracked, loading, unloading ...
-    sigma, tangent, _ = crack_traction(w, w_max, ft, wc, c1, c2, penalty)
+    sigma, tangent, _ = law_crack_traction(HordijkLaw(), PARAMS, w, w_max, penalty)
     h = 1e-7 * wc
-    plus, _, _ = crack_traction(w + h, w_max, ft, wc, c1, c2, penalty)
-    minus, _, _ = crack_traction(w - h, w_max, ft, wc, c1, c2, penalty)
+    plus, _, _ = law_crack_traction(HordijkLaw(), PARAMS, w + h, w_max, penalty)
+    minus, _, _ = law_crack_traction(HordijkLaw(), PARAMS, w - h, w_max, penalty)
     np.testing.assert_allclose(tangent, (plus - minus) / (2 * h), rtol=1e-5)
     assert sigma[0] < 0 and sigma[1] == pytest.approx(0.5 * ft) and sigma[-1] == 0.0
 

@@ -255,15 +255,15 @@ knn = { method = "grid", n = 5, k = 5 }
 
 def test_specimen_maps_match_the_specimens():
     """The controls and observables the config accepts are those the specimens provide."""
-    from fracid.config import _SPECIMENS, _specimen_class
+    from fracid.config.registry import SPECIMEN_DEFAULTS, specimen_class
 
     params = DamageParameters()
-    for kind, (controls, observables) in _SPECIMENS.items():
-        cls = _specimen_class(kind)
+    for kind, (controls, observables) in SPECIMEN_DEFAULTS.items():
+        cls = specimen_class(kind)
         assert cls.default_control == controls[0]
         assert set(DamageModel().observers(cls().describe(), params)) == set(observables)
     problem = DamageModel().build(BarWithWeakZone(n_elements=20), params)
-    assert set(problem.functionals) == set(_SPECIMENS["bar"][0])
+    assert set(problem.functionals) == set(SPECIMEN_DEFAULTS["bar"][0])
 
 
 def test_restart_is_a_setting_of_the_built_method(tmp_path):

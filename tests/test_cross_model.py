@@ -9,7 +9,8 @@ cores; the tolerances were set from measured values (stated beside each) with a 
 import numpy as np
 import pytest
 
-from fracid.inverse.studies.cross_model import Candidate, compare_models, cross_calibration, relative_rms
+from fracid.inverse.studies.cross_model import compare_models, cross_calibration
+from fracid.inverse.studies.model_fit import Candidate, relative_rms
 from fracid.inverse.methods.knn import ParameterSpace
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.material.parameters import DamageParameters

@@ -128,7 +128,7 @@ def test_bar_with_unloading_points_gradient_model():
     problem = model.build(bar, params)
     fields = run.fields[run.n_steps]
     q = problem.restrict(np.concatenate([fields["u"], fields["ebar"]]))
-    driving = problem.gather(q)[:, problem.dofs.n_u:] @ problem.disc.ebar_shape.T
+    driving = problem.gather(q)[:, problem.dofs.n_u:] @ problem.disc.space("linear").shape.T
     unloading = (driving < fields["kappa"] * (1 - 1e-9)) & (fields["kappa"] > params.kappa_i)
     assert unloading.sum() >= 2
 

@@ -150,7 +150,7 @@ def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     """The count from the corners and elements is exact for one piece without holes; beyond
     MAX_UNKNOWNS the configuration refuses the mesh before it is built."""
     from fracid.config import schema
-    from fracid.config.mesh_section import _check_mesh_size
+    from fracid.config.mesh_section import check_mesh_size
     from fracid.specimens.mesh import mesh_size, mesh_unknowns
 
     for triangles in (True, False):
@@ -162,7 +162,7 @@ def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     assert mesh_size(path) == (21, 24)
     with pytest.raises(MeshError, match=r"big.msh: 24 elements and 21 corner nodes make about 151 unknowns .*"
                                         r"at most 100 unknowns are allowed: use a coarser mesh"):
-        _check_mesh_size(str(path))
+        check_mesh_size(str(path))
     assert read_mesh(path).n_vertices == 21  # the limit is the configuration's, not the reader's
 
 
@@ -171,7 +171,7 @@ def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-d
     from types import SimpleNamespace
 
     from fracid.config import ConfigError
-    from fracid.config.checker import _Checker
+    from fracid.config.checker import Checker
     from fracid.config.mesh_section import check_mesh_units
     from fracid.config.schema import ModelConfig, SpecimenConfig
 
@@ -180,7 +180,7 @@ def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-d
                    loads=(("right", "x", True, 1.0),), controls=(("elongation", (("right", "x", 1.0),)),))
     identify = bounds and SimpleNamespace(parameters=("beta", "c"), lower=(100.0, bounds[0]), upper=(900.0, bounds[1]))
     try:
-        check_mesh_units(_Checker(tmp_path / "cfg.toml"), ModelConfig(model, (("c", c),)),
+        check_mesh_units(Checker(tmp_path / "cfg.toml"), ModelConfig(model, (("c", c),)),
                          SpecimenConfig("mesh", "elongation", tuple(options.items())), identify)
     except ConfigError as err:
         return str(err)

@@ -122,7 +122,8 @@ class FailingBar(LinearCohesiveBar):
 
 
 def test_model_comparison_records_a_failed_fit_and_keeps_the_others():
-    from fracid.inverse.studies.cross_model import Candidate, compare_models
+    from fracid.inverse.studies.cross_model import compare_models
+    from fracid.inverse.studies.model_fit import Candidate
 
     op = ForwardOperator([Observation(Bar(), POINTS)], SofteningBarParameters(), ("ft", "Gf"), model=LinearCohesiveBar())
     data = synthetic_data(op, [3.0, 0.05], {"global:relative": 0.01}, seed=None)

@@ -13,12 +13,11 @@ import _batch_tasks as bt
 import numpy as np
 import pytest
 
+from fracid.batch import BatchStats, run_batch
 from fracid.parallel import (
     THREAD_VARIABLES,
-    BatchStats,
     SerialExecutor,
     make_executor,
-    run_batch,
 )
 from fracid.store import RunStore
 

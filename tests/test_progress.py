@@ -38,7 +38,7 @@ def test_no_lines_unless_asked_for_or_on_a_terminal(monkeypatch):
     assert not progress.lines_wanted(None)  # outside progress_lines: a library call stays silent
     with progress.progress_lines():
         assert progress.lines_wanted(None) and not progress.lines_wanted(False)
-        monkeypatch.setattr(progress, "_is_terminal", lambda: True)
+        monkeypatch.setattr(progress, "is_terminal", lambda: True)
         assert not progress.lines_wanted(None)  # a terminal has its bars
     with progress.progress_lines(False):
         assert not progress.lines_wanted(None)

@@ -8,14 +8,8 @@ import pytest
 from scipy.optimize import curve_fit
 
 import fracid
-from fracid.inverse.studies.size_effect import (
-    SizeEffectFit,
-    bazant_law,
-    fit_size_effect,
-    nominal_strength,
-    size_effect_series,
-    specimen_size,
-)
+from fracid.inverse.studies.size_effect import nominal_strength, size_effect_series, specimen_size
+from fracid.inverse.studies.size_effect_law import SizeEffectFit, bazant_law, fit_size_effect
 from fracid.fem.path.path_following import ConvergenceError, PathResult
 from fracid.parallel import make_executor
 from fracid.report.figures import size_effect_figure, to_png

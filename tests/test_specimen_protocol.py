@@ -13,7 +13,7 @@ import pytest
 
 from fracid import cli
 from fracid.config import ConfigError, load_config
-from fracid.config.sections import _specimen_error_key
+from fracid.config.sections import specimen_error_key
 from fracid.fem.material.laws import HordijkLaw
 from fracid.fem.path.path_following import StepOptions
 from fracid.field_error import FieldError
@@ -152,10 +152,10 @@ def test_the_tension_strip_is_configured_like_the_others(tmp_path):
 def test_a_field_error_is_classified_by_its_names_not_its_message():
     err = FieldError(("notch_depth", "depth"), 60.0, "a message that names no field at all")
     fields = {"depth": None, "notch_depth": None}
-    assert _specimen_error_key(err, fields, {"depth": 40.0}) == "depth"  # the one given first
-    assert _specimen_error_key(err, fields, {}) == "notch_depth"
+    assert specimen_error_key(err, fields, {"depth": 40.0}) == "depth"  # the one given first
+    assert specimen_error_key(err, fields, {}) == "notch_depth"
     # another package's ValueError: the field names in its message, as a fallback
-    assert _specimen_error_key(ValueError("depth = 3 is too small"), fields, {}) == "depth"
+    assert specimen_error_key(ValueError("depth = 3 is too small"), fields, {}) == "depth"
     with pytest.raises(FieldError) as info:
         NotchedBeam(notch_depth=60.0)
     assert info.value.names == ("notch_depth", "depth") and info.value.value == 60.0

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.store import RunStore, decode_record, encode_record, key_for
+from fracid.store import RunStore, key_for
+from fracid.store_records import decode_record, encode_record
 
 SRC = str(Path(fracid.__file__).resolve().parents[1])
 

@@ -17,7 +17,7 @@ def check_specimen(specimen, model=None) -> None:
     specimen types of a configuration and their classes), a class, None or a number; for the built-in
     models (``model`` of :mod:`fracid.models`), one with ``describe`` or a description (``node_sets``).
     Another model may take other specimen objects."""
-    from fracid.models import _PathFollowing
+    from fracid.models import PathFollowingModel
 
     if isinstance(specimen, str):
         raise TypeError(f"specimen = {specimen!r} is a name; give a specimen object, e.g. fracid.BarWithWeakZone() "
@@ -25,7 +25,8 @@ def check_specimen(specimen, model=None) -> None:
     if isinstance(specimen, type):
         raise TypeError(f"specimen is the class {specimen.__name__}; give an instance, e.g. {specimen.__name__}()")
     described = hasattr(specimen, "describe") or hasattr(specimen, "node_sets")
-    if specimen is None or isinstance(specimen, (int, float)) or (isinstance(model, _PathFollowing) and not described):
+    if (specimen is None or isinstance(specimen, (int, float))
+            or (isinstance(model, PathFollowingModel) and not described)):
         raise TypeError(f"specimen is a {type(specimen).__name__}; give a specimen object, e.g. "
                         f"fracid.BarWithWeakZone() (the specimen classes: {_specimen_names()})")
 
@@ -39,6 +40,41 @@ def check_parameters(model, params) -> None:
     hint = f"{cls.__name__}(**params)" if isinstance(params, dict) else f"{cls.__name__}(c=2.0)"
     raise TypeError(f"params is a {type(params).__name__}; the model {model.key!r} takes a {cls.__name__} "
                     f"(e.g. {hint}; its parameters: {', '.join(cls.names())})")
+
+
+def model_with_regularization(model=None, regularization: str | None = None, *, restated: bool = False):
+    """The forward model of ``model=`` and of the shorthand ``regularization=`` (``DamageModel(regularization)``).
+
+    Parameters
+    ----------
+    model : forward model, optional
+        A model of :mod:`fracid.models`; if None, ``DamageModel(regularization or "gradient")``.
+    regularization : {"gradient", "local", "integral"}, optional
+        Not with ``model``, unless ``restated``.
+    restated : bool
+        Accept a ``regularization`` equal to the model's own (an object that records its model's
+        regularization is rebuilt from both, e.g. by :func:`dataclasses.replace`).
+
+    Returns
+    -------
+    forward model
+
+    Raises
+    ------
+    ValueError
+        Both given (with ``restated``: a ``regularization`` other than the model's).
+    """
+    from fracid.models import DamageModel, declared
+
+    if model is None:
+        return DamageModel(regularization or "gradient")
+    if regularization is None:
+        return model
+    if not restated:
+        raise ValueError("give either model= or regularization=, not both")
+    if regularization != declared(model).regularization:
+        raise ValueError(f"regularization = {regularization!r} contradicts the model {model.key!r}; give one of them")
+    return model
 
 
 def simulate(specimen, params, *, model=None, regularization: str | None = None, **options) -> PathResult:
@@ -68,12 +104,7 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
         Before the run: ``specimen`` is not a specimen object (e.g. its name), ``params`` not the
         model's parameter class.
     """
-    from fracid.models import DamageModel
-
-    if model is None:
-        model = DamageModel(regularization or "gradient")
-    elif regularization is not None:
-        raise ValueError("give either model= or regularization=, not both")
+    model = model_with_regularization(model, regularization)
     check_specimen(specimen, model)
     check_parameters(model, params)
     return model.simulate(specimen, params, **options)

@@ -73,7 +73,7 @@ def select_observers(observers: dict, names=None) -> dict:
     return {name: fn for name, fn in observers.items() if name in set(names)}
 
 
-class _PathFollowing(ModelDefaults):
+class PathFollowingModel(ModelDefaults):
     """``simulate`` of the models below: build the problem, follow the path with the specimen's
     default control, target and steps."""
 
@@ -99,7 +99,7 @@ class _PathFollowing(ModelDefaults):
 
 
 @dataclass(frozen=True)
-class DamageModel(_PathFollowing):
+class DamageModel(PathFollowingModel):
     """Continuum damage: ``"gradient"`` (implicit gradient enhancement), ``"local"`` (no
     regularisation; mesh-dependent, for comparison) or ``"integral"`` (Gaussian average of the
     equivalent strain, internal length l = sqrt(2 c)), with a damage law (exponential softening and
@@ -157,7 +157,7 @@ class DamageModel(_PathFollowing):
                                                                                              names))}
 
 
-class _CrackModel(_PathFollowing):
+class _CrackModel(PathFollowingModel):
     """The models of one crack with a traction-separation law (:class:`~fracid.fem.material.tsl.TractionSeparationLaw`,
     Hordijk's by default): plane stress, where the specimen says the crack runs."""
 
@@ -218,7 +218,7 @@ class CohesiveCrackModel(_CrackModel):
                                     stiffness_factor=at_points(d.stiffness_factor, disc))
 
     def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
-        return {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.kappa)}
+        return {"crack_length": lambda problem, q, arrays: problem.cracked_length(arrays.history)}
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ _write_lock = threading.Lock()
 @contextlib.contextmanager
 def progress_lines(enabled: bool = True):
     """Within: progress left to the default (``enabled=None`` of :func:`progress_bar`, ``progress=None``
-    of :func:`fracid.parallel.run_batch`) prints lines when stderr is not a terminal."""
+    of :func:`fracid.batch.run_batch`) prints lines when stderr is not a terminal."""
     before, _state["lines"] = _state["lines"], bool(enabled)
     try:
         yield
@@ -33,7 +33,8 @@ def progress_lines(enabled: bool = True):
         _state["lines"] = before
 
 
-def _is_terminal() -> bool:
+def is_terminal() -> bool:
+    """Whether stderr is a terminal (False when it cannot tell: closed, None, or without ``isatty``)."""
     try:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):
@@ -42,7 +43,7 @@ def _is_terminal() -> bool:
 
 def lines_wanted(enabled) -> bool:
     """Whether progress asked for with ``enabled`` (None: the default) is to be printed as lines."""
-    return enabled is None and _state["lines"] and not _is_terminal()
+    return enabled is None and _state["lines"] and not is_terminal()
 
 
 def line_interval() -> float:
@@ -143,12 +144,12 @@ def progress_bar(total: float, description: str, enabled: bool | None = None, un
     from tqdm import tqdm
 
     if enabled is None:
-        enabled = _is_terminal()
+        enabled = is_terminal()
     return tqdm(total=total, desc=description, unit=unit, disable=not enabled, leave=False, dynamic_ncols=True)
 
 
 def batch_lines(description: str = "forward runs", failed=None):
-    """A ``progress(done, total)`` callable for :func:`fracid.parallel.run_batch` printing lines; it
+    """A ``progress(done, total)`` callable for :func:`fracid.batch.run_batch` printing lines; it
     closes (its last line) when ``done`` reaches ``total``."""
     line = None
 
@@ -166,7 +167,7 @@ def batch_lines(description: str = "forward runs", failed=None):
 
 
 def batch_progress(bar):
-    """Adapter for :func:`fracid.parallel.run_batch`'s ``progress(done, total)`` callable."""
+    """Adapter for :func:`fracid.batch.run_batch`'s ``progress(done, total)`` callable."""
 
     def report(done, total):
         bar.total = total

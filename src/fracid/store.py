@@ -2,10 +2,10 @@
 
 A run is identified by a key, the SHA-256 of a canonical JSON of everything that determines it
 (:func:`key_for`). Its record is a JSON-like dict that may hold numpy arrays, stored losslessly
-(:func:`encode_record`, :func:`decode_record`).
+(:func:`fracid.store_records.encode_record`, :func:`fracid.store_records.decode_record`).
 
 Concurrency: any number of processes may read a store, but only one process should write it. In a
-batch (:func:`fracid.parallel.run_batch`) the workers compute and return records; the parent process
+batch (:func:`fracid.batch.run_batch`) the workers compute and return records; the parent process
 alone writes them. A :class:`RunStore` cannot be sent to another process.
 
 Durability: every :meth:`RunStore.put` is its own transaction. SQLite in WAL mode guarantees that a
@@ -16,7 +16,6 @@ but never corrupts the file.
 
 from __future__ import annotations
 
-import base64
 import dataclasses
 import hashlib
 import json
@@ -31,9 +30,10 @@ from typing import Self
 
 import numpy as np
 
-__all__ = ["NotARunStore", "RunStore", "UndecodableRecord", "decode_record", "encode_record", "key_for"]
+from fracid.store_records import decode_record, encode_record, require_str_key
 
-_ARRAY_TAG = "__ndarray__"
+__all__ = ["NotARunStore", "RunStore", "UndecodableRecord", "key_for"]
+
 _SIGNIFICANT_DIGITS = 12
 _EXACT_INT_LIMIT = 10**_SIGNIFICANT_DIGITS
 _SQL_VARIABLES_PER_QUERY = 500
@@ -109,7 +109,7 @@ def _canonical(value, where: str):
     if isinstance(value, np.ndarray):
         return _canonical(value.tolist(), where)
     if isinstance(value, Mapping):
-        return {_str_key(k, where): _canonical(v, f"{where}[{k!r}]") for k, v in value.items()}
+        return {require_str_key(k, where): _canonical(v, f"{where}[{k!r}]") for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_canonical(v, f"{where}[{i}]") for i, v in enumerate(value)]
     if isinstance(value, (set, frozenset)):
@@ -138,102 +138,6 @@ def _round(x: float) -> float:
     if not math.isfinite(x):
         return x
     return float(f"{x:.{_SIGNIFICANT_DIGITS}g}") + 0.0
-
-
-def _str_key(key, where: str) -> str:
-    if not isinstance(key, str):
-        raise TypeError(f"{where}: dict keys must be str, got {key!r} ({type(key).__name__})")
-    return key
-
-
-# ----------------------------------------------------------------------------------------------
-# records
-
-
-def encode_record(record: Mapping) -> bytes:
-    """Serialise a record (a dict of JSON types and numpy arrays) to UTF-8 JSON bytes.
-
-    Arrays are stored bit for bit as ``{"__ndarray__": base64 of the C-order bytes, "dtype": ...,
-    "shape": [...]}``; any dtype but ``object`` is allowed. Numpy scalars become Python numbers,
-    tuples become lists. NaN and infinities are kept.
-
-    Raises
-    ------
-    TypeError
-        If ``record`` is not a dict or holds a value that is not storable (the message names it).
-    ValueError
-        If a dict uses the reserved key ``"__ndarray__"``.
-    """
-    if not isinstance(record, Mapping):
-        raise TypeError(f"a record must be a dict, got {type(record).__name__}")
-    plain = _to_json(record, "record")
-    return json.dumps(plain, separators=(",", ":"), allow_nan=True).encode("utf-8")
-
-
-def decode_record(blob: bytes | bytearray | memoryview | str) -> dict:
-    """Inverse of :func:`encode_record`: arrays come back with their dtype, shape and bytes."""
-    if isinstance(blob, (bytearray, memoryview)):
-        blob = bytes(blob)
-    return json.loads(blob, object_hook=_from_json)
-
-
-def _to_json(value, where: str):
-    """``value`` as JSON types, arrays as tagged dicts; errors name the offending entry."""
-    if value is None or isinstance(value, (bool, str)):
-        return value
-    if isinstance(value, np.generic) and not isinstance(value, np.void):
-        value = value.item()
-        if isinstance(value, (bool, int, float, str)):
-            return value
-    if isinstance(value, (int, float)):
-        return value
-    if isinstance(value, np.ndarray):
-        return _encode_array(value, where)
-    if isinstance(value, Mapping):
-        return _encode_mapping(value, where)
-    if isinstance(value, (list, tuple)):
-        return [_to_json(v, f"{where}[{i}]") for i, v in enumerate(value)]
-    raise TypeError(
-        f"{where} = {value!r} (type {type(value).__name__}) cannot be stored; "
-        "records hold None, bool, int, float, str, lists, dicts with str keys and numpy arrays"
-    )
-
-
-def _encode_mapping(value: Mapping, where: str) -> dict:
-    if _ARRAY_TAG in value:
-        raise ValueError(f"{where}: the key {_ARRAY_TAG!r} is reserved for arrays")
-    return {_str_key(k, where): _to_json(v, f"{where}[{k!r}]") for k, v in value.items()}
-
-
-def _encode_array(array: np.ndarray, where: str) -> dict:
-    if array.dtype.hasobject:
-        raise TypeError(f"{where}: arrays of dtype {array.dtype} cannot be stored (convert to lists)")
-    data = np.ascontiguousarray(array).tobytes()
-    return {
-        _ARRAY_TAG: base64.b64encode(data).decode("ascii"),
-        "dtype": np.lib.format.dtype_to_descr(array.dtype),
-        "shape": list(array.shape),
-    }
-
-
-def _from_json(obj: dict):
-    if _ARRAY_TAG not in obj:
-        return obj
-    descr = obj["dtype"]
-    dtype = np.lib.format.descr_to_dtype(_as_descr(descr))
-    raw = base64.b64decode(obj[_ARRAY_TAG])
-    return np.frombuffer(raw, dtype=dtype).reshape(obj["shape"]).copy()
-
-
-def _as_descr(descr):
-    """JSON turned the tuples of a structured dtype's descr into lists; turn them back."""
-    if not isinstance(descr, list):
-        return descr
-    fields = []
-    for name, kind, *shape in descr:
-        name = tuple(name) if isinstance(name, list) else name  # (title, name)
-        fields.append((name, _as_descr(kind), *(tuple(s) for s in shape)))
-    return fields
 
 
 # ----------------------------------------------------------------------------------------------

@@ -22,10 +22,10 @@ unknowns of a 2D mesh counted from the geometry).
 Warnings: valid settings that are probably not meant (``relative_std`` above 1, process-zone
 elements larger than the internal length l = sqrt(2 c)) are returned in ``Config.warnings``.
 
-The package's modules, each importing only those listed before it: :mod:`~fracid.config.registry`
-(the model and specimen types), :mod:`~fracid.config.schema` (the schema and the validated
-dataclasses), :mod:`~fracid.config.checker` (TOML reading and value checks),
-:mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments`,
+The package's modules, each importing only those listed before it: :mod:`~fracid.config.vocabulary`
+(the keys and values of each section), :mod:`~fracid.config.registry` (the model and specimen types),
+:mod:`~fracid.config.schema` (the schema and the validated dataclasses), :mod:`~fracid.config.checker`
+(TOML reading and value checks), :mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments`,
 :mod:`~fracid.config.identify` and :mod:`~fracid.config.posterior` (one validator per section),
 :mod:`~fracid.config.loading` (:func:`load_config`) and :mod:`~fracid.config.builders`.
 
@@ -57,8 +57,6 @@ from fracid.config.builders import (
     study_settings,
 )
 from fracid.config.loading import load_config
-# private, imported from here by the tests (kept for them)
-from fracid.config.registry import _SPECIMENS, _specimen_class  # noqa: F401
 from fracid.config.schema import (
     BAR_BYTES_PER_ELEMENT,
     BYTES_PER_UNKNOWN,

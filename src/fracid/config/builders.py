@@ -6,11 +6,10 @@ from __future__ import annotations
 
 import contextlib
 
-
 import numpy as np
 
-from fracid.config.checker import _show
-from fracid.config.registry import _model_of, _specimen_class
+from fracid.config.checker import show
+from fracid.config.registry import model_of, model_parameters, specimen_class
 from fracid.config.schema import Config, ConfigError, ExperimentConfig
 
 
@@ -24,14 +23,14 @@ def _require(cfg: Config, section: str):
 
 def build_model(cfg: Config):
     """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
-    return _model_of(cfg.model.type)
+    return model_of(cfg.model.type)
 
 
 def build_parameters(cfg: Config):
     """The model parameters, an instance of the model's parameter class (``DamageParameters`` for
     the damage models, ``CohesiveParameters`` for the cohesive crack): those given in
     ``[model.parameters]``, the rest the class's defaults."""
-    return build_model(cfg).parameters(**dict(cfg.model.parameters))
+    return model_parameters(cfg.model)
 
 
 def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
@@ -41,7 +40,7 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
     options = dict(cfg.specimen.options)
     if experiment is not None:
         options.update(dict(experiment.specimen))
-    return _specimen_class(cfg.specimen.type)(**options)
+    return specimen_class(cfg.specimen.type)(**options)
 
 
 def _experiment_data(cfg: Config, exp: ExperimentConfig):
@@ -184,7 +183,7 @@ def _operator(cfg: Config, experiments, data):
                                             damage_threshold=exp.damage_threshold))
         except ValueError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
-                              f"{_show(exp.control_range and list(exp.control_range))}: {err}") from None
+                              f"{show(exp.control_range and list(exp.control_range))}: {err}") from None
     return ForwardOperator(observations, build_parameters(cfg), identify.parameters, model=build_model(cfg))
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 from fracid.config.schema import ConfigError
 
 
-def _bytes(n: float) -> str:
+def bytes_text(n: float) -> str:
     """A memory size in words: ``18.6 GiB``, ``195 MiB``, ``12 KiB``."""
     for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
         if n >= size:
@@ -20,7 +20,7 @@ def _bytes(n: float) -> str:
     return f"{n:.0f} bytes"
 
 
-def _show(value) -> str:
+def show(value) -> str:
     if isinstance(value, dict):
         text = "a table {" + ", ".join(value) + "}"
     else:
@@ -28,7 +28,7 @@ def _show(value) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-class _Checker:
+class Checker:
     """Raises ConfigError messages naming the file, the dotted key, the value and what is allowed."""
 
     def __init__(self, path: Path):
@@ -36,7 +36,7 @@ class _Checker:
         self.warnings: list[str] = []
 
     def fail(self, key: str, value, allowed: str):
-        raise ConfigError(f"{self.path}: {key} = {_show(value)}: {allowed}")
+        raise ConfigError(f"{self.path}: {key} = {show(value)}: {allowed}")
 
     def warn(self, text: str) -> None:
         """Record a warning (a valid value that is probably not what was meant), once."""
@@ -123,7 +123,7 @@ MAX_CONFIG_BYTES = 1 << 20
 STDIN = "-"
 
 
-def _read_toml(path: Path, stdin=None) -> dict:
+def read_toml(path: Path, stdin=None) -> dict:
     """The TOML table of ``path`` (``stdin``: the bytes read from standard input instead); a path that is
     not a regular file (a FIFO, a device, a directory), a file too large to be a configuration, text that
     is not UTF-8 or not TOML, each raise a ConfigError naming the file."""

@@ -7,16 +7,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from fracid.config.checker import _bytes, _Checker
-from fracid.config.registry import _model_of
+from fracid.config.checker import Checker, bytes_text
+from fracid.config.registry import model_of
 from fracid.config.schema import (
-    _GAUSS_NEWTON_KEYS,
-    _IDENTIFY_KEYS,
-    _KALMAN_KEYS,
-    _KNN_KEYS,
-    _METHODS,
-    _RESTARTS,
-    DEFAULT_INVERSE_METHOD,
     MAX_POPULATION,
     GaussNewtonConfig,
     IdentifyConfig,
@@ -24,10 +17,20 @@ from fracid.config.schema import (
     KnnConfig,
     ModelConfig,
 )
-from fracid.config.sections import _range_text, _valid_parameter
+from fracid.config.sections import range_text, valid_parameter
+from fracid.config.vocabulary import (
+    DEFAULT_INVERSE_METHOD,
+    GAUSS_NEWTON_KEYS,
+    IDENTIFY_KEYS,
+    KALMAN_KEYS,
+    KNN_KEYS,
+    KNN_METHODS,
+    RESTARTS,
+    SECTION_METHODS,
+)
 
 
-def _check_plausible(ck: _Checker, key: str, pair, name: str, bounds, units: dict) -> None:
+def _check_plausible(ck: Checker, key: str, pair, name: str, bounds, units: dict) -> None:
     """Refuse a bound of ``name`` far outside its usual range (:func:`fracid.models.implausible`): the
     message names the parameter, the bound and the usual range, before any data are read (a kappa_i
     1000 times too large would otherwise make the data look 1000 times too short)."""
@@ -41,15 +44,15 @@ def _check_plausible(ck: _Checker, key: str, pair, name: str, bounds, units: dic
                                f"~ 1e-4 for concrete, about ft / E; E in MPa, c in mm^2)")
 
 
-def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:
+def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:
     if raw is None:
         if needed:
             ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
         return None
     from fracid.inverse.methods.registry import METHODS
 
-    ck.table("identify", raw, (*_IDENTIFY_KEYS, *(name for name in METHODS if name not in _IDENTIFY_KEYS)))
-    cls = _model_of(model.type).parameters
+    ck.table("identify", raw, (*IDENTIFY_KEYS, *(name for name in METHODS if name not in IDENTIFY_KEYS)))
+    cls = model_of(model.type).parameters
     names = _identified(ck, raw, cls, model)
     inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
     lower, upper, log = _bounds(ck, raw, cls, names)
@@ -63,7 +66,7 @@ def _identify(ck: _Checker, raw, n_y: int | None, needed: bool, model: ModelConf
     return identify
 
 
-def _identified(ck: _Checker, raw, cls, model: ModelConfig) -> tuple:
+def _identified(ck: Checker, raw, cls, model: ModelConfig) -> tuple:
     """``identify.parameters``: a non-empty list of distinct parameters of the model's class."""
     names_all = cls.names()
     if "parameters" not in raw:
@@ -81,7 +84,7 @@ def _identified(ck: _Checker, raw, cls, model: ModelConfig) -> tuple:
     return tuple(value)
 
 
-def _bounds(ck: _Checker, raw, cls, names: tuple) -> tuple[tuple, tuple, tuple]:
+def _bounds(ck: Checker, raw, cls, names: tuple) -> tuple[tuple, tuple, tuple]:
     """``[identify.bounds]``: (lower, upper, log) of the identified parameters."""
     if "bounds" not in raw:
         ck.missing("identify.bounds", "a table with [lower, upper] for " + ", ".join(names))
@@ -105,10 +108,10 @@ def _bounds(ck: _Checker, raw, cls, names: tuple) -> tuple[tuple, tuple, tuple]:
     return tuple(lower), tuple(upper), log
 
 
-def _bound_pair(ck: _Checker, bounds: dict, cls, name: str) -> tuple[float, float]:
+def _bound_pair(ck: Checker, bounds: dict, cls, name: str) -> tuple[float, float]:
     key = f"identify.bounds.{name}"
     unit = cls.units().get(name, "-")
-    allowed = f"must be [lower, upper] with lower < upper, both in the valid range {_range_text(cls, name)} [{unit}]"
+    allowed = f"must be [lower, upper] with lower < upper, both in the valid range {range_text(cls, name)} [{unit}]"
     if name not in bounds:
         ck.missing(key, f"[lower, upper] bounds of the identified parameter {name} [{unit}]")
     pair = bounds[name]
@@ -116,17 +119,17 @@ def _bound_pair(ck: _Checker, bounds: dict, cls, name: str) -> tuple[float, floa
     if not lo < hi:
         ck.fail(key, pair, f"lower = {lo:g} must be below upper = {hi:g} ({allowed})")
     for which, v in (("lower", lo), ("upper", hi)):
-        if not _valid_parameter(cls, name, v):
-            ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {_range_text(cls, name)} [{unit}]")
+        if not valid_parameter(cls, name, v):
+            ck.fail(key, pair, f"the {which} bound {v:g} is outside the valid range {range_text(cls, name)} [{unit}]")
     _check_plausible(ck, key, pair, name, (lo, hi), cls.units())
     return lo, hi
 
 
-def _knn(ck: _Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
+def _knn(ck: Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
     """``[identify.knn]``, with the population limit."""
-    raw_knn = ck.table("identify.knn", raw.get("knn", {}), _KNN_KEYS)
+    raw_knn = ck.table("identify.knn", raw.get("knn", {}), KNN_KEYS)
     n = ck.integer("identify.knn.n", raw_knn.get("n", 64), "must be an integer >= 2", lambda v: v >= 2)
-    method = ck.choice("identify.knn.method", raw_knn.get("method", "sobol"), _METHODS)
+    method = ck.choice("identify.knn.method", raw_knn.get("method", "sobol"), KNN_METHODS)
     seed = ck.integer("identify.knn.seed", raw_knn.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0)
     knn = KnnConfig(n=n, method=method, k=5, seed=seed)
     population = knn.population(len(names))
@@ -136,7 +139,7 @@ def _knn(ck: _Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
         ck.fail("identify.knn.n", n, f"the population of {population:,} points ({how}, method {method!r}) is above the "
                                      f"limit of {MAX_POPULATION:,}: each point is one forward run (seconds to minutes "
                                      f"each), and the points and their outputs alone take {values:,} x 8 bytes = "
-                                     f"{_bytes(8.0 * values)} (p = {len(names)} parameters + n_y = {n_y or 0} outputs "
+                                     f"{bytes_text(8.0 * values)} (p = {len(names)} parameters + n_y = {n_y or 0} outputs "
                                      "per point); a few hundred points are enough to start the Kalman filter")
     k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), raw_knn.get("k", 5),
                    f"must be an integer with 1 <= k <= the population size {population} ({how}, method {method!r})",
@@ -144,9 +147,9 @@ def _knn(ck: _Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
     return dataclasses.replace(knn, k=k)
 
 
-def _kalman(ck: _Checker, raw, n_y: int | None) -> KalmanConfig:
+def _kalman(ck: Checker, raw, n_y: int | None) -> KalmanConfig:
     """``[identify.kalman]``."""
-    raw_kf = ck.table("identify.kalman", raw.get("kalman", {}), _KALMAN_KEYS)
+    raw_kf = ck.table("identify.kalman", raw.get("kalman", {}), KALMAN_KEYS)
     groups = None
     if "groups" in raw_kf:
         top = n_y if n_y else None
@@ -160,18 +163,17 @@ def _kalman(ck: _Checker, raw, n_y: int | None) -> KalmanConfig:
                                   "must be an integer >= 1", lambda v: v >= 1),
         tol=ck.number("identify.kalman.tol", raw_kf.get("tol", 0.01), "must be a number > 0 [standard deviations]",
                       lambda v: v > 0),
-        restart=ck.choice("identify.kalman.restart", raw_kf.get("restart", "linearize"), _RESTARTS),
+        restart=ck.choice("identify.kalman.restart", raw_kf.get("restart", "linearize"), RESTARTS),
         max_starts=ck.integer("identify.kalman.max_starts", raw_kf.get("max_starts", 3),
                               "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1),
     )
 
 
-def _gauss_newton(ck: _Checker, raw, inverse: str) -> GaussNewtonConfig:
+def _gauss_newton(ck: Checker, raw, inverse: str) -> GaussNewtonConfig:
     """``[identify.gauss-newton]``."""
-    raw_gn = ck.table("identify.gauss-newton", raw.get("gauss-newton", {}), _GAUSS_NEWTON_KEYS)
-    if raw_gn and inverse != "knn-gauss-newton":
-        ck.warn(f"[identify.gauss-newton] is given but identify.method = {inverse!r}: its settings are not used "
-                "(set method = \"knn-gauss-newton\" to use them)")
+    raw_gn = ck.table("identify.gauss-newton", raw.get("gauss-newton", {}), GAUSS_NEWTON_KEYS)
+    if raw_gn:
+        _warn_if_unused(ck, "gauss-newton", inverse)
     return GaussNewtonConfig(
         max_iterations=ck.integer("identify.gauss-newton.max_iterations", raw_gn.get("max_iterations", 20),
                                   "must be an integer >= 1 (linearisations at most)", lambda v: v >= 1),
@@ -180,7 +182,7 @@ def _gauss_newton(ck: _Checker, raw, inverse: str) -> GaussNewtonConfig:
     )
 
 
-def _method_tables(ck: _Checker, raw, inverse: str) -> dict:
+def _method_tables(ck: Checker, raw, inverse: str) -> dict:
     """The registered methods' own tables ``[identify.<name>]``, as read (the method's ``from_config``
     checks its own); a warning for one of a method not chosen."""
     from fracid.inverse.methods.registry import METHODS
@@ -190,10 +192,18 @@ def _method_tables(ck: _Checker, raw, inverse: str) -> dict:
         if not isinstance(raw[name], dict):
             ck.fail(f"identify.{name}", raw[name], f"must be a table (section) of the settings of the method {name!r}")
         methods[name] = dict(raw[name])
-        if name != inverse:
-            ck.warn(f"[identify.{name}] is given but identify.method = {inverse!r}: its settings are not used "
-                    f"(set method = \"{name}\" to use them)")
+        _warn_if_unused(ck, name, inverse)
     return methods
+
+
+def _warn_if_unused(ck: Checker, section: str, inverse: str) -> None:
+    """Warn that ``[identify.<section>]`` is given for a method other than the chosen ``inverse``: a built-in
+    section is read by its method of :data:`~fracid.config.vocabulary.SECTION_METHODS`, a registered method's
+    own table by the method of its name."""
+    method = SECTION_METHODS.get(section, section)
+    if method != inverse:
+        ck.warn(f"[identify.{section}] is given but identify.method = {inverse!r}: its settings are not used "
+                f"(set method = \"{method}\" to use them)")
 
 
 def method_from_config(identify: IdentifyConfig, n_y: int | None):

@@ -10,30 +10,29 @@ import os
 import sys
 from pathlib import Path
 
-from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, _Checker, _read_toml
-from fracid.config.experiments import _experiments
-from fracid.config.identify import _identify
+from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, Checker, read_toml
+from fracid.config.experiments import read_experiments
+from fracid.config.identify import read_identify
 from fracid.config.mesh_section import c_range
-from fracid.config.posterior import _posterior
-from fracid.config.registry import _model_of, _section_reader, _specimen_class
+from fracid.config.posterior import read_posterior
+from fracid.config.registry import section_reader, specimen_class
 from fracid.config.schema import (
-    _PURPOSES,
-    _TOP_KEYS,
     Config,
     ConfigError,
     ModelConfig,
     SpecimenConfig,
 )
 from fracid.config.sections import (
-    _check_model_runs_on,
-    _field_key,
-    _model,
-    _output,
-    _simulate,
-    _specimen,
-    _study,
-    _value_text,
+    check_model_runs_on,
+    field_key,
+    read_model,
+    read_output,
+    read_simulate,
+    read_specimen,
+    read_study,
+    value_text,
 )
+from fracid.config.vocabulary import PURPOSES, TOP_KEYS
 
 
 def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config:
@@ -57,25 +56,25 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     ConfigError
         For any invalid, missing or unknown key, naming the file, the key, the value and what is allowed.
     """
-    if purpose not in _PURPOSES:
+    if purpose not in PURPOSES:
         raise ValueError(f"purpose = {purpose!r}; choose 'identify' or 'simulate'")
     path, stdin = _config_path(path)
-    ck = _Checker(path)
-    raw = ck.table("", _read_toml(path, stdin), _TOP_KEYS)
+    ck = Checker(path)
+    raw = ck.table("", read_toml(path, stdin), TOP_KEYS)
     base = path.parent
-    model = _model(ck, raw.get("model"))
-    specimen = _specimen(ck, raw.get("specimen"), base)
-    _check_model_runs_on(ck, model, specimen)
-    experiments = _experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
+    model = read_model(ck, raw.get("model"))
+    specimen = read_specimen(ck, raw.get("specimen"), base)
+    check_model_runs_on(ck, model, specimen)
+    experiments = read_experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
     n_y = sum(e.n_points for e in experiments if e.role == "calibration") or None
     if experiments and not n_y and purpose == "identify":
         ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
-    identify = _identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
-    output = _output(ck, raw.get("output"), base)
-    simulate = _simulate(ck, raw.get("simulate"))
-    study = _study(ck, raw.get("study"))
-    posterior = _posterior(ck, raw.get("posterior"))
-    section = _section_reader(_specimen_class(specimen.type))
+    identify = read_identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
+    output = read_output(ck, raw.get("output"), base)
+    simulate = read_simulate(ck, raw.get("simulate"))
+    study = read_study(ck, raw.get("study"))
+    posterior = read_posterior(ck, raw.get("posterior"))
+    section = section_reader(specimen_class(specimen.type))
     if section is not None:  # the checks of a specimen's own section (a mesh's units against l)
         section.check(ck, model, specimen, identify)
     _mesh_warnings(ck, model, specimen, experiments, identify)
@@ -98,7 +97,7 @@ def _config_path(path) -> tuple[Path, bytes | None]:
         raise ConfigError(f"{text}: cannot be resolved ({err}): a symbolic link that points to itself?") from None
 
 
-def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:
+def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:
     """Warn when the element size in the process zone exceeds the internal length l = sqrt(2 c) of a
     gradient or integral damage model (the smallest c: the given one, or the lower bound when c is
     identified): the damage band, a few l wide, is then not resolved and the results depend on the mesh.
@@ -114,7 +113,7 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
     variants = [("specimen", dict(specimen.options), dict(specimen.options))]
     variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))
                  for e in experiments if e.specimen]
-    cls = _specimen_class(specimen.type)
+    cls = specimen_class(specimen.type)
     fields = {f.name for f in dataclasses.fields(cls)}
     for prefix, options, given in variants:
         resolution = cls(**options).resolution(length)
@@ -122,12 +121,7 @@ def _mesh_warnings(ck: _Checker, model: ModelConfig, specimen: SpecimenConfig, e
             continue
         size = f"specimen ({specimen.type}): {resolution.text}"
         if resolution.field is not None:
-            key, default = _field_key(prefix, resolution.field, options, given)
-            size = f"{key} = {_value_text(resolution.value)}{default if resolution.field in fields else ''}: {resolution.text}"
+            key, default = field_key(prefix, resolution.field, options, given)
+            size = f"{key} = {value_text(resolution.value)}{default if resolution.field in fields else ''}: {resolution.text}"
         ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
                 f"the damage band is not resolved and the results depend on the mesh; {resolution.advice}")
-
-
-def _model_parameters(model: ModelConfig):
-    """The parameters of a validated ``[model]`` section (those given, the rest the class's defaults)."""
-    return _model_of(model.type).parameters(**dict(model.parameters))

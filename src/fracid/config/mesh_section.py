@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from fracid.config import schema
-from fracid.config.checker import ConfigError, _bytes, _Checker
-from fracid.config.registry import SpecimenSection
+from fracid.config.checker import Checker, ConfigError, bytes_text
+from fracid.config.registry import SpecimenSection, model_parameters
 from fracid.config.schema import SpecimenConfig
 
 _KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
@@ -41,7 +41,7 @@ _COARSEST = 100.0
 _METRES = 5.0
 
 
-def mesh_specimen(ck: _Checker, raw: dict, base: Path, kind: str = "mesh") -> SpecimenConfig:
+def mesh_specimen(ck: Checker, raw: dict, base: Path, kind: str = "mesh") -> SpecimenConfig:
     """The validated ``[specimen]`` of a mesh (registered as ``kind``): the file is read and every group
     named is checked."""
     ck.table("specimen", raw, _KEYS)
@@ -161,13 +161,13 @@ def _regions(ck, value) -> tuple:
     return tuple(out)
 
 
-def _check_mesh(ck: _Checker, options: dict) -> None:
+def _check_mesh(ck: Checker, options: dict) -> None:
     """Count the mesh's unknowns, then read the mesh and describe the specimen once: a bad mesh, one too
     large or a group it lacks is a config error."""
     from fracid.specimens.mesh import MeshSpecimen
 
     try:
-        _check_mesh_size(options["path"])
+        check_mesh_size(options["path"])
         MeshSpecimen(**options).describe()
     except ImportError as err:
         raise ConfigError(f"{ck.path}: specimen.file: {err}") from None
@@ -176,7 +176,7 @@ def _check_mesh(ck: _Checker, options: dict) -> None:
         raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {text}") from None
 
 
-def _check_mesh_size(path: str) -> None:
+def check_mesh_size(path: str) -> None:
     """Raise MeshError, before the mesh is built, when its unknowns exceed :data:`MAX_UNKNOWNS` (the limit
     of the built-in specimens' meshes)."""
     from fracid.specimens.mesh import MeshError, mesh_size, mesh_unknowns
@@ -186,13 +186,13 @@ def _check_mesh_size(path: str) -> None:
     if unknowns > schema.MAX_UNKNOWNS:
         raise MeshError(
             f"{path}: {n_cells:,} elements and {n_vertices:,} corner nodes make about {unknowns:,} unknowns once "
-            f"fracid adds the mid-edge nodes, needing about {_bytes(unknowns * schema.BYTES_PER_UNKNOWN)} of memory "
+            f"fracid adds the mid-edge nodes, needing about {bytes_text(unknowns * schema.BYTES_PER_UNKNOWN)} of memory "
             f"in a forward run ({schema.BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most "
             f"{schema.MAX_UNKNOWNS:,} unknowns are allowed: use a coarser mesh (small elements only where the crack "
             "runs; a few elements per internal length l = sqrt(2 c) are enough)")
 
 
-def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) -> None:
+def check_mesh_units(ck: Checker, model, specimen: SpecimenConfig, identify) -> None:
     """Refuse a mesh whose size is implausible against the internal length l = sqrt(2 c) of a gradient or
     integral damage model, a sign of a unit mistake (a mesh drawn in metres without ``scale = 1000``, or in
     micrometres): l larger than the whole mesh for the smallest c considered, or the smallest element side
@@ -201,7 +201,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
 
     Parameters
     ----------
-    ck : _Checker
+    ck : Checker
         The configuration's checker (its path starts the message).
     model : ModelConfig
         The validated ``[model]``.
@@ -244,9 +244,7 @@ def check_mesh_units(ck: _Checker, model, specimen: SpecimenConfig, identify) ->
 
 def c_range(model, identify) -> tuple:
     """((smallest c, where), (largest c, where)) [mm^2] of the model's c and the bounds of an identified c."""
-    from fracid.config.loading import _model_parameters
-
-    c = _model_parameters(model).c
+    c = model_parameters(model).c
     values = [(c, f"c = {c:g} mm^2" + ("" if "c" in dict(model.parameters) else " (default)"))]
     if identify is not None and "c" in identify.parameters:
         i = identify.parameters.index("c")

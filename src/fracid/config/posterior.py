@@ -3,13 +3,14 @@
 
 from __future__ import annotations
 
-from fracid.config.checker import _Checker
-from fracid.config.schema import _POSTERIOR_KEYS, PosteriorConfig
+from fracid.config.checker import Checker
+from fracid.config.schema import PosteriorConfig
+from fracid.config.vocabulary import POSTERIOR_KEYS
 from fracid.inverse.sampling.posterior import MIN_ESS, ess_floor
 
 
-def _posterior(ck: _Checker, raw) -> PosteriorConfig:
-    raw = ck.table("posterior", {} if raw is None else raw, _POSTERIOR_KEYS)
+def read_posterior(ck: Checker, raw) -> PosteriorConfig:
+    raw = ck.table("posterior", {} if raw is None else raw, POSTERIOR_KEYS)
     default = PosteriorConfig()
 
     def given(name):
@@ -38,7 +39,7 @@ def _posterior(ck: _Checker, raw) -> PosteriorConfig:
     return config
 
 
-def _warn_floor(ck: _Checker, config: PosteriorConfig) -> None:
+def _warn_floor(ck: Checker, config: PosteriorConfig) -> None:
     """Warn of settings that cannot give an effective sample size at the floor or the target."""
     total = config.samples_per_round * config.max_rounds
     floor = ess_floor(config.target_ess)

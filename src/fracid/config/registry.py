@@ -33,25 +33,32 @@ class SpecimenSection:
     check: Callable
 
 
-def _model_types() -> tuple:
+def model_types() -> tuple:
     """The ``[model] type`` names: those of :data:`fracid.models.MODEL_TYPES` at the time of the call."""
     from fracid.models import MODEL_TYPES
 
     return tuple(MODEL_TYPES)
 
 
-def _model_of(kind: str):
+def model_of(kind: str):
+    """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
     from fracid.models import model_from_type
 
     return model_from_type(kind)
 
 
-def _specimen_types() -> tuple:
+def model_parameters(model):
+    """The parameters of a validated ``[model]`` (a :class:`~fracid.config.schema.ModelConfig`): those given,
+    the rest the class's defaults."""
+    return model_of(model.type).parameters(**dict(model.parameters))
+
+
+def specimen_types() -> tuple:
     """The ``[specimen] type`` names: those of :data:`fracid.specimens.SPECIMENS` at the time of the call."""
     return tuple(SPECIMENS)
 
 
-def _specimen_class(kind: str):
+def specimen_class(kind: str):
     """The specimen class registered as ``kind`` in :data:`fracid.specimens.SPECIMENS`."""
     try:
         return SPECIMENS[kind]
@@ -59,7 +66,7 @@ def _specimen_class(kind: str):
         raise ValueError(f"specimen type = {kind!r}; choose one of {', '.join(map(repr, SPECIMENS))}") from None
 
 
-def _section_reader(cls) -> SpecimenSection | None:
+def section_reader(cls) -> SpecimenSection | None:
     """The :class:`SpecimenSection` of a specimen class that declares one (its ``config_section``,
     ``"module:name"``), or None when its dataclass fields are the section's keys."""
     where = cls.config_section
@@ -71,10 +78,10 @@ def _section_reader(cls) -> SpecimenSection | None:
 
 def _build(specimen):
     """The specimen object of a validated ``[specimen]`` (a :class:`~fracid.config.schema.SpecimenConfig`)."""
-    return _specimen_class(specimen.type)(**dict(specimen.options))
+    return specimen_class(specimen.type)(**dict(specimen.options))
 
 
-def _specimen_observables(specimen) -> tuple:
+def specimen_observables(specimen) -> tuple:
     """The local observables of a validated ``[specimen]``, asked of the specimen (a mesh's depend on its crack line)."""
     return tuple(_build(specimen).observables)
 
@@ -82,5 +89,5 @@ def _specimen_observables(specimen) -> tuple:
 #: specimen type -> (control names, the first the default; local observables [mm]) of the default instances
 #: registered at import (not the mesh, which has none); the configuration asks the specimen itself, this map
 #: is kept for the tests that import it
-_SPECIMENS = {kind: (tuple(instance.control_names), tuple(instance.observables)) for kind, cls in SPECIMENS.items()
+SPECIMEN_DEFAULTS = {kind: (tuple(instance.control_names), tuple(instance.observables)) for kind, cls in SPECIMENS.items()
               if (instance := cls.default_instance()) is not None}

@@ -5,7 +5,8 @@ Schema
 ------
 The sections ``[[experiments]]`` and ``[identify]`` are required for identification
 (``purpose="identify"``) and optional for a forward analysis (``purpose="simulate"``); when
-present they are always validated. Every other key is optional unless marked *required*.
+present they are always validated. Every other key is optional unless marked *required*. The keys and
+values allowed are named in :mod:`fracid.config.vocabulary`.
 
 .. code-block:: toml
 
@@ -154,7 +155,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fracid.config.registry import _model_of
+from fracid.config.registry import model_of
+from fracid.config.vocabulary import CONTROL_UNITS, DEFAULT_INVERSE_METHOD, FORCE_UNITS, LOCAL_UNITS
 from fracid.inverse.sampling.posterior import PosteriorSettings
 from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
     BAR_BYTES_PER_ELEMENT,
@@ -166,43 +168,6 @@ from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits o
 
 class ConfigError(ValueError):
     """An invalid configuration: the message names the file, the dotted key, the value and what is allowed."""
-
-
-# ------------------------------------------------------------------------------------ vocabularies
-
-_CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
-#: ``delimiter`` values -> the cell separator ("tab" spells a tab; " " is any run of whitespace)
-_DELIMITERS = {",": ",", ";": ";", "\t": "\t", "tab": "\t", " ": " "}
-_DECIMALS = (".", ",")
-_FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
-_LOCAL_UNITS = dict(_CONTROL_UNITS)
-_KINDS = ("repeats", "envelope", "single")
-_METHODS = ("sobol", "lhs", "grid")
-_RESTARTS = ("linearize", "prior-mean")
-_PURPOSES = ("identify", "simulate")
-
-_TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study", "posterior")
-_MODEL_KEYS = ("type", "parameters")
-_EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
-                    "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
-                    "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
-                    "backtrack_tolerance", "negate", "sampling")
-_KIND_KEYS = {
-    "repeats": ("force_columns",),
-    "envelope": ("mean_column", "lower_column", "upper_column"),
-    "single": ("force_columns", "std", "relative_std"),
-}
-_IDENTIFY_KEYS = ("parameters", "method", "bounds", "knn", "kalman", "gauss-newton")
-_KNN_KEYS = ("n", "method", "k", "seed")
-_KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
-_GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
-#: the default of [identify] method (a key of fracid.inverse.methods.registry.METHODS)
-DEFAULT_INVERSE_METHOD = "knn-kalman"
-_OUTPUT_KEYS = ("directory", "vtk_steps")
-_SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
-_STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
-_POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
-_ROLES = ("calibration", "prediction")
 
 
 # ------------------------------------------------------------------------------ size limits
@@ -231,7 +196,7 @@ class ModelConfig:
     def regularization(self) -> str | None:
         """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
         (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
-        return _model_of(self.type).regularization
+        return model_of(self.type).regularization
 
 
 @dataclass(frozen=True)
@@ -280,12 +245,12 @@ class ExperimentConfig:
     @property
     def control_scale(self) -> float:
         """Multiplier from ``control_unit`` to mm."""
-        return _CONTROL_UNITS[self.control_unit]
+        return CONTROL_UNITS[self.control_unit]
 
     @property
     def force_scale(self) -> float:
         """Multiplier from ``force_unit`` to N (force) or to mm (local quantity)."""
-        return (_FORCE_UNITS if self.quantity == "force" else _LOCAL_UNITS)[self.force_unit]
+        return (FORCE_UNITS if self.quantity == "force" else LOCAL_UNITS)[self.force_unit]
 
     @property
     def control_range_mm(self) -> tuple | None:

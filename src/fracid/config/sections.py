@@ -1,7 +1,7 @@
 """Validators of the sections ``[model]``, ``[specimen]``, ``[output]``, ``[simulate]`` and ``[study]``,
 and the specimen field checks the ``specimen`` overrides of ``[[experiments]]`` share.
 
-Each validator takes the :class:`~fracid.config.checker._Checker` of the file and the raw TOML table
+Each validator takes the :class:`~fracid.config.checker.Checker` of the file and the raw TOML table
 and returns the section's frozen dataclass (:mod:`fracid.config.schema`), or raises
 :class:`~fracid.config.schema.ConfigError`.
 """
@@ -12,13 +12,9 @@ import dataclasses
 import re
 from pathlib import Path
 
-from fracid.config.checker import _bytes, _Checker, _show
-from fracid.config.registry import _model_of, _model_types, _section_reader, _specimen_class, _specimen_types
+from fracid.config.checker import Checker, bytes_text, show
+from fracid.config.registry import model_of, model_types, section_reader, specimen_class, specimen_types
 from fracid.config.schema import (
-    _MODEL_KEYS,
-    _OUTPUT_KEYS,
-    _SIMULATE_KEYS,
-    _STUDY_KEYS,
     ConfigError,
     ModelConfig,
     OutputConfig,
@@ -26,9 +22,15 @@ from fracid.config.schema import (
     SpecimenConfig,
     StudyConfig,
 )
+from fracid.config.vocabulary import (
+    MODEL_KEYS,
+    OUTPUT_KEYS,
+    SIMULATE_KEYS,
+    STUDY_KEYS,
+)
 
 
-def _range_text(cls, name: str) -> str:
+def range_text(cls, name: str) -> str:
     """The valid range of parameter ``name`` of the parameter class ``cls`` in words (e.g. ``"0 < c"``,
     ``"-1 < nu < 0.5"``): from its :class:`~fracid.fem.material.ranges.ParameterRange` when it declares
     ``ranges``, else the limits of ``valid_bounds`` (the interface every model's class has)."""
@@ -40,13 +42,13 @@ def _range_text(cls, name: str) -> str:
 
 
 def _parameter_allowed(cls, name: str) -> str:
-    return f"must be a number in the valid range {_range_text(cls, name)} [{cls.units().get(name, '-')}]"
+    return f"must be a number in the valid range {range_text(cls, name)} [{cls.units().get(name, '-')}]"
 
 
-def _valid_parameter(cls, name: str, value: float) -> bool:
+def valid_parameter(cls, name: str, value: float) -> bool:
     """Whether ``value`` lies in the valid range of ``name`` (its ``ParameterRange``, else the class's
     ``valid_bounds``, whose open ends are moved inside). Conditions joining several parameters are
-    left to the class (see :func:`_model`)."""
+    left to the class (see :func:`read_model`)."""
     rng = getattr(cls, "ranges", {}).get(name)
     if rng is not None:
         return rng.admits(value)
@@ -54,12 +56,12 @@ def _valid_parameter(cls, name: str, value: float) -> bool:
     return bool(lower[0] <= value <= upper[0])
 
 
-def _model(ck: _Checker, raw) -> ModelConfig:
+def read_model(ck: Checker, raw) -> ModelConfig:
     if raw is None:
         return ModelConfig()
-    ck.table("model", raw, _MODEL_KEYS)
-    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), _model_types())
-    cls = _model_of(kind).parameters
+    ck.table("model", raw, MODEL_KEYS)
+    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), model_types())
+    cls = model_of(kind).parameters
     names = cls.names()
     params = raw.get("parameters", {})
     if not isinstance(params, dict):
@@ -71,7 +73,7 @@ def _model(ck: _Checker, raw) -> ModelConfig:
             ck.fail(key, value, f"not a parameter of model.type = {kind!r} ({cls.__name__}); "
                                 f"allowed keys here: {', '.join(names)}")
         values[name] = ck.number(key, value, _parameter_allowed(cls, name),
-                                 lambda v, name=name: _valid_parameter(cls, name, v))
+                                 lambda v, name=name: valid_parameter(cls, name, v))
     try:  # conditions joining several parameters, e.g. the area of the cohesive law over c1, c2
         cls(**values)
     except ValueError as err:
@@ -79,17 +81,17 @@ def _model(ck: _Checker, raw) -> ModelConfig:
     return ModelConfig(type=kind, parameters=tuple(values.items()))
 
 
-def _check_model_runs_on(ck: _Checker, model: ModelConfig, specimen) -> None:
+def check_model_runs_on(ck: Checker, model: ModelConfig, specimen) -> None:
     """Refuse a model that does not run on the specimen, with its reason and the specimen types it runs on."""
     from fracid.models import runs_on
 
-    made = _model_of(model.type)
-    built = _specimen_class(specimen.type)(**dict(specimen.options))
+    made = model_of(model.type)
+    built = specimen_class(specimen.type)(**dict(specimen.options))
     if runs_on(made, built):
         return
     fits = []
-    for kind in _specimen_types():
-        instance = _specimen_class(kind).default_instance()
+    for kind in specimen_types():
+        instance = specimen_class(kind).default_instance()
         if instance is not None and runs_on(made, instance):
             fits.append(repr(kind))
     ck.fail("specimen.type", specimen.type, f"model.type = {model.type!r} does not run on it ({made.why_not(built)}); "
@@ -101,7 +103,7 @@ def _field_kind(field: dataclasses.Field) -> str:
     return text.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
 
 
-def _specimen_error_key(err: Exception, fields, given) -> str | None:
+def specimen_error_key(err: Exception, fields, given) -> str | None:
     """The specimen field an error of its validation is about: of the fields the error names (its
     ``names``, a :class:`~fracid.field_error.FieldError`), the first the user gave, else the first.
     An error without ``names`` (a specimen class of another package) is searched for field names."""
@@ -115,7 +117,7 @@ def _specimen_error_key(err: Exception, fields, given) -> str | None:
     return next((name for name in names if name in given), names[0] if names else None)
 
 
-def _specimen_options(ck: _Checker, prefix: str, raw: dict, cls) -> dict:
+def specimen_options(ck: Checker, prefix: str, raw: dict, cls) -> dict:
     """Type-check specimen fields (``raw`` holds field names only)."""
     fields = {f.name: f for f in dataclasses.fields(cls)}
     options = {}
@@ -132,57 +134,57 @@ def _specimen_options(ck: _Checker, prefix: str, raw: dict, cls) -> dict:
     return options
 
 
-def _check_specimen(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+def check_specimen(ck: Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
     """Build the specimen once so its own validation runs; errors name the key under ``prefix``."""
     try:
         cls(**options)
     except (TypeError, ValueError) as err:
         fields = {f.name: f for f in dataclasses.fields(cls)}
-        name = _specimen_error_key(err, fields, options)
+        name = specimen_error_key(err, fields, options)
         if name is None:
             raise ConfigError(f"{ck.path}: {prefix} ({kind}) is invalid: {err}") from None
         value = options.get(name, getattr(cls, name, None))
         where = f"{prefix}.{name}" if name in given else f"specimen.{name}"
         default = "" if name in options else " (default)"
-        raise ConfigError(f"{ck.path}: {where} = {_show(value)}{default}: {err}") from None
+        raise ConfigError(f"{ck.path}: {where} = {show(value)}{default}: {err}") from None
 
 
-def _value_text(value) -> str:
+def value_text(value) -> str:
     """A specimen field's value in a message: a float as ``%g`` (2, 0.01), anything else as TOML shows it."""
     if isinstance(value, float):
         return f"{value:g}"
-    return _show(value)
+    return show(value)
 
 
-def _field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, str]:
+def field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, str]:
     """The dotted key of specimen field ``name`` (under ``prefix`` if given there, else ``specimen``)
     and " (default)" when it was not given at all."""
     return (f"{prefix}.{name}" if name in given else f"specimen.{name}"), ("" if name in options else " (default)")
 
 
-def _check_specimen_size(ck: _Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
+def check_specimen_size(ck: Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
     """Refuse a problem beyond the specimen's limit (bar elements, unknowns of a plane mesh), estimated by
-    the specimen from its geometry without building the mesh (the specimen is valid: :func:`_check_specimen`
+    the specimen from its geometry without building the mesh (the specimen is valid: :func:`check_specimen`
     ran first)."""
     size = cls(**options).size_estimate()
     if not size.too_large:
         return
-    key, default = _field_key(prefix, size.field or "type", options, given)
+    key, default = field_key(prefix, size.field or "type", options, given)
     if prefix != "specimen" and size.field not in given:  # the experiment's overrides make the problem too large
-        default += f" with {prefix} = {{" + ", ".join(f"{k} = {_show(v)}" for k, v in given.items()) + "}"
+        default += f" with {prefix} = {{" + ", ".join(f"{k} = {show(v)}" for k, v in given.items()) + "}"
     shape = ", ".join(f"{name} = {value:g}" for name, value in options.items()
                       if isinstance(value, float) and name != size.field)
     raise ConfigError(
-        f"{ck.path}: {key} = {_value_text(size.value)}{default}: the mesh of this {kind} would have {size.summary} "
-        f"(estimated from the geometry{': ' + shape if shape else ''}), needing about {_bytes(size.memory)} of "
+        f"{ck.path}: {key} = {value_text(size.value)}{default}: the mesh of this {kind} would have {size.summary} "
+        f"(estimated from the geometry{': ' + shape if shape else ''}), needing about {bytes_text(size.memory)} of "
         f"memory in a forward run ({size.bytes_per:,} bytes per {size.unit}, measured); at most {size.limit:,} "
         f"{size.unit}s are allowed: {size.advice}")
 
 
-def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
+def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
     """The validated ``[specimen]``: its type among :data:`fracid.specimens.SPECIMENS`, read by the
     specimen's own section reader if it declares one (a mesh file), else by its dataclass fields."""
-    types = _specimen_types()
+    types = specimen_types()
     if raw is None:
         ck.missing("specimen", "a [specimen] section with type = " + " | ".join(repr(t) for t in types))
     if not isinstance(raw, dict):
@@ -190,22 +192,22 @@ def _specimen(ck: _Checker, raw, base=None) -> SpecimenConfig:
     if "type" not in raw:
         ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in types))
     kind = ck.choice("specimen.type", raw["type"], types)
-    cls = _specimen_class(kind)
-    reader = _section_reader(cls)
+    cls = specimen_class(kind)
+    reader = section_reader(cls)
     if reader is not None:
         return reader.read(ck, raw, base if base is not None else ck.path.parent, kind)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     ck.table("specimen", raw, ("type", "control", *fields))
-    options = _specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
-    _check_specimen(ck, "specimen", kind, cls, options, options)
+    options = specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
+    check_specimen(ck, "specimen", kind, cls, options, options)
     controls = cls(**options).control_names
     control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
-    _check_specimen_size(ck, "specimen", kind, cls, options, options)
+    check_specimen_size(ck, "specimen", kind, cls, options, options)
     return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
 
 
-def _output(ck: _Checker, raw, base: Path) -> OutputConfig:
-    raw = ck.table("output", {} if raw is None else raw, _OUTPUT_KEYS)
+def read_output(ck: Checker, raw, base: Path) -> OutputConfig:
+    raw = ck.table("output", {} if raw is None else raw, OUTPUT_KEYS)
     path = ck.location("output.directory", raw.get("directory", "results"), base, "must be a directory path (string)")
     steps = raw.get("vtk_steps", [])
     allowed = "must be a list of step numbers (integers >= 0)"
@@ -217,8 +219,8 @@ def _output(ck: _Checker, raw, base: Path) -> OutputConfig:
     return OutputConfig(directory=path, vtk_steps=tuple(sorted(set(steps))))
 
 
-def _simulate(ck: _Checker, raw) -> SimulateConfig:
-    raw = ck.table("simulate", {} if raw is None else raw, _SIMULATE_KEYS)
+def read_simulate(ck: Checker, raw) -> SimulateConfig:
+    raw = ck.table("simulate", {} if raw is None else raw, SIMULATE_KEYS)
     target = None
     if "target" in raw:
         target = ck.number("simulate.target", raw["target"], "must be a number > 0 [mm] (final control value)",
@@ -233,8 +235,8 @@ def _simulate(ck: _Checker, raw) -> SimulateConfig:
     )
 
 
-def _study(ck: _Checker, raw) -> StudyConfig:
-    raw = ck.table("study", {} if raw is None else raw, _STUDY_KEYS)
+def read_study(ck: Checker, raw) -> StudyConfig:
+    raw = ck.table("study", {} if raw is None else raw, STUDY_KEYS)
     return StudyConfig(
         starts=ck.integer("study.starts", raw.get("starts", 3), "must be an integer >= 0 (0 or 1: no multi-start check)",
                           lambda v: v >= 0),
@@ -251,7 +253,7 @@ def _study(ck: _Checker, raw) -> StudyConfig:
     )
 
 
-def _flag(ck: _Checker, key: str, value, allowed: str) -> bool:
+def _flag(ck: Checker, key: str, value, allowed: str) -> bool:
     """A TOML boolean (true or false; not 1, 0 or a string)."""
     if not isinstance(value, bool):
         ck.fail(key, value, allowed)

@@ -235,31 +235,69 @@ def read_curve_csv(
     """
     path = file_path(path)
     wanted = [column_name(control_column, "control_column"), *force_column_names(force_columns)]
-    c_scale = unit_scale(control_unit_scale, "control_unit_scale")
-    f_scale = unit_scale(force_unit_scale, "force_unit_scale")
+    scales = unit_scale(control_unit_scale, "control_unit_scale"), unit_scale(force_unit_scale, "force_unit_scale")
     min_points = integer_at_least(min_points, 2, "min_points")
     delimiter, decimal = check_format(delimiter, decimal)
-
     table = read_table(path, delimiter, decimal, wanted)
+    values, lines = _parsed_rows(path, table, wanted, delimiter, decimal, min_points)
+    keep, notes = _kept_rows(path, values, lines, wanted, scales, backtrack_tolerance, min_points)
+    return _curves(path, table, values[keep], wanted, scales, notes)
+
+
+def _parsed_rows(path, table: CsvTable, wanted: list, delimiter: str, decimal: str, min_points: int):
+    """The numbers of the ``wanted`` columns of ``table`` (control first) and the file line of each row.
+
+    Raises
+    ------
+    DataError
+        A requested column missing, fewer than ``min_points`` rows, a cell that is not a number.
+    """
     indices = column_indices(table, wanted, delimiter)
     if len(table.rows) < min_points:
         raise DataError(f"{path}: {len(table.rows)} data rows, fewer than the {min_points} a curve needs")
-    values, lines = parse_table(table, wanted, indices, decimal, delimiter)
+    return parse_table(table, wanted, indices, decimal, delimiter)
+
+
+def _kept_rows(path, values, lines, wanted: list, scales: tuple, backtrack_tolerance, min_points: int):
+    """The rows kept by the checks of :mod:`fracid.data.checks` on the scaled ``values``, and their notes.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n_rows, 1 + n_forces)
+        Control then force columns, unscaled.
+    lines : ndarray of int
+        The file line of each row, for the messages.
+    scales : (float, float)
+        Multipliers of the control and force columns.
+
+    Returns
+    -------
+    keep : ndarray of bool, shape (n_rows,)
+    notes : tuple of str
+    """
+    control_column = wanted[0]
     labels = Labels(f"{path} (control {control_column!r})", repr(control_column),
                     tuple(map(repr, wanted[1:])), "row")
-    keep, notes = checked_curve(values[:, 0] * c_scale, values[:, 1:] * f_scale, lines, backtrack_tolerance, labels)
+    keep, notes = checked_curve(values[:, 0] * scales[0], values[:, 1:] * scales[1], lines, backtrack_tolerance,
+                                labels)
     if keep.sum() < min_points:
         raise DataError(
-            f"{path}: {int(keep.sum())} data rows left of {len(table.rows)} after dropping backtracking rows, "
+            f"{path}: {int(keep.sum())} data rows left of {len(values)} after dropping backtracking rows, "
             f"fewer than the {min_points} a curve needs"
         )
+    return keep, notes
+
+
+def _curves(path, table: CsvTable, values, wanted: list, scales: tuple, notes) -> list[Curve]:
+    """One :class:`Curve` per force column of the kept rows ``values``, with the notes of the reading."""
+    control_column, (c_scale, f_scale) = wanted[0], scales
     scale_notes = list(table.notes())
     if c_scale != 1.0:
         scale_notes.append(f"{path}: control column {control_column!r} multiplied by {c_scale:g} to mm")
     return [
         Curve(
-            control=values[keep, 0] * c_scale,
-            force=values[keep, k + 1] * f_scale,
+            control=values[:, 0] * c_scale,
+            force=values[:, k + 1] * f_scale,
             source=f"{path}, column {name!r} against {control_column!r}",
             notes=(*scale_notes, *([f"{path}: force column {name!r} multiplied by {f_scale:g} to N"]
                                    if f_scale != 1.0 else []), *notes),

@@ -102,6 +102,32 @@ def write_vtk(
         import meshio
     except ImportError as err:
         raise ImportError("writing VTK files needs meshio, a dependency of fracid: pip install meshio") from err
+    nodes, cells = _checked_mesh(nodes, cells, cell_type)
+    n_nodes, dim = nodes.shape
+    omega, kappa = _checked_point_fields(fields, len(cells))
+    point_data = {"displacement": _displacement(fields["u"], n_nodes, n_u_components)}
+    if fields.get("ebar") is not None:
+        point_data["ebar"] = corner_to_nodes(fields["ebar"], cells, cell_type, n_nodes, ebar_nodes)
+    cell_data = {"damage_max": omega.max(axis=1), "damage_mean": omega.mean(axis=1), "kappa_max": kappa.max(axis=1)}
+    _add_extra(point_data, point_data_extra, n_nodes)
+    _add_extra(cell_data, cell_data_extra, len(cells))
+
+    points = np.zeros((n_nodes, 3))
+    points[:, :dim] = nodes
+    mesh = meshio.Mesh(
+        points,
+        [(cell_type, cells.astype(np.int64))],
+        point_data=point_data,
+        cell_data={name: [values] for name, values in cell_data.items()},
+    )
+    path = Path(path)
+    meshio.write(path, mesh, file_format="vtu")
+    return path
+
+
+def _checked_mesh(nodes, cells, cell_type: str) -> tuple[np.ndarray, np.ndarray]:
+    """``nodes`` as an (n_nodes, dim) float array and ``cells`` as an array, checked against each other and
+    ``cell_type`` (ValueError naming the defect)."""
     if cell_type not in _CELL_TYPES:
         raise ValueError(f"cell_type = {cell_type!r}; supported: {sorted(_CELL_TYPES)}")
     nodes = np.asarray(nodes, dtype=float)
@@ -115,39 +141,44 @@ def write_vtk(
         raise ValueError(f"{cell_type!r} cells must be integers of shape (n_el, {n_per_cell}); got {cells.dtype} {cells.shape}")
     if cells.size and (cells.min() < 0 or cells.max() >= n_nodes):
         raise ValueError(f"cell node numbers must be in [0, {n_nodes})")
-    omega, kappa = np.asarray(fields["omega"], dtype=float), np.asarray(fields["kappa"], dtype=float)
-    if omega.ndim != 2 or omega.shape[0] != len(cells) or kappa.shape != omega.shape:
-        raise ValueError(f"omega {omega.shape} and kappa {kappa.shape} must have shape (n_el = {len(cells)}, n_q)")
+    return nodes, cells
 
-    u = np.asarray(fields["u"], dtype=float)
+
+def _checked_point_fields(fields: dict, n_el: int) -> tuple[np.ndarray, np.ndarray]:
+    """``omega`` and ``kappa`` of ``fields`` at the integration points, both of shape (n_el, n_q)."""
+    omega, kappa = np.asarray(fields["omega"], dtype=float), np.asarray(fields["kappa"], dtype=float)
+    if omega.ndim != 2 or omega.shape[0] != n_el or kappa.shape != omega.shape:
+        raise ValueError(f"omega {omega.shape} and kappa {kappa.shape} must have shape (n_el = {n_el}, n_q)")
+    return omega, kappa
+
+
+def _displacement(u, n_nodes: int, n_u_components: int | None) -> np.ndarray:
+    """The nodal displacements ``u`` (node by node) as (n_nodes, 3), padded with zeros.
+
+    Parameters
+    ----------
+    u : array_like, shape (n_nodes * n_u_components,)
+    n_nodes : int
+    n_u_components : int or None
+        Components per node; None: ``len(u) / n_nodes``.
+    """
+    u = np.asarray(u, dtype=float)
     if n_u_components is None:
         n_u_components = u.size // n_nodes
     if not 1 <= n_u_components <= 3 or u.size != n_nodes * n_u_components:
         raise ValueError(f"{u.size} displacement dofs do not make {n_u_components} (1 to 3) components at {n_nodes} nodes")
     displacement = np.zeros((n_nodes, 3))
     displacement[:, :n_u_components] = u.reshape(n_nodes, n_u_components)
-    point_data = {"displacement": displacement}
-    if fields.get("ebar") is not None:
-        point_data["ebar"] = corner_to_nodes(fields["ebar"], cells, cell_type, n_nodes, ebar_nodes)
-    cell_data = {"damage_max": omega.max(axis=1), "damage_mean": omega.mean(axis=1), "kappa_max": kappa.max(axis=1)}
-    for extra, n, what in ((point_data_extra, n_nodes, point_data), (cell_data_extra, len(cells), cell_data)):
-        for name, values in (extra or {}).items():
-            values = np.asarray(values)
-            if values.shape[:1] != (n,):
-                raise ValueError(f"extra array {name!r} of shape {values.shape} needs {n} rows")
-            what[name] = values
+    return displacement
 
-    points = np.zeros((n_nodes, 3))
-    points[:, :dim] = nodes
-    mesh = meshio.Mesh(
-        points,
-        [(cell_type, cells.astype(np.int64))],
-        point_data=point_data,
-        cell_data={name: [values] for name, values in cell_data.items()},
-    )
-    path = Path(path)
-    meshio.write(path, mesh, file_format="vtu")
-    return path
+
+def _add_extra(data: dict, extra: dict | None, n_rows: int) -> None:
+    """Add the arrays of ``extra`` to ``data``, each checked to have ``n_rows`` rows."""
+    for name, values in (extra or {}).items():
+        values = np.asarray(values)
+        if values.shape[:1] != (n_rows,):
+            raise ValueError(f"extra array {name!r} of shape {values.shape} needs {n_rows} rows")
+        data[name] = values
 
 
 def write_result_vtk(directory, specimen, result, stem: str = "step") -> list:

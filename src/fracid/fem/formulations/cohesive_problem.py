@@ -17,7 +17,6 @@ import numpy as np
 
 from fracid.fem.formulations import damage_sensitivity as ds
 from fracid.fem.mesh.assembly import assemble_vector
-from fracid.fem.material.cohesive import hordijk_envelope
 from fracid.fem.mesh.elements import gauss_line, line_quadratic
 from fracid.fem.mesh.level_sets import superlevel_length
 from fracid.fem.formulations.problem import ElasticProblem
@@ -82,14 +81,6 @@ def law_crack_traction(law, params, w, w_max, penalty):
     (w0 = ft / penalty, ft = ``law.strength(params)``)."""
     return penalty_crack_traction(w, w_max, law.strength(params) / penalty, penalty,
                                   lambda v: law.traction(v, params))
-
-
-def crack_traction(w, w_max, ft, wc, c1, c2, penalty):
-    """:func:`penalty_crack_traction` of Hordijk's law with arguments (ft, wc, c1, c2), w0 = ft / penalty.
-
-    Kept for callers that pass Hordijk's arguments (tests); the formulation uses its law object
-    (:func:`law_crack_traction`)."""
-    return penalty_crack_traction(w, w_max, ft / penalty, penalty, lambda v: hordijk_envelope(v, ft, wc, c1, c2))
 
 
 def crack_traction_parameter_derivatives(law, w, w_max, params, penalty, penalty_rates):
@@ -211,7 +202,7 @@ class CohesiveCrackProblem(ElasticProblem):
         cols = self.slots[:, None, :]
         tangent[self.owners[:, None, None], rows, cols] += stiffness
         residual = residual + assemble_vector(self.element_dofs[self.owners], element_force, self.n_free)
-        return residual, arrays._replace(tangent=tangent, kappa=w_max), references
+        return residual, arrays._replace(tangent=tangent, history=w_max), references
 
     def cracked_length(self, w_max) -> float:
         """Length of the crack path where the faces have separated (opening beyond w0) [mm]."""

@@ -11,7 +11,7 @@ from fracid.fem.material.crack_band import (band_damage, band_damage_parameter_d
                                    crack_direction_stress, crack_direction_stress_nu_derivative, element_mean,
                                    snap_back_limit)
 from fracid.fem.material.damage import update_history
-from fracid.fem.formulations.forms import ElementArrays, _btdb, point_outputs
+from fracid.fem.formulations.forms import ElementArrays, btdb, point_outputs
 from fracid.fem.formulations.problem import ContinuumProblem
 from fracid.fem.material.tsl import ScaledLaw, differentiable
 
@@ -98,7 +98,7 @@ class CrackBandProblem(ContinuumProblem):
         B, w = self.disc.strain_operator, self.disc.weights
         sigma, dsigma, (a, b), kappa, omega = self._stress(ue, kappa_old)
         forces = np.einsum("eqsi,eqs->ei", B, sigma * w[..., None])
-        self._tangent[:] = _btdb(B * w[..., None, None], np.matmul(dsigma, self.const.DB))
+        self._tangent[:] = btdb(B * w[..., None, None], np.matmul(dsigma, self.const.DB))
         # the element's common damage couples its points: a rank-one term per element
         self._tangent -= np.einsum("ei,ej->eij", np.einsum("eqsi,eqs->ei", B, a * w[..., None]),
                                    np.einsum("eqs,eqsj->ej", b, self.const.DB))

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.fem.formulations.forms import _bt
+from fracid.fem.formulations.forms import bt
 
 
 def check_names(names, known) -> tuple:
@@ -56,7 +56,7 @@ def equilibrium_pseudo_load(disc, params, const, ue, omega, omega_rate, names) -
     """
     B, w = disc.strain_operator, disc.weights
     eps = np.einsum("eqsi,ei->eqs", B, ue)
-    bt_sigma = _bt(np.einsum("eqsj,ej->eqs", const.DB, ue), B)  # B^T D eps per unit E
+    bt_sigma = bt(np.einsum("eqsj,ej->eqs", const.DB, ue), B)  # B^T D eps per unit E
     intact = (1.0 - omega) * const.E * w
     out = np.empty(ue.shape + (len(names),))
     for k, name in enumerate(names):
@@ -64,7 +64,7 @@ def equilibrium_pseudo_load(disc, params, const, ue, omega, omega_rate, names) -
         force = np.einsum("eqi,eq->ei", bt_sigma, factor)
         if name == "nu":
             d_sigma = np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(params.nu), eps)
-            force += np.einsum("eqi,eq->ei", _bt(d_sigma, B), intact)
+            force += np.einsum("eqi,eq->ei", bt(d_sigma, B), intact)
         out[..., k] = force
     return out
 

@@ -109,33 +109,71 @@ def model_constants(disc, params, stiffness_factor, damageable=1.0, gradient_spa
     return ModelConstants(E, D, DB, M, mask)
 
 
-def _btdb(weighted_B, DB):
-    """sum over points and strain components of B^T (D B): batched matmul, 6x faster than einsum here."""
+def btdb(weighted_B, DB):
+    """Sum over the points and strain components of B^T (D B): the element stiffness.
+
+    Parameters
+    ----------
+    weighted_B : ndarray, shape (n_el, n_q, n_strain, n_u)
+        The strain operator times the point weights (and the secant modulus).
+    DB : ndarray, shape (n_el, n_q, n_strain, n_u)
+        The elastic matrix times the strain operator.
+
+    Returns
+    -------
+    ndarray, shape (n_el, n_u, n_u)
+    """
+    # a batched matmul, 6x faster than einsum here
     n_el, n_u = DB.shape[0], DB.shape[-1]
     return np.matmul(weighted_B.reshape(n_el, -1, n_u).transpose(0, 2, 1), DB.reshape(n_el, -1, n_u))
 
 
-def _bt(vector, B):
-    """B^T v at every integration point: (n_el, n_q, n_strain) x (n_el, n_q, n_strain, n_u) -> (n_el, n_q, n_u)."""
+def bt(vector, B):
+    """B^T v at every integration point.
+
+    Parameters
+    ----------
+    vector : ndarray, shape (n_el, n_q, n_strain)
+    B : ndarray, shape (n_el, n_q, n_strain, n_u)
+
+    Returns
+    -------
+    ndarray, shape (n_el, n_q, n_u)
+    """
     return np.matmul(vector[..., None, :], B)[..., 0, :]
 
 
-def _damage(law, params, const, kappa):
+def masked_damage(law, params, const, kappa):
+    """The damage and its derivative d omega / d kappa of ``law`` at every point, zero where the material
+    cannot damage (``const.damageable``).
+
+    Parameters
+    ----------
+    law : DamageLaw
+    params : parameter object of the law
+    const : ModelConstants
+    kappa : ndarray, shape (n_el, n_q)
+        The history variable.
+
+    Returns
+    -------
+    omega, d_omega : ndarray, shape (n_el, n_q)
+    """
     omega, d_omega = law.damage(kappa, params)
     return omega * const.damageable, d_omega * const.damageable
 
 
 def _secant_equilibrium(B, const, w, ue, omega):
     """Shared by the models: B^T D eps at the points, the internal forces and the weights of the secant
-    stiffness (``_btdb(B * w_sec, DB)``)."""
+    stiffness (``btdb(B * w_sec, DB)``)."""
     sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
     w_sec = w * (1.0 - omega) * const.E
-    bt_sigma = _bt(sigma_eff, B)  # (n_el, n_q, n_u)
+    bt_sigma = bt(sigma_eff, B)  # (n_el, n_q, n_u)
     return bt_sigma, np.einsum("eqi,eq->ei", bt_sigma, w_sec), w_sec
 
 
 def _secant(B, const, w_sec):
-    return _btdb(B * w_sec[..., None, None], const.DB)
+    return btdb(B * w_sec[..., None, None], const.DB)
 
 
 def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kappa_old, out_tangent) -> ElementArrays:
@@ -161,7 +199,7 @@ def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kap
     ebar = ee @ N.T
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, ebar)
-    omega, d_omega = _damage(law, params, const, kappa)
+    omega, d_omega = masked_damage(law, params, const, kappa)
     bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
     f_eq = (w * eq) @ N
     f_e = np.einsum("eij,ej->ei", const.ebar_matrix, ee) - f_eq
@@ -170,7 +208,7 @@ def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kap
         out_tangent[:, :nu, :nu] = _secant(B, const, w_sec)
         w_ue = -(w * const.E * d_omega * loading)
         out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
-        out_tangent[:, nu:, :nu] = -np.matmul(N.T, _bt(d_eq * w[..., None], B))
+        out_tangent[:, nu:, :nu] = -np.matmul(N.T, bt(d_eq * w[..., None], B))
         return out_tangent
 
     return ElementArrays(np.concatenate([f_u, f_e], axis=1), tangent, {"u": f_u, "ebar": f_eq}, kappa,
@@ -183,12 +221,12 @@ def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_ta
     eps = np.einsum("eqsi,ei->eqs", B, ue)
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, eq)
-    omega, d_omega = _damage(law, params, const, kappa)
+    omega, d_omega = masked_damage(law, params, const, kappa)
     bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
 
     def tangent():
         softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1),
-                              _bt(d_eq, B))
+                              bt(d_eq, B))
         out_tangent[:] = _secant(B, const, w_sec) - softening
         return out_tangent
 
@@ -222,11 +260,11 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
     kappa, loading = update_history(kappa_old, ebar)
-    omega, d_omega = _damage(law, params, const, kappa)
+    omega, d_omega = masked_damage(law, params, const, kappa)
     bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
     secant = _secant(B, const, w_sec)
     g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
-    h = _bt(d_eq, B)  # d eps_eq / d u at each point
+    h = bt(d_eq, B)  # d eps_eq / d u at each point
     out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
     coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
     return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, coupling=coupling, outputs={"omega": omega})

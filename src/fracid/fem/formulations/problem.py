@@ -14,8 +14,8 @@ from fracid.fem.mesh.assembly import assemble_vector, norm2
 from fracid.fem.formulations import damage_sensitivity as ds
 from fracid.fem.mesh.discretization import MixedDiscretization
 from fracid.fem.mesh.dofs import Conditions, FieldSpec, number_dofs
-from fracid.fem.formulations.forms import (_damage, elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage,
-                              model_constants, point_outputs)
+from fracid.fem.formulations.forms import (elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage,
+                                           masked_damage, model_constants, point_outputs)
 from fracid.fem.material.laws import DamageLaw
 from fracid.fem.formulations.nonlocal_average import averaging_length_derivative, internal_length, nonlocal_averaging
 from fracid.fem.formulations.protocol import HistoryVariable, allocate_history
@@ -187,7 +187,7 @@ class DamageProblem(ContinuumProblem):
         driving, eps, eq, d_eq = self._driving(qe)
         loading = driving >= kappa_old
         kappa = np.where(loading, driving, kappa_old)
-        omega, d_omega = _damage(self.law, self.params, self.const, kappa)
+        omega, d_omega = masked_damage(self.law, self.params, self.const, kappa)
         law_rate = ds.damage_parameter_derivatives(self.law, self.params, self.const, kappa, names)
         explicit = self._driving_parameter_rate(eps, eq, names)
         omega_rate = law_rate + d_omega[..., None] * np.where(loading[..., None], explicit, kappa_old_rate)

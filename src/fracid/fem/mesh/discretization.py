@@ -83,24 +83,6 @@ class MixedDiscretization:
             raise ValueError(f"unknown scalar space {name!r}; this discretisation offers {sorted(self.spaces)}")
         return self.spaces[name]
 
-    # the names of the single (u, ebar) layout, kept for tests and scripts written against it: the
-    # gradient model's field on the "linear" space, numbered after the displacements
-    @property
-    def ebar_shape(self) -> np.ndarray:
-        return self.spaces["linear"].shape
-
-    @property
-    def ebar_gradient(self) -> np.ndarray:
-        return self.spaces["linear"].gradient
-
-    @property
-    def ebar_dofs(self) -> np.ndarray:
-        return self.n_u_dofs + self.spaces["linear"].nodes
-
-    @property
-    def n_ebar_dofs(self) -> int:
-        return self.spaces["linear"].n_nodes
-
 
 def bar_discretization(vertices, areas, n_gauss: int = 3) -> MixedDiscretization:
     """Mixed 1D bar elements: quadratic displacement; linear and quadratic scalar spaces.

@@ -9,10 +9,11 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from fracid.fem.mesh.assembly import dot
 from fracid.fem.path.ddm import PathDerivatives
-from fracid.fem.path.linear_solvers import SingularMatrixError, linear_solver as _make_linear_solver
-from fracid.fem.formulations.protocol import initial_history, state_energy, state_fields
+from fracid.fem.path.recorder import Recorder
+from fracid.fem.path import linear_solvers
+from fracid.fem.path.linear_solvers import SingularMatrixError
+from fracid.fem.formulations.protocol import initial_history
 from fracid.fem.path.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 
 
@@ -234,85 +235,136 @@ def follow_path(
     """
     _check_request(problem, control, target, stop_force_fraction, max_steps)
     _check_steps(steps, target)
-    t_start = time.perf_counter()
-    solver = _make_linear_solver(linear_solver)
-    system = ControlledSystem(problem, problem.functionals[control])
-    stats = SolverStatistics()
-    recorder = _Recorder(problem, control, dict(observers or {}), field_steps)
-    derivatives = PathDerivatives(problem, sensitivities, observers) if sensitivities is not None else None
-    factor = None  # a factorization to start the next increment with (the derivatives' or the last iteration's)
+    run = _Run(problem, control, linear_solver, newton, observers, field_steps, sensitivities)
+    return run.trace(_StepSizes(steps, target, checkpoints), max_steps, stop_force_fraction, callback)
 
-    z = np.zeros(problem.n_free + 1)
-    history = initial_history(problem)
-    state = None  # evaluation at the current converged z, reused by the next increment
-    tau, status = 0.0, "target reached"
-    base = steps.initial  # reference increment; set from the onset of damage when not given
-    step = base if base is not None else 1e-3 * target  # elastic probe
-    first_step = step
-    marks = np.sort(np.asarray([] if checkpoints is None else checkpoints, dtype=float))
-    elastic = True
 
-    def result(final_status):
-        stats.time_total = time.perf_counter() - t_start
-        out = recorder.result(stats, final_status)
-        if derivatives is not None:
-            out.derivatives = derivatives.result()
-        return out
+class _StepSizes:
+    """The adaptive sequence of increments of :class:`StepOptions`: cut after a failure, grown after an easy
+    step, jumping to damage onset while the response is linear."""
 
-    while tau < target * (1.0 - 1e-12):
-        if stats.steps >= max_steps:
-            status = f"stopped after max_steps = {max_steps} steps"
-            break
-        increment = min(step, target - tau)
-        ahead = marks[marks > tau * (1.0 + 1e-12) + 1e-15]
+    def __init__(self, steps: StepOptions, target: float, checkpoints):
+        self.steps, self.target = steps, target
+        self.base = steps.initial  # reference increment; set from the onset of damage when not given
+        self.step = self.base if self.base is not None else 1e-3 * target  # elastic probe
+        self.first_step = self.step
+        self.marks = np.sort(np.asarray([] if checkpoints is None else checkpoints, dtype=float))
+        self.elastic = True
+
+    def increment(self, tau: float) -> float:
+        """The next increment from ``tau``: the current step, ending at the target or the next checkpoint."""
+        increment = min(self.step, self.target - tau)
+        ahead = self.marks[self.marks > tau * (1.0 + 1e-12) + 1e-15]
         if ahead.size and ahead[0] < tau + increment:
             increment = ahead[0] - tau
-        try:
-            z_new, arrays, iterations, state, factor = solve_increment(
-                system, z, tau + increment, history, solver, newton, stats, state, factor
-            )
-        except IncrementFailed as err:
-            state = factor = None  # the failed iterations overwrote the problem's tangent buffer
-            stats.failed_increments += 1
-            step = increment * steps.shrink
-            minimum = steps.minimum if steps.minimum is not None else 1e-4 * (base or first_step)
-            if step < minimum:
-                raise _failure(control, tau, increment, stats, recorder, err, result("failed: " + str(err))) from None
-            continue
-        tau += increment
-        if derivatives is not None:
-            try:
-                factor = derivatives.step(system, z_new, history, arrays, solver, stats)
-            except SingularMatrixError as err:
-                message = (f"the tangent of the converged step at {control} = {tau:.6g} mm is singular, so the "
-                           f"derivatives are not defined there (a bifurcation of the path): {err}")
-                raise ConvergenceError(message, result("failed: singular tangent for the derivatives"),
-                                       control=control, functionals=tuple(problem.functionals)) from None
-        z, history = z_new, arrays.history
-        stats.steps += 1
-        force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
-        if callback is not None:
-            callback(stats.steps, tau, force)
-        if stop_force_fraction is not None and abs(force) < stop_force_fraction * recorder.peak:
-            status = f"force below {stop_force_fraction:g} of the peak"
-            break
-        onset_ratio = problem.onset_ratio(history)
-        if elastic and 0.0 < onset_ratio < 1.0 and steps.jump_to_onset:
+        return increment
+
+    def cut(self, increment: float) -> bool:
+        """Shrink the step after ``increment`` failed; whether it fell below the minimum step."""
+        steps = self.steps
+        self.step = increment * steps.shrink
+        minimum = steps.minimum if steps.minimum is not None else 1e-4 * (self.base or self.first_step)
+        return self.step < minimum
+
+    def advance(self, tau: float, increment: float, iterations: int, onset_ratio: float) -> None:
+        """Set the next step after ``increment`` converged at ``tau`` in ``iterations`` Newton iterations.
+
+        Parameters
+        ----------
+        tau : float
+            The control reached [mm].
+        increment : float
+            The increment that converged [mm].
+        iterations : int
+        onset_ratio : float
+            The problem's ``onset_ratio`` of the converged history: in (0, 1) while no point has damaged.
+        """
+        steps = self.steps
+        if self.elastic and 0.0 < onset_ratio < 1.0 and steps.jump_to_onset:
             # linear response so far: jump to just below damage onset
             tau_onset = tau / onset_ratio
-            base = base if base is not None else tau_onset / 20.0
+            self.base = self.base if self.base is not None else tau_onset / 20.0
             # land half a small step below onset, so the next step clearly crosses it
             # (landing on it exactly would leave the crossing to rounding)
-            step = max(tau_onset - 0.5 * base * steps.onset_fraction - tau, base * steps.onset_fraction)
-            continue
-        base = base if base is not None else increment
-        if elastic:  # this step crossed damage onset: go on with small steps, growing again
-            elastic = False
-            step = base * steps.onset_fraction
-            continue
-        maximum = steps.maximum if steps.maximum is not None else steps.max_factor * base
-        step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
-    return result(status)
+            self.step = max(tau_onset - 0.5 * self.base * steps.onset_fraction - tau, self.base * steps.onset_fraction)
+            return
+        self.base = self.base if self.base is not None else increment
+        if self.elastic:  # this step crossed damage onset: go on with small steps, growing again
+            self.elastic = False
+            self.step = self.base * steps.onset_fraction
+            return
+        maximum = steps.maximum if steps.maximum is not None else steps.max_factor * self.base
+        self.step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
+
+
+class _Run:
+    """One incremental analysis of :func:`follow_path`: the solver, the records and the derivatives."""
+
+    def __init__(self, problem, control, linear_solver, newton, observers, field_steps, sensitivities):
+        self.t_start = time.perf_counter()
+        self.problem, self.control, self.newton = problem, control, newton
+        self.solver = linear_solvers.linear_solver(linear_solver)
+        self.system = ControlledSystem(problem, problem.functionals[control])
+        self.stats = SolverStatistics()
+        self.recorder = Recorder(problem, dict(observers or {}), field_steps)
+        self.derivatives = PathDerivatives(problem, sensitivities, observers) if sensitivities is not None else None
+
+    def trace(self, sizes: _StepSizes, max_steps, stop_force_fraction, callback) -> PathResult:
+        """Converged steps up to the target or a stop criterion (see :func:`follow_path`)."""
+        stats, recorder = self.stats, self.recorder
+        factor = None  # a factorization to start the next increment with (the derivatives' or the last iteration's)
+        z = np.zeros(self.problem.n_free + 1)
+        history = initial_history(self.problem)
+        state = None  # evaluation at the current converged z, reused by the next increment
+        tau, status = 0.0, "target reached"
+        while tau < sizes.target * (1.0 - 1e-12):
+            if stats.steps >= max_steps:
+                status = f"stopped after max_steps = {max_steps} steps"
+                break
+            increment = sizes.increment(tau)
+            try:
+                z_new, arrays, iterations, state, factor = solve_increment(
+                    self.system, z, tau + increment, history, self.solver, self.newton, stats, state, factor
+                )
+            except IncrementFailed as err:
+                state = factor = None  # the failed iterations overwrote the problem's tangent buffer
+                stats.failed_increments += 1
+                if sizes.cut(increment):
+                    raise _failure(self.control, tau, increment, stats, recorder, err,
+                                   self.result("failed: " + str(err))) from None
+                continue
+            tau += increment
+            if self.derivatives is not None:
+                factor = self.differentiate(tau, z_new, history, arrays)
+            z, history = z_new, arrays.history
+            stats.steps += 1
+            force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
+            if callback is not None:
+                callback(stats.steps, tau, force)
+            if stop_force_fraction is not None and abs(force) < stop_force_fraction * recorder.peak:
+                status = f"force below {stop_force_fraction:g} of the peak"
+                break
+            sizes.advance(tau, increment, iterations, self.problem.onset_ratio(history))
+        return self.result(status)
+
+    def differentiate(self, tau, z, history, arrays):
+        """The derivatives' step at the converged ``z``; its factorization of the tangent (or None)."""
+        try:
+            return self.derivatives.step(self.system, z, history, arrays, self.solver, self.stats)
+        except SingularMatrixError as err:
+            message = (f"the tangent of the converged step at {self.control} = {tau:.6g} mm is singular, so the "
+                       f"derivatives are not defined there (a bifurcation of the path): {err}")
+            raise ConvergenceError(message, self.result("failed: singular tangent for the derivatives"),
+                                   control=self.control, functionals=tuple(self.problem.functionals)) from None
+
+    def result(self, status: str) -> PathResult:
+        """The :class:`PathResult` of the steps recorded so far, ending with ``status``."""
+        self.stats.time_total = time.perf_counter() - self.t_start
+        control, force, observables, fields = self.recorder.curves()
+        out = PathResult(self.control, control, force, observables, fields, self.stats, status)
+        if self.derivatives is not None:
+            out.derivatives = self.derivatives.result()
+        return out
 
 
 def _failure(control, tau, increment, stats, recorder, err, partial) -> ConvergenceError:
@@ -323,56 +375,3 @@ def _failure(control, tau, increment, stats, recorder, err, partial) -> Converge
     if snap_back:
         message += "; snap-back: past the peak the force fell faster than the elastic stiffness"
     return ConvergenceError(message, partial, snap_back, control, tuple(recorder.problem.functionals))
-
-
-class _Recorder:
-    """Collects the curves, observables and fields of the converged steps."""
-
-    def __init__(self, problem, control, observers, field_steps):
-        self.problem, self.control, self.observers, self.field_steps = problem, control, observers, field_steps
-        self.keep = _field_selector(field_steps)
-        # displacement work-conjugate to the load factor, for the whole specimen
-        self.load_point = problem.symmetry_factor * problem.load_vector
-        names = ["tau", "force", "work", "elastic", "load_point", *problem.functionals, *observers]
-        self.records = {name: [0.0] for name in names}
-        self.fields, self.last, self.peak = {}, None, 0.0
-
-    def record(self, step, tau, q, force, arrays) -> float:
-        rec, problem = self.records, self.problem
-        displacement = dot(self.load_point, q)
-        work = 0.5 * (force + rec["force"][-1]) * (displacement - rec["load_point"][-1])
-        rec["work"].append(rec["work"][-1] + work)
-        rec["tau"].append(tau)
-        rec["force"].append(force)
-        rec["load_point"].append(displacement)
-        rec["elastic"].append(state_energy(problem, q, arrays))
-        for name, vec in problem.functionals.items():
-            rec[name].append(dot(vec, q))
-        for name, fn in self.observers.items():
-            rec[name].append(float(fn(problem, q, arrays)))
-        if self.keep(step):
-            self.fields[step] = state_fields(problem, q, arrays)
-        self.last = (step, q, arrays)
-        self.peak = max(self.peak, abs(force))
-        return force
-
-    def result(self, stats, status) -> PathResult:
-        if self.last is not None and self.field_steps is not None and self.last[0] not in self.fields:
-            step, q, arrays = self.last
-            self.fields[step] = state_fields(self.problem, q, arrays)
-        rec = {name: np.array(values) for name, values in self.records.items()}
-        obs = {name: rec[name] for name in [*self.problem.functionals, *self.observers]}
-        obs["load_point_displacement"] = rec["load_point"]
-        obs["external_work"] = rec["work"]
-        obs["elastic_energy"] = rec["elastic"]
-        obs["dissipated_energy"] = rec["work"] - rec["elastic"]
-        return PathResult(self.control, rec["tau"], rec["force"], obs, self.fields, stats, status)
-
-
-def _field_selector(field_steps):
-    if field_steps is None or field_steps == "last":
-        return lambda step: False
-    if field_steps == "all":
-        return lambda step: True
-    wanted = {int(s) for s in field_steps}
-    return lambda step: step in wanted

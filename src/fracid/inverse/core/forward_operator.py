@@ -18,7 +18,8 @@ import numpy as np
 
 from fracid.inverse.core.observations import FieldObservation, Observation, ObservationKind, check_control_points
 from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
-from fracid.models import ConvergenceError, DamageModel, StepOptions, declared
+from fracid.forward import model_with_regularization
+from fracid.models import ConvergenceError, StepOptions, declared
 
 __all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RunRecord"]
 _control_points = check_control_points  # the old private name
@@ -106,11 +107,7 @@ class ForwardOperator:
         if strangers or not self.observations:
             raise TypeError(f"observations must be a non-empty sequence of Observation (or FieldObservation, or an "
                             f"object with the members of ObservationKind), got {strangers or 'none'}")
-        if self.model is None:
-            object.__setattr__(self, "model", DamageModel(self.regularization or "gradient"))
-        elif self.regularization is not None and self.regularization != declared(self.model).regularization:
-            raise ValueError(f"regularization = {self.regularization!r} contradicts the model {self.model.key!r}; "
-                             "give one of them")
+        object.__setattr__(self, "model", model_with_regularization(self.model, self.regularization, restated=True))
         object.__setattr__(self, "regularization", declared(self.model).regularization)
         if not isinstance(self.base, self.model.parameters):
             raise TypeError(f"base is a {type(self.base).__name__}; the model {self.model.key!r} takes "

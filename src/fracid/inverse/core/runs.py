@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.core.forward_operator import RunRecord
-from fracid.parallel import BatchStats, run_batch
+from fracid.batch import BatchStats, run_batch
 from fracid.store import key_for
 
 

@@ -3,6 +3,22 @@
 The same Bayesian MAP estimate as the Kalman filter with ``restart="linearize"``, found by
 :func:`scipy.optimize.least_squares` (trust region, bounds) with the Jacobian from the sensitivity
 interface: with an exact sensitivity (direct differentiation) every linearisation costs about one run.
+
+Notes on :func:`gauss_newton`
+-----------------------------
+Scaling: in the variables x / sqrt(diag C0) the prior term is a correlation matrix, so
+``x_scale=1`` suits parameters of any magnitude. Stopping: least_squares' own tolerances (1e-12)
+are only a safety net; the Jacobian callback ends the solve when the undamped Gauss-Newton step
+within the box (:func:`scipy.optimize.lsq_linear`) moves no parameter by more than ``tol``
+posterior std, and that step is then taken, as the Kalman filter's last pass is (one more
+sensitivity call, unless the step is below ``tol**2`` std and reaches no bound): the error drops
+to about its square. A failed forward run gets a residual a thousand times the best one, so the
+trust region shrinks away from it; the failure is recorded with the number of linearisations
+done before it. ``max_nfev = 4 max_iterations`` bounds the rejected trial points as well.
+With an exact Jacobian (direct differentiation, docs/theory.md section 6) each iteration costs
+about one forward run, against 2 p + 1 with central differences. C is the Laplace (Gauss-Newton)
+posterior covariance, the Kalman filter's at its fixed point; on a bound it is the curvature
+there, not the spread of the one-sided posterior (see ``at_bound``).
 """
 
 from __future__ import annotations
@@ -11,7 +27,8 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares, lsq_linear
 
-from fracid.inverse.methods.kalman import KalmanResult, _box, _check_inputs
+from fracid.inverse.methods.kalman_status import KalmanResult
+from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity, memoized
 
 
@@ -28,12 +45,12 @@ class _WhitenedProblem:
     point is remembered as failed.
     """
 
-    def __init__(self, evaluate, sensitivity, executor, y_exp, C_exp, x0, C0, box, result):
+    def __init__(self, evaluate, sensitivity, executor, y_exp, C_exp, x0, C0, limits, result):
         self.evaluate, self.sensitivity, self.executor = memoized(evaluate), sensitivity, executor
         self.y_exp, self.x0, self.result = y_exp, x0, result
-        self.lower, self.upper = box
+        self.lower, self.upper = limits
         self.s = np.sqrt(np.diag(C0))
-        self.C_exp = C_exp  # a Covariance (from _check_inputs): used through its whitening
+        self.C_exp = C_exp  # a Covariance (from check_inputs): used through its whitening
         self.W0 = solve_triangular(np.linalg.cholesky(C0 / np.outer(self.s, self.s)), np.eye(x0.size), lower=True)
         self.points = {}  # x bytes -> (y, S), or None where the run failed
         self.best = np.inf  # smallest |r| met: a failed point gets a residual far above it
@@ -93,7 +110,8 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
     as the least-squares problem |r(x)|^2 of the whitened residual
     r(x) = [L_exp^-1 (h(x) - y_exp); L0^-1 (x - x0)] (C_exp = L_exp L_exp^T, C0 = L0 L0^T), solved by
     :func:`scipy.optimize.least_squares` (method ``"trf"``) in the variables x / sqrt(diag C0), with
-    the Jacobian [L_exp^-1 S; L0^-1] from ``sensitivity``. x and y are in the caller's units.
+    the Jacobian [L_exp^-1 S; L0^-1] from ``sensitivity``. x and y are in the caller's units. Scaling,
+    stopping rule, failed runs and the meaning of C: see the module's notes.
 
     Parameters
     ----------
@@ -127,46 +145,46 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
         failures (``{"iteration", "x", "error"}``), at_bound, and a history entry per linearisation
         ``{"iteration", "step", "observations", "x", "C"}``. Never raises for a failed forward run:
         when the run at the starting point fails, ``status = "stopped: ..."``.
-
-    Notes
-    -----
-    Scaling: in the variables x / sqrt(diag C0) the prior term is a correlation matrix, so
-    ``x_scale=1`` suits parameters of any magnitude. Stopping: least_squares' own tolerances (1e-12)
-    are only a safety net; the Jacobian callback ends the solve when the undamped Gauss-Newton step
-    within the box (:func:`scipy.optimize.lsq_linear`) moves no parameter by more than ``tol``
-    posterior std, and that step is then taken, as the Kalman filter's last pass is (one more
-    sensitivity call, unless the step is below ``tol**2`` std and reaches no bound): the error drops
-    to about its square. A failed forward run gets a residual a thousand times the best one, so the
-    trust region shrinks away from it; the failure is recorded with the number of linearisations
-    done before it. ``max_nfev = 4 max_iterations`` bounds the rejected trial points as well.
-    With an exact Jacobian (direct differentiation, docs/theory.md section 6) each iteration costs
-    about one forward run, against 2 p + 1 with central differences. C is the Laplace (Gauss-Newton)
-    posterior covariance, the Kalman filter's at its fixed point; on a bound it is the curvature
-    there, not the spread of the one-sided posterior (see ``at_bound``).
     """
-    y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
+    y_exp, C_exp, x0, C0 = check_inputs(y_exp, C_exp, x0, C0)
     if sensitivity is None:
         evaluate, sensitivity = exact_sensitivity(evaluate)
-    lower, upper = _box(bounds, x0.size)
+    lower, upper = box(bounds, x0.size)
     if np.any(lower >= upper):
         raise ValueError("gauss_newton needs lower < upper for every parameter; leave a fixed parameter out of x")
     x0 = np.clip(x0, lower, upper)
     result = KalmanResult(x=x0.copy(), C=C0.copy())
     problem = _WhitenedProblem(evaluate, sensitivity, executor, y_exp, C_exp, x0, C0, (lower, upper), result)
-    lb, ub = lower / problem.s, upper / problem.s
-    z_start = _strictly_inside(x0 / problem.s, lb, ub)  # least_squares' own nudge would be a new point
+    # off the bounds by our own margin: least_squares' own nudge would be a new point
+    z_start = _strictly_inside(x0 / problem.s, lower / problem.s, upper / problem.s)
     if problem.at(problem.x(z_start)) is None:
         result.y = np.full(y_exp.size, np.nan)
         result.status = f"stopped: the forward run at the starting point failed: {result.failures[-1]['error']}"
-        result.at_bound = _at_bound(x0, lower, upper)
+        result.at_bound = at_bound(x0, lower, upper)
         return result
+    message = _solve(problem, z_start, max_iterations, tol, callback)
+    x, y, C = _last_step(problem, tol, callback)
+    result.x, result.y, result.C, result.iterations = x, y, C, problem.iteration
+    result.status = ("converged" if result.converged else
+                     f"not converged: {message}, the last Gauss-Newton step was {problem.moved:.3g} std")
+    result.at_bound = at_bound(x, lower, upper)
+    return result
+
+
+def _solve(problem, z_start, max_iterations, tol, callback) -> str:
+    """Run least_squares from ``z_start`` until the stopping rule (module notes); returns why it stopped.
+
+    The Jacobian callback records every linearisation and the bounded Gauss-Newton step from it on
+    ``problem`` (``last``, ``step``, ``moved``), and ends the solve by raising :class:`_Done`.
+    """
+    lb, ub = problem.lower / problem.s, problem.upper / problem.s
 
     def jacobian(z):
         x = problem.x(z)
         y, J, C = problem.jacobian_at(x)
         problem.iteration += 1
         problem.last = (x, y, J, C)
-        _record(result, problem.iteration, x, C, y_exp.size, callback)
+        _record(problem.result, problem.iteration, x, C, problem.y_exp.size, callback)
         step = _step(J, problem.residual(z), lb - z, ub - z) * problem.s
         problem.moved = float(np.max(np.abs(step) / np.sqrt(np.diag(C))))
         problem.step = step
@@ -178,23 +196,28 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
         solved = least_squares(problem.residual, z_start, jac=jacobian, bounds=(lb, ub), method="trf",
                                x_scale=1.0, tr_solver="exact", ftol=1e-12, xtol=1e-12, gtol=1e-12,
                                max_nfev=4 * max_iterations)
-        message = f"least_squares stopped ({solved.message})"
+        return f"least_squares stopped ({solved.message})"
     except _Done:
-        message = f"{max_iterations} iterations reached"
+        return f"{max_iterations} iterations reached"
+
+
+def _last_step(problem, tol, callback):
+    """(x, y, C) at the last linearisation, or after the last Gauss-Newton step when converged (module notes).
+
+    Sets ``result.converged``; the step is skipped when below ``tol**2`` std and reaching no new bound, or
+    when its run fails.
+    """
+    result, lower, upper = problem.result, problem.lower, problem.upper
     x, y, _, C = problem.last
     result.converged = problem.moved <= tol
-    x_new = _snap(np.clip(x + problem.step, lower, upper), lower, upper)
-    reaches_bound = np.any(_at_bound(x_new, lower, upper) & ~_at_bound(x, lower, upper))
-    if result.converged and (problem.moved > tol**2 or reaches_bound):  # take the last step (Notes)
+    x_new = snap_to_bounds(np.clip(x + problem.step, lower, upper), lower, upper)
+    reaches_bound = np.any(at_bound(x_new, lower, upper) & ~at_bound(x, lower, upper))
+    if result.converged and (problem.moved > tol**2 or reaches_bound):
         if problem.at(x_new) is not None:
             problem.iteration += 1
             (y, _, C), x = problem.jacobian_at(x_new), x_new
-            _record(result, problem.iteration, x, C, y_exp.size, callback)
-    result.x, result.y, result.C, result.iterations = x, y, C, problem.iteration
-    result.status = ("converged" if result.converged else
-                     f"not converged: {message}, the last Gauss-Newton step was {problem.moved:.3g} std")
-    result.at_bound = _at_bound(x, lower, upper)
-    return result
+            _record(result, problem.iteration, x, C, problem.y_exp.size, callback)
+    return x, y, C
 
 
 def _step(J, r, lo, hi):
@@ -216,19 +239,3 @@ def _strictly_inside(z, lb, ub):
     z = np.where(z < lo, lo, np.where(z > hi, hi, z))
     with np.errstate(invalid="ignore"):  # lb + ub of an unbounded parameter, not used
         return np.where(lo > hi, 0.5 * (lb + ub), z)
-
-
-def _span(lower, upper, x):
-    return np.where(np.isfinite(upper - lower), upper - lower, np.abs(x) + 1.0)
-
-
-def _snap(x, lower, upper):
-    """Within 1e-9 of the box's span from a bound: on it (the solvers' tolerance)."""
-    span = _span(lower, upper, x)
-    x = np.where(x - lower <= 1e-9 * span, lower, x)
-    return np.where(upper - x <= 1e-9 * span, upper, x)
-
-
-def _at_bound(x, lower, upper):
-    span = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
-    return (np.abs(x - lower) <= 1e-9 * span) | (np.abs(upper - x) <= 1e-9 * span)

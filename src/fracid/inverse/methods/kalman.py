@@ -1,13 +1,28 @@
-"""Kalman filter for parameter identification (docs/theory.md, section 4.3): step by step, and the batch variant."""
+"""Kalman filter for parameter identification (docs/theory.md, section 4.3): step by step, and the batch variant.
+
+Bounds
+    An update that leaves the box is projected back by :func:`project_to_box` (the most probable point
+    of the update's Gaussian inside the box), and backtracking only moves between points of the box, so
+    every point the filter evaluates is inside it. The covariance is the linearised posterior's, unchanged
+    by the projection. For a parameter on a bound it describes the curvature of the objective there, not
+    the spread of a posterior cut by the bound: the true posterior is one-sided, and the parameter is
+    flagged in ``at_bound``.
+Oscillation
+    When the estimates of successive passes alternate (:func:`~fracid.inverse.methods.kalman_status.oscillates`),
+    the steps are under-relaxed, halved at each detection down to
+    :data:`~fracid.inverse.methods.kalman_status.MIN_RELAXATION` (``result.relaxation``).
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.methods.assimilation import assimilate, information_update, kalman_update  # noqa: F401
 from fracid.inverse.methods.kalman_status import GaussianEstimate, KalmanResult, judge_last_pass, relaxed  # noqa: F401
+from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
 
 
@@ -29,10 +44,7 @@ def project_to_box(x, C, lower, upper) -> np.ndarray:
         z = lsq_linear(W, W @ (x / scale), bounds=(lower / scale, upper / scale)).x * scale
     except (np.linalg.LinAlgError, ValueError):
         z = x
-    z = np.clip(z, lower, upper)
-    span = np.where(np.isfinite(upper - lower), upper - lower, np.abs(z) + 1.0)
-    z = np.where(z - lower <= 1e-9 * span, lower, z)  # the solver's tolerance: an active bound is exact
-    return np.where(upper - z <= 1e-9 * span, upper, z)
+    return snap_to_bounds(np.clip(z, lower, upper), lower, upper)
 
 
 def _observation_groups(n, groups):
@@ -43,29 +55,6 @@ def _observation_groups(n, groups):
     if not np.array_equal(np.sort(flat), np.arange(n)) or np.any(np.diff([g.max() for g in groups]) <= 0):
         raise ValueError("observation groups must cover every observation once, in increasing order")
     return groups
-
-
-def _check_inputs(y_exp, C_exp, x0, C0):
-    """y_exp, x0 as float arrays, C_exp as a Covariance of their size, C0 checked (p, p) symmetric positive definite."""
-    y_exp, x0 = np.asarray(y_exp, float), np.asarray(x0, float)
-    C_exp = as_covariance(C_exp if np.ndim(C_exp) != 0 else np.atleast_2d(C_exp), name="C_exp")
-    if C_exp.n != y_exp.size:
-        raise ValueError(f"C_exp has shape {C_exp.shape}; expected {(y_exp.size, y_exp.size)}")
-    C0 = np.atleast_2d(np.asarray(C0, float))
-    if C0.shape != (x0.size, x0.size):
-        raise ValueError(f"C0 has shape {C0.shape}; expected {(x0.size, x0.size)}")
-    if not np.allclose(C0, C0.T) or np.any(np.linalg.eigvalsh(0.5 * (C0 + C0.T)) <= 0):
-        raise ValueError("C0 must be symmetric positive definite")
-    return y_exp, C_exp, x0, C0
-
-
-def _box(bounds, p):
-    if bounds is None:
-        return np.full(p, -np.inf), np.full(p, np.inf)
-    lower, upper = (np.broadcast_to(np.asarray(b, float), (p,)).copy() for b in bounds)
-    if np.any(lower > upper):
-        raise ValueError(f"bounds: lower {lower.tolist()} above upper {upper.tolist()}")
-    return lower, upper
 
 
 def _converged(x_new, x_old, C, tol):
@@ -125,25 +114,9 @@ class _Linearizer:
         self.result.failures.append({**where, "x": point.tolist(), "error": error})
 
 
-def kalman_filter(
-    evaluate,
-    y_exp,
-    C_exp,
-    x0,
-    C0,
-    *,
-    groups=None,
-    max_iterations: int = 10,
-    tol: float = 0.01,
-    restart: str = "linearize",
-    sensitivity=None,
-    executor=None,
-    bounds=None,
-    callback=None,
-    max_backtracks: int = 4,
-    names=None,
-    damping: bool = True,
-) -> KalmanResult:
+def kalman_filter(evaluate, y_exp, C_exp, x0, C0, *, groups=None, max_iterations: int = 10, tol: float = 0.01,
+                  restart: str = "linearize", sensitivity=None, executor=None, bounds=None, callback=None,
+                  max_backtracks: int = 4, names=None, damping: bool = True) -> KalmanResult:
     """Step-by-step Kalman filter with global iterations (docs/theory.md, section 4.3), bounded and failure tolerant.
 
     For t = 1..n the observations of group t are assimilated with :func:`kalman_update`, using
@@ -186,15 +159,15 @@ def kalman_filter(
     executor : Executor, optional
         Runs the 2 p + 1 runs of central differences in parallel.
     bounds : (lower, upper) arrays, optional
-        The box every estimate stays in (the identification bounds).
+        The box every estimate stays in (the identification bounds; see the module's notes).
     callback : callable(iteration, step, x, C), optional
     max_backtracks : int
         Halvings of a step towards the last good point when the run at the filter's point fails.
     names : sequence of str, optional
         Parameter names, for the status (a valley names its pair).
     damping : bool
-        Under-relax the steps when the estimates of successive passes alternate (see Notes); False: the
-        oscillation is only reported.
+        Under-relax the steps when the estimates of successive passes alternate (see the module's
+        notes); False: the oscillation is only reported.
 
     Returns
     -------
@@ -203,67 +176,65 @@ def kalman_filter(
         stops with the last complete estimate and ``status = "stopped: ..."``. The status judges
         convergence on the last pass's step in std and objective change
         (:func:`~fracid.inverse.methods.kalman_status.judge`): the loop itself stops at ``tol``.
-
-    Notes
-    -----
-    Bounds: an update that leaves the box is projected back by :func:`project_to_box` (the most
-    probable point of the update's Gaussian inside the box), and backtracking only moves between
-    points of the box, so every point the filter evaluates is inside it. The covariance is the
-    linearised posterior's, unchanged by the projection. For a parameter on a bound it describes the
-    curvature of the objective there, not the spread of a posterior cut by the bound: the true
-    posterior is one-sided, and the parameter is flagged in ``at_bound``.
-
-    Oscillation: when the estimates of successive passes alternate
-    (:func:`~fracid.inverse.methods.kalman_status.oscillates`), the steps are under-relaxed, halved at each
-    detection down to :data:`~fracid.inverse.methods.kalman_status.MIN_RELAXATION` (``result.relaxation``).
     """
     if restart not in ("linearize", "prior-mean"):
         raise ValueError(f"restart = {restart!r}; choose 'linearize' or 'prior-mean'")
-    y_exp, C_exp, x0, C0 = _check_inputs(y_exp, C_exp, x0, C0)
+    y_exp, C_exp, x0, C0 = check_inputs(y_exp, C_exp, x0, C0)
     if sensitivity is None:
         evaluate, sensitivity = exact_sensitivity(evaluate)
     groups = _observation_groups(y_exp.size, groups)
-    lower, upper = _box(bounds, x0.size)
+    lower, upper = box(bounds, x0.size)
     x0 = np.clip(x0, lower, upper)
     result = KalmanResult(x=x0.copy(), C=C0.copy(), passes=[{"iteration": 0, "x": x0.copy()}])
     lin = _Linearizer(evaluate, sensitivity, executor, result, max_backtracks, y_exp.size)
     objective = _map_objective(y_exp, C_exp, x0, C0 if restart == "linearize" else None)
-    previous, stopped, last = x0.copy(), "", None
+    problem = _FilterProblem(y_exp, C_exp, x0, C0, groups, lower, upper, restart == "linearize", callback)
+    stopped, last = _global_iterations(problem, lin, objective, result, max_iterations, tol, damping)
+    if not _finish(result, lin, lower, upper, stopped):
+        judge_last_pass(result, lambda x: lin.objective_at(x, objective), objective, last, max_iterations, names)
+    return result
+
+
+@dataclass(frozen=True)
+class _FilterProblem:
+    """What every pass of the filter assimilates: the checked data, prior, observation groups and box."""
+
+    y_exp: np.ndarray
+    C_exp: object
+    x0: np.ndarray
+    C0: np.ndarray
+    groups: list
+    lower: np.ndarray
+    upper: np.ndarray
+    linearize: bool  # restart="linearize": every pass from the prior, one linearisation per pass
+    callback: object = None
+
+
+def _global_iterations(problem, lin, objective, result, max_iterations, tol, damping):
+    """The passes of the filter, until converged, stopped by a failed run, or ``max_iterations``.
+
+    Returns
+    -------
+    stopped : str
+        Why a failed run stopped the filter ("" if none did).
+    last : tuple or None
+        (the last pass's linearisation point, its estimate, the objective at the point or None), for
+        :func:`~fracid.inverse.methods.kalman_status.judge_last_pass`.
+    """
+    previous, last = problem.x0.copy(), None
     for iteration in range(1, max_iterations + 1):
-        fixed_point = restart == "linearize" and iteration > 1
-        x, C = (x0.copy() if restart == "linearize" else previous.copy()), C0.copy()
-        f_start = None
-        if fixed_point:  # one linearisation for the whole pass
-            anchor = lin.last_full[0] if lin.last_full is not None else None
-            accept = None if anchor is None else _decreases(objective, *lin.last_full)
-            got = lin.at(previous, anchor, None, {"iteration": iteration, "step": 0}, accept)
-            if got is None:  # keep the last point that ran (and its pass's covariance)
-                stopped = f"at iteration {iteration}: {lin.last_error}"
-                result.x = anchor if anchor is not None else result.x
-                break
-            previous, y_lin, S_lin = got
-            f_start = objective(previous, y_lin)
+        fixed, f_start = None, None
+        if problem.linearize and iteration > 1:
+            fixed = _relinearize(lin, objective, previous, iteration, result)
+            if fixed is None:
+                return f"at iteration {iteration}: {lin.last_error}", last
+            previous = fixed[0]
+            f_start = objective(previous, fixed[1])
             result.passes[-1]["objective"] = f_start
-        last_point = None
-        for step, rows in enumerate(groups, start=1):
-            if fixed_point:
-                point, y, S = previous, y_lin, S_lin
-            else:
-                got = lin.at(x, last_point, int(rows.max()) + 1, {"iteration": iteration, "step": step})
-                if got is None:
-                    stopped = f"at iteration {iteration}, step {step}: {lin.last_error}"
-                    break
-                point, y, S = got
-                x = last_point = point
-            innovation = y_exp[rows] - y[rows] - S[rows] @ (x - point)
-            x, C, _ = assimilate(x, C, S[rows], innovation, C_exp.take(rows))
-            x = project_to_box(x, C, lower, upper)
-            result.history.append({"iteration": iteration, "step": step, "observations": rows.tolist(),
-                                   "x": x.copy(), "C": C.copy()})
-            if callback is not None:
-                callback(iteration, step, x, C)
+        start = problem.x0 if problem.linearize else previous
+        x, C, stopped = _one_pass(problem, lin, result, iteration, start.copy(), problem.C0.copy(), fixed)
         if stopped:
-            break
+            return stopped, last
         result.iterations = iteration
         last = (previous, x, f_start)
         result.converged = iteration > 1 and _converged(x, previous, C, tol)
@@ -272,9 +243,52 @@ def kalman_filter(
         result.passes.append({"iteration": iteration, "x": x.copy()})
         if result.converged:
             break
-    if not _finish(result, lin, lower, upper, stopped):
-        judge_last_pass(result, lambda x: lin.objective_at(x, objective), objective, last, max_iterations, names)
-    return result
+    return "", last
+
+
+def _relinearize(lin, objective, previous, iteration, result):
+    """(point, y, S) of the pass's one linearisation, at the last estimate or backtracked towards the last full
+    run while its objective rises; None when no point runs (then ``result.x`` is that last full run's point)."""
+    anchor = lin.last_full[0] if lin.last_full is not None else None
+    accept = None if anchor is None else _decreases(objective, *lin.last_full)
+    got = lin.at(previous, anchor, None, {"iteration": iteration, "step": 0}, accept)
+    if got is None:  # keep the last point that ran (and its pass's covariance)
+        result.x = anchor if anchor is not None else result.x
+    return got
+
+
+def _one_pass(problem, lin, result, iteration, x, C, fixed):
+    """One pass over the observation groups from (x, C).
+
+    Parameters
+    ----------
+    fixed : (point, y, S) or None
+        The pass's one linearisation; None: linearise at the running estimate before every step.
+
+    Returns
+    -------
+    x, C, stopped
+        The estimate and covariance after the last group, and why a failed run stopped the pass ("" if
+        none did).
+    """
+    last_point = None
+    for step, rows in enumerate(problem.groups, start=1):
+        if fixed is not None:
+            point, y, S = fixed
+        else:
+            got = lin.at(x, last_point, int(rows.max()) + 1, {"iteration": iteration, "step": step})
+            if got is None:
+                return x, C, f"at iteration {iteration}, step {step}: {lin.last_error}"
+            point, y, S = got
+            x = last_point = point
+        innovation = problem.y_exp[rows] - y[rows] - S[rows] @ (x - point)
+        x, C, _ = assimilate(x, C, S[rows], innovation, problem.C_exp.take(rows))
+        x = project_to_box(x, C, problem.lower, problem.upper)
+        result.history.append({"iteration": iteration, "step": step, "observations": rows.tolist(),
+                               "x": x.copy(), "C": C.copy()})
+        if problem.callback is not None:
+            problem.callback(iteration, step, x, C)
+    return x, C, ""
 
 
 def _map_objective(y_exp, C_exp, x0, C0):
@@ -313,8 +327,7 @@ def _finish(result, lin, lower, upper, stopped) -> str:
     if stopped:
         result.converged = False
         result.status = f"stopped: {stopped}"
-    span = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
-    result.at_bound = (np.abs(result.x - lower) <= 1e-9 * span) | (np.abs(upper - result.x) <= 1e-9 * span)
+    result.at_bound = at_bound(result.x, lower, upper)
     return stopped
 
 

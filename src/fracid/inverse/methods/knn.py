@@ -164,7 +164,7 @@ def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="s
         Runs the population in parallel (see :mod:`fracid.parallel`).
     store : RunStore, optional
         Stored runs are reused, new ones stored as they finish (an interrupted population resumes).
-    stats : fracid.parallel.BatchStats, optional
+    stats : fracid.batch.BatchStats, optional
         Filled with the numbers of runs computed, reused and failed.
     retry_failed : bool
         Run again the points stored as failed.

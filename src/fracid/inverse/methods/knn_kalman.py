@@ -23,7 +23,7 @@ from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_p
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.core.space import ParameterSpace
-from fracid.parallel import BatchStats
+from fracid.batch import BatchStats
 
 
 def _knn_kalman_stages() -> dict:

@@ -17,7 +17,8 @@ Units: control (CMOD) [mm], force [N], energy [N mm]; parameters in the units of
 
 Example
 -------
->>> from fracid.inverse.studies.cross_model import Candidate, compare_models
+>>> from fracid.inverse.studies.cross_model import compare_models
+>>> from fracid.inverse.studies.model_fit import Candidate
 >>> table = compare_models(data, beam, [Candidate("cohesive", CohesiveCrackModel(), CohesiveParameters(E=37000.0),
 ...                                               ("ft", "Gf"), space)], n=16, k=3)   # doctest: +SKIP
 >>> table.rows()                                                                     # doctest: +SKIP
@@ -25,141 +26,17 @@ Example
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from fracid.data import Diagonal, ExperimentalData
-from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.sensitivity import ForwardRunError
-from fracid.inverse.methods.strategy import IdentificationResult, identify_data
+from fracid.inverse.studies.model_fit import Candidate, ModelFit, fit_model, run_to_end
 from fracid.models import ConvergenceError
 
-__all__ = [
-    "Candidate",
-    "CrossCalibration",
-    "ModelComparison",
-    "ModelFit",
-    "compare_models",
-    "cross_calibration",
-    "fit_model",
-    "relative_rms",
-    "run_to_end",
-]
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """A model to fit: its forward model, fixed parameters, identified names and search space.
-
-    Parameters
-    ----------
-    label : str
-        Name of the row in tables and figures.
-    model : ForwardModel
-        E.g. ``DamageModel("gradient")`` or ``CohesiveCrackModel()`` (:mod:`fracid.models`).
-    base : parameter object
-        Values of the parameters that are not identified (an instance of ``model.parameters``).
-    names : sequence of str
-        Identified parameters.
-    space : ParameterSpace
-        Bounds (and log flags) of the KNN population over ``names``.
-    specimen : object, optional
-        The specimen this model runs on (e.g. its own mesh); None: the one given to the caller.
-    settings : dict, optional
-        Settings of :func:`~fracid.inverse.methods.strategy.identify` for this candidate only (``n``, ``k``,
-        ``groups``, ...), overriding the shared ones.
-    """
-
-    label: str
-    model: object
-    base: object
-    names: tuple
-    space: ParameterSpace
-    specimen: object = None
-    settings: dict = field(default_factory=dict)
-
-    def __post_init__(self):
-        object.__setattr__(self, "names", tuple(self.names))
-        if tuple(self.space.names) != self.names:
-            raise ValueError(f"candidate {self.label!r}: the space is over {tuple(self.space.names)} but the "
-                             f"identified parameters are {self.names}")
-
-
-@dataclass
-class ModelFit:
-    """One model fitted to one data set, and its run at the estimate.
-
-    Attributes
-    ----------
-    label, model_key : str
-        The candidate's label and the model's ``key``.
-    identification : IdentificationResult
-        Estimate ``x``, covariance ``C``, the fit ``y_fit`` at the data's points, runs, ...
-    params : parameter object
-        The full parameter set at the estimate.
-    control, force : ndarray
-        Curve of the run at the estimate from 0 to the last data control value [mm], [N].
-    rms_relative : float
-        RMS of ``y_fit - y`` over the data points divided by the data's largest |y| [-].
-    peak_force : float
-        Largest force of the run at the estimate [N].
-    dissipated_energy : float
-        Energy dissipated by the run at the estimate up to the last data control value [N mm]
-        (NaN if that run stopped before it).
-    forward_runs : int
-        Forward runs of the identification: KNN population plus Kalman filter (the run at the
-        estimate is not counted).
-    seconds : float
-        Wall time of the identification and of the run at the estimate [s].
-    """
-
-    label: str
-    model_key: str
-    identification: IdentificationResult
-    params: object
-    control: np.ndarray
-    force: np.ndarray
-    rms_relative: float
-    peak_force: float
-    dissipated_energy: float
-    forward_runs: int
-    seconds: float
-
-    @property
-    def names(self) -> list:
-        return list(self.identification.names)
-
-    @property
-    def x(self) -> np.ndarray:
-        """The estimate (units of the parameters)."""
-        return np.asarray(self.identification.x, float)
-
-    @property
-    def std(self) -> np.ndarray:
-        """Standard deviations of the estimate from the Kalman filter's covariance."""
-        return np.asarray(self.identification.std, float)
-
-    @property
-    def units(self) -> dict:
-        return dict(self.identification.units)
-
-    def row(self) -> dict:
-        """A plain dict for tables and JSON: ``label``, ``model``, ``parameters`` ({name: {value, std,
-        unit}}), ``rms_percent``, ``peak_force_N``, ``dissipated_energy_Nmm``, ``forward_runs``,
-        ``converged``, ``status`` (of the Kalman filter), ``seconds``."""
-        units = self.units
-        return {
-            "label": self.label, "model": self.model_key,
-            "parameters": {n: {"value": float(v), "std": float(s), "unit": units.get(n, "")}
-                           for n, v, s in zip(self.names, self.x, self.std)},
-            "rms_percent": 100.0 * self.rms_relative, "peak_force_N": self.peak_force,
-            "dissipated_energy_Nmm": self.dissipated_energy, "forward_runs": self.forward_runs,
-            "converged": bool(self.identification.converged), "status": self.identification.status,
-            "seconds": self.seconds,
-        }
+__all__ = ["CrossCalibration", "ModelComparison", "compare_models", "cross_calibration"]
 
 
 @dataclass
@@ -218,95 +95,6 @@ class CrossCalibration:
     def energy_ratio(self) -> float:
         """Dissipated energy of the fitted model B over that of the source A [-], both to the last point."""
         return self.fit.dissipated_energy / self.source_energy
-
-
-def relative_rms(y_fit, y) -> float:
-    """RMS of ``y_fit - y`` divided by the largest |y| [-] (NaN entries of ``y_fit`` count as missing)."""
-    y_fit, y = np.asarray(y_fit, float), np.asarray(y, float)
-    both = np.isfinite(y_fit) & np.isfinite(y)
-    if not both.any():
-        return float("nan")
-    return float(np.sqrt(np.mean((y_fit[both] - y[both]) ** 2)) / np.max(np.abs(y)))
-
-
-def run_to_end(model, specimen, params, control_points, *, control="cmod", steps=None):
-    """One run of ``model`` from 0 to the last of ``control_points``, landing on each of them.
-
-    Parameters
-    ----------
-    model : ForwardModel
-    specimen : object
-    params : parameter object
-    control_points : array_like
-        Increasing control values [mm]; the run stops at the last one (no stop on the force).
-    control : str
-        The specimen's control quantity.
-    steps : StepOptions, optional
-        Step rule (the specimen's default if None).
-
-    Returns
-    -------
-    run : PathResult
-        The run (the partial run if it stopped on a ConvergenceError).
-    dissipated_energy : float
-        ``observables["dissipated_energy"]`` at the last control point [N mm]; NaN if not reached or
-        if the model does not report it.
-    """
-    points = np.asarray(control_points, float)
-    target = float(points[-1])
-    try:
-        run = model.simulate(specimen, params, control=control, target=target, stop_force_fraction=None,
-                             steps=steps, field_steps=None, checkpoints=points)
-    except ConvergenceError as err:
-        run = err.partial
-    reached = run.control.size > 0 and run.control[-1] >= target * (1.0 - 1e-9)
-    dissipated = run.observables.get("dissipated_energy")
-    energy = float(np.interp(target, run.control, dissipated)) if reached and dissipated is not None else float("nan")
-    return run, energy
-
-
-def fit_model(data: ExperimentalData, candidate: Candidate, specimen=None, *, control="cmod", steps=None,
-              **settings) -> ModelFit:
-    """Identify one candidate model on force data, then run it at the estimate.
-
-    Parameters
-    ----------
-    data : ExperimentalData
-        Force blocks [N] at control values [mm] of one specimen (every block is a force curve).
-    candidate : Candidate
-    specimen : object, optional
-        Used when ``candidate.specimen`` is None.
-    control : str
-        Control quantity of the data (``"cmod"`` for the notched beam).
-    steps : StepOptions, optional
-        Step rule of every forward run (the specimen's default if None): the data's control
-        values are landed on exactly whatever the rule, so a coarser rule than the default
-        changes the computed points little and saves time.
-    **settings
-        Passed to :func:`~fracid.inverse.methods.strategy.identify_data` (``n``, ``k``, ``groups``,
-        ``executor``, ``store``, ``progress``, ...); ``candidate.settings`` override them.
-
-    Returns
-    -------
-    ModelFit
-    """
-    start = time.perf_counter()
-    specimen = candidate.specimen if candidate.specimen is not None else specimen
-    if specimen is None:
-        raise ValueError(f"candidate {candidate.label!r} has no specimen and none was given")
-    observations = [Observation(specimen, data.control[a:b], quantity="force", control=control, name=name)
-                    for name, a, b in data.blocks]
-    operator = ForwardOperator(observations, candidate.base, candidate.names, model=candidate.model, steps=steps)
-    result = identify_data(operator, data, candidate.space, **{**settings, **candidate.settings})
-    params = operator.parameters(result.x)
-    run, energy = run_to_end(candidate.model, specimen, params, data.control, control=control, steps=steps)
-    return ModelFit(
-        label=candidate.label, model_key=candidate.model.key, identification=result, params=params,
-        control=np.asarray(run.control, float), force=np.asarray(run.force, float),
-        rms_relative=relative_rms(result.y_fit, data.y), peak_force=float(np.max(run.force)),
-        dissipated_energy=energy, forward_runs=result.forward_runs,
-        seconds=time.perf_counter() - start,
-    )
 
 
 def compare_models(data: ExperimentalData, specimen, candidates, *, control="cmod", steps=None, log=None,
@@ -431,16 +219,8 @@ def cross_calibration(source_model, source_params, target_model, target_base, ta
     points = np.asarray(cmod_points, float)
     if log is not None:
         log(f"source: {source_label} to {control} = {points[-1]:g} mm")
-    run, energy = run_to_end(source_model, specimen, source_params, points, control=control, steps=steps)
-    if not np.isfinite(energy):
-        raise RuntimeError(f"the source run ({source_label}, {source_params}) stopped at {control} = "
-                           f"{run.control[-1]:.6g} mm, before the last point {points[-1]:.6g} mm")
-    y = np.interp(points, run.control, run.force)
-    std = relative_std * float(np.max(np.abs(y)))
-    notes = (f"cross-calibration data: force of {source_label} at {source_params}, {points.size} {control} points "
-             f"from {points[0]:g} to {points[-1]:g} mm, no noise added; std {std:.4g} N "
-             f"({relative_std:g} of its peak) at every point",)
-    data = ExperimentalData(points, y, Diagonal(np.full(points.size, std**2)), (("global", 0, points.size),), notes)
+    run, energy = _source_run(source_model, specimen, source_params, points, source_label, control, steps)
+    data = _source_data(points, run, source_label, source_params, relative_std, control)
     candidate = Candidate(target_label, target_model, target_base, target_names, space, target_specimen)
     if log is not None:
         log(f"target: fitting {target_label} ({', '.join(candidate.names)})")
@@ -450,3 +230,29 @@ def cross_calibration(source_model, source_params, target_model, target_base, ta
     return CrossCalibration(source_label=source_label, source_params=source_params,
                             source_control=np.asarray(run.control, float), source_force=np.asarray(run.force, float),
                             source_energy=energy, data=data, fit=fit)
+
+
+def _source_run(model, specimen, params, points, label, control, steps):
+    """The source run to the last of ``points`` and the energy it dissipated there [N mm].
+
+    Raises
+    ------
+    RuntimeError
+        If the run stops before the last point: the data would end early.
+    """
+    run, energy = run_to_end(model, specimen, params, points, control=control, steps=steps)
+    if not np.isfinite(energy):
+        raise RuntimeError(f"the source run ({label}, {params}) stopped at {control} = "
+                           f"{run.control[-1]:.6g} mm, before the last point {points[-1]:.6g} mm")
+    return run, energy
+
+
+def _source_data(points, run, label, params, relative_std, control) -> ExperimentalData:
+    """The source run's force at ``points`` as one block of data, no noise added, with the standard deviation
+    ``relative_std`` times its peak at every point."""
+    y = np.interp(points, run.control, run.force)
+    std = relative_std * float(np.max(np.abs(y)))
+    notes = (f"cross-calibration data: force of {label} at {params}, {points.size} {control} points "
+             f"from {points[0]:g} to {points[-1]:g} mm, no noise added; std {std:.4g} N "
+             f"({relative_std:g} of its peak) at every point",)
+    return ExperimentalData(points, y, Diagonal(np.full(points.size, std**2)), (("global", 0, points.size),), notes)

@@ -167,13 +167,7 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
     study.runs[search_label] = (len(overview.points), overview.n_failed)
     study.stage("search")
     C0 = overview.C0 if settings.prior == "knn" else C_bounds
-    with study.counting("sensitivity", evaluate, f"sensitivity along the load history at the {search_label} estimate"):
-        try:
-            history = sensitivity_history(evaluate, overview.x0, C, C_bounds, names=space.names, blocks=data.blocks,
-                                          executor=executor)
-        except ForwardRunError as err:
-            history = None
-            study.notes.append(f"sensitivity history skipped: {err}")
+    history = _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_label, executor)
     with study.counting(refine_label, evaluate, f"{refine_label} from the {search_label} prior"):
         ident = method.refine(evaluate, y, C, overview, executor=executor, blocks=list(data.blocks),
                               notes=list(data.notes), C0=C0, progress=progress)
@@ -200,6 +194,18 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
                                  tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=usable)
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, study.timings, study.runs,
                        study.notes, posterior=post)
+
+
+def _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_label, executor):
+    """The sensitivity along the load history at the search's estimate (None, with a note, when a run fails)."""
+    history = None
+    with study.counting("sensitivity", evaluate, f"sensitivity along the load history at the {search_label} estimate"):
+        try:
+            history = sensitivity_history(evaluate, overview.x0, data.covariance, C_bounds, names=space.names,
+                                          blocks=data.blocks, executor=executor)
+        except ForwardRunError as err:
+            study.notes.append(f"sensitivity history skipped: {err}")
+    return history
 
 
 def _stage_labels(method) -> tuple[str, str]:

@@ -1,0 +1,56 @@
+"""The vocabulary of a TOML configuration: the keys each section allows and the values its choices
+take (units with their scale to mm and N, the kinds of data, the roles of an experiment, ...).
+
+The schema itself, with every key explained, is the docstring of :mod:`fracid.config.schema`.
+"""
+
+from __future__ import annotations
+
+# ------------------------------------------------------------------------------------ values
+
+#: ``control_unit`` -> multiplier to mm
+CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
+#: ``delimiter`` values -> the cell separator ("tab" spells a tab; " " is any run of whitespace)
+DELIMITERS = {",": ",", ";": ";", "\t": "\t", "tab": "\t", " ": " "}
+DECIMALS = (".", ",")
+#: ``force_unit`` of a force -> multiplier to N
+FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
+#: ``force_unit`` of a local quantity (a length) -> multiplier to mm
+LOCAL_UNITS = dict(CONTROL_UNITS)
+KINDS = ("repeats", "envelope", "single")
+#: ``[identify.knn] method``: how the KNN population is sampled
+KNN_METHODS = ("sobol", "lhs", "grid")
+RESTARTS = ("linearize", "prior-mean")
+PURPOSES = ("identify", "simulate")
+ROLES = ("calibration", "prediction")
+
+# ------------------------------------------------------------------------------------ keys
+
+TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study", "posterior")
+MODEL_KEYS = ("type", "parameters")
+EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
+                   "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
+                   "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
+                   "backtrack_tolerance", "negate", "sampling")
+#: ``kind`` -> the keys of its data columns (and of its std)
+KIND_KEYS = {
+    "repeats": ("force_columns",),
+    "envelope": ("mean_column", "lower_column", "upper_column"),
+    "single": ("force_columns", "std", "relative_std"),
+}
+IDENTIFY_KEYS = ("parameters", "method", "bounds", "knn", "kalman", "gauss-newton")
+KNN_KEYS = ("n", "method", "k", "seed")
+KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
+GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
+OUTPUT_KEYS = ("directory", "vtk_steps")
+SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
+STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
+POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
+
+# ------------------------------------------------------------------------------------ inverse methods
+
+#: the default of [identify] method (a key of fracid.inverse.methods.registry.METHODS)
+DEFAULT_INVERSE_METHOD = "knn-kalman"
+#: a built-in ``[identify.<section>]`` of one method's settings -> the method that reads it; a section given
+#: for another method is warned of. A registered method's own table ``[identify.<name>]`` is its name's.
+SECTION_METHODS = {"gauss-newton": "knn-gauss-newton"}
