@@ -39,7 +39,7 @@ local or integral damage; cohesive interface; crack band) with a material law
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
@@ -47,7 +47,7 @@ import numpy as np
 from fracid.fem.formulations.crack_band_problem import CrackBandProblem, element_extent
 from fracid.fem.formulations.cohesive_problem import CohesiveCrackProblem, crack_edges
 from fracid.fem.formulations.fpz import zone_width_observer
-from fracid.fem.material.laws import DamageLaw, HordijkLaw
+from fracid.fem.material.laws import TRACTION_SEPARATION_LAWS, DamageLaw, HordijkLaw
 from fracid.fem.mesh.probes import probe_matrix
 from fracid.fem.material.tsl import differentiable as gives_derivatives
 from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOptions, follow_path
@@ -58,7 +58,7 @@ from fracid.specimens.description import uniform, at_points, conditions, discret
 
 __all__ = ["IMPLAUSIBLE_FACTOR", "probe_matrix", "MODEL_TYPES", "USUAL_RANGES", "CohesiveCrackModel", "ConvergenceError",
            "CrackBandModel", "DamageModel", "ForwardModel", "ModelDefaults", "PathResult", "StepOptions", "declared",
-           "implausible", "known_units", "model_from_type", "parameter_units", "runs_on", "usual_range_text"]
+           "implausible", "known_units", "model_from_type", "model_laws", "parameter_units", "runs_on", "usual_range_text"]
 
 
 def _description(specimen):
@@ -337,9 +337,24 @@ MODEL_TYPES = {
 }
 
 
-def model_from_type(name: str):
-    """The forward model named ``name`` in a configuration's ``[model] type`` (see :data:`MODEL_TYPES`)."""
+def model_from_type(name: str, law: str | None = None):
+    """The forward model named ``name`` in a configuration's ``[model] type`` (see :data:`MODEL_TYPES`), with
+    the law named ``law`` among its :func:`model_laws` (None: its default law)."""
     try:
-        return MODEL_TYPES[name]()
+        model = MODEL_TYPES[name]()
     except KeyError:
         raise ValueError(f"model type = {name!r}; choose one of {sorted(MODEL_TYPES)}") from None
+    if law is None:
+        return model
+    laws = model_laws(model)
+    if law not in laws:
+        allowed = ", ".join(map(repr, laws)) or "none: its law is fixed"
+        raise ValueError(f"law = {law!r} for model type {name!r}; choose one of {allowed}")
+    return replace(model, law=laws[law]())
+
+
+def model_laws(model) -> dict:
+    """The laws a configuration may give ``model`` by name (``[model] law``): the traction-separation laws
+    (:data:`~fracid.fem.material.laws.TRACTION_SEPARATION_LAWS`) for the crack models; none for the others
+    (their law is given in Python: ``DamageModel(law=...)``)."""
+    return dict(TRACTION_SEPARATION_LAWS) if isinstance(model, _CrackModel) else {}

@@ -78,20 +78,30 @@ def executor_width(executor) -> int:
     return max(1, int(getattr(executor, "_max_workers", 1)))
 
 
-def concurrently(function, items, executor) -> list:
+def concurrently(function, items, executor, progress=None) -> list:
     """``[function(item) for item in items]``, as many at once as ``executor`` has workers.
 
     For independent sequential procedures whose steps are forward runs on ``executor`` (the filters
     of a multi-start check or of noisy replicates): each runs in a thread of this process and
     submits its runs to the executor, so the workers stay busy although every procedure waits for
     its own run. Results in the order of ``items``; an exception of ``function`` propagates.
+    ``progress(done, total)``, when given, is called after each procedure ends.
     """
     items = list(items)
+    done = []
+
+    def counted(item):
+        result = function(item)
+        done.append(item)
+        if progress is not None:
+            progress(len(done), len(items))
+        return result
+
     width = min(executor_width(executor), len(items))
     if width <= 1:
-        return [function(item) for item in items]
+        return [counted(item) for item in items]
     with cf.ThreadPoolExecutor(width, thread_name_prefix="fracid-concurrent") as threads:
-        return list(threads.map(function, items))
+        return list(threads.map(counted, items))
 
 
 def make_executor(workers=None, scheduler: str | None = None):

@@ -23,7 +23,7 @@ def _require(cfg: Config, section: str):
 
 def build_model(cfg: Config):
     """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
-    return model_of(cfg.model.type)
+    return model_of(cfg.model.type, cfg.model.law)
 
 
 def build_parameters(cfg: Config):

@@ -52,7 +52,7 @@ def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelC
     from fracid.inverse.methods.registry import METHODS
 
     ck.table("identify", raw, (*IDENTIFY_KEYS, *(name for name in METHODS if name not in IDENTIFY_KEYS)))
-    cls = model_of(model.type).parameters
+    cls = model_of(model.type, model.law).parameters
     names = _identified(ck, raw, cls, model)
     inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
     lower, upper, log = _bounds(ck, raw, cls, names)

@@ -40,17 +40,17 @@ def model_types() -> tuple:
     return tuple(MODEL_TYPES)
 
 
-def model_of(kind: str):
-    """The forward model of ``[model] type`` (:func:`fracid.models.model_from_type`)."""
+def model_of(kind: str, law: str | None = None):
+    """The forward model of ``[model] type`` with ``[model] law`` (:func:`fracid.models.model_from_type`)."""
     from fracid.models import model_from_type
 
-    return model_from_type(kind)
+    return model_from_type(kind, law)
 
 
 def model_parameters(model):
     """The parameters of a validated ``[model]`` (a :class:`~fracid.config.schema.ModelConfig`): those given,
     the rest the class's defaults."""
-    return model_of(model.type).parameters(**dict(model.parameters))
+    return model_of(model.type, model.law).parameters(**dict(model.parameters))
 
 
 def specimen_types() -> tuple:

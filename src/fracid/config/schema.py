@@ -15,6 +15,10 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
                                         #   validated: "gradient-damage" | "local-damage" (mesh-
                                         #   dependent) | "cohesive-crack" (Hordijk crack on the beam's
                                         #   ligament; parameters E nu ft Gf c1 c2) | models added later
+    law = "hordijk"                     # optional, cohesive-crack and crack-band: the traction-separation
+                                        #   law by name (fracid.fem.material.laws.TRACTION_SEPARATION_LAWS):
+                                        #   "hordijk" (default) | "linear" | "bilinear"; the parameters are
+                                        #   then the law's (linear: E nu ft Gf; bilinear: + psi chi)
     [model.parameters]                  # any subset of the model's parameters (its parameter class's
                                         # names(); checked by its own validation); the rest take the
                                         # class's defaults. Gradient and local damage (DamageParameters):
@@ -187,16 +191,17 @@ MAX_POPULATION = 100_000
 
 @dataclass(frozen=True)
 class ModelConfig:
-    """``[model]``: the model type and the parameter values given (the rest are defaults)."""
+    """``[model]``: the model type, its law and the parameter values given (the rest are defaults)."""
 
     type: str = "gradient-damage"
     parameters: tuple = ()  # ((name, value), ...) as given
+    law: str | None = None  # a law of the model by name (fracid.models.model_laws); None: its default
 
     @property
     def regularization(self) -> str | None:
         """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
         (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
-        return model_of(self.type).regularization
+        return model_of(self.type, self.law).regularization
 
 
 @dataclass(frozen=True)

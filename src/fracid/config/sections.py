@@ -56,12 +56,25 @@ def valid_parameter(cls, name: str, value: float) -> bool:
     return bool(lower[0] <= value <= upper[0])
 
 
+def _model_law(ck: Checker, raw, kind: str) -> str | None:
+    """``[model] law``: one of the model's laws by name (:func:`fracid.models.model_laws`), or None."""
+    if "law" not in raw:
+        return None
+    from fracid.models import model_laws
+
+    laws = tuple(model_laws(model_of(kind)))
+    if not laws:
+        ck.fail("model.law", raw["law"], f"model.type = {kind!r} takes no law by name (its law is fixed here)")
+    return ck.choice("model.law", raw["law"], laws)
+
+
 def read_model(ck: Checker, raw) -> ModelConfig:
     if raw is None:
         return ModelConfig()
     ck.table("model", raw, MODEL_KEYS)
     kind = ck.choice("model.type", raw.get("type", "gradient-damage"), model_types())
-    cls = model_of(kind).parameters
+    law = _model_law(ck, raw, kind)
+    cls = model_of(kind, law).parameters
     names = cls.names()
     params = raw.get("parameters", {})
     if not isinstance(params, dict):
@@ -78,14 +91,14 @@ def read_model(ck: Checker, raw) -> ModelConfig:
         cls(**values)
     except ValueError as err:
         ck.fail("model.parameters", params, f"rejected together by {cls.__name__} (model.type = {kind!r}): {err}")
-    return ModelConfig(type=kind, parameters=tuple(values.items()))
+    return ModelConfig(type=kind, parameters=tuple(values.items()), law=law)
 
 
 def check_model_runs_on(ck: Checker, model: ModelConfig, specimen) -> None:
     """Refuse a model that does not run on the specimen, with its reason and the specimen types it runs on."""
     from fracid.models import runs_on
 
-    made = model_of(model.type)
+    made = model_of(model.type, model.law)
     built = specimen_class(specimen.type)(**dict(specimen.options))
     if runs_on(made, built):
         return

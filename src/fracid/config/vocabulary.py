@@ -27,7 +27,7 @@ ROLES = ("calibration", "prediction")
 # ------------------------------------------------------------------------------------ keys
 
 TOP_KEYS = ("model", "specimen", "experiments", "identify", "output", "simulate", "study", "posterior")
-MODEL_KEYS = ("type", "parameters")
+MODEL_KEYS = ("type", "law", "parameters")
 EXPERIMENT_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
                    "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
                    "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",

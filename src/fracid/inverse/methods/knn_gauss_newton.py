@@ -13,13 +13,11 @@ from typing import ClassVar
 import numpy as np
 
 from fracid.inverse.methods.gauss_newton import gauss_newton
-from fracid.inverse.methods.knn_kalman import KnnSettings, knn_record, population_search
-from fracid.inverse.core.method import MethodResult, check_problem, identification_bounds, result_fields
+from fracid.inverse.methods.knn_kalman import KnnSettings, knn_record, population_search, search_then_refine
+from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
 from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
-from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.core.space import ParameterSpace
-from fracid.batch import BatchStats
 
 
 def _stages() -> dict:
@@ -134,16 +132,8 @@ class KnnGaussNewton:
     def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,
                  retry_failed=False, blocks=(), notes=()) -> GaussNewtonResult:
         """Both stages (see :class:`~fracid.inverse.core.method.InverseMethod`)."""
-        start = time.perf_counter()
-        y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
-        stats = BatchStats()
-        knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
-                          stats=stats, retry_failed=retry_failed)
-        stored = StoredOperator(operator, store, retry_failed=retry_failed)
-        result = self.refine(stored, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes, started=start,
-                             progress=progress)
-        result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
-        return result
+        return search_then_refine(self, operator, y_exp, C_exp, space, executor=executor, store=store,
+                                  progress=progress, retry_failed=retry_failed, blocks=blocks, notes=notes)
 
 
 __all__ = ["GaussNewtonResult", "KnnGaussNewton"]

@@ -214,16 +214,8 @@ class KnnKalman:
             When fewer than k population runs succeeded. A failed run of the Kalman stage never
             raises: see :func:`refine`.
         """
-        start = time.perf_counter()
-        y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
-        stats = BatchStats()
-        knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
-                          stats=stats, retry_failed=retry_failed)
-        evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
-        result = self.refine(evaluate, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes,
-                             started=start, progress=progress)
-        result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
-        return result
+        return search_then_refine(self, operator, y_exp, C_exp, space, executor=executor, store=store,
+                                  progress=progress, retry_failed=retry_failed, blocks=blocks, notes=notes)
 
 
 def refine(operator, y_exp, C_exp, knn, *, groups=None, max_iterations=10, tol=0.01, restart="linearize",
@@ -316,6 +308,23 @@ def kalman_progress(progress, groups, n_outputs, max_iterations):
         bar.refresh()
 
 
+def search_then_refine(method, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None,
+                       progress=None, retry_failed=False, blocks=(), notes=()):
+    """A KNN-started method's call: its ``search`` (the population through ``store``), then its ``refine``
+    from that prior with the runs stored too; the result counts the population's computed and reused runs
+    and the wall time of both."""
+    start = time.perf_counter()
+    y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
+    stats = BatchStats()
+    knn = method.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+                        stats=stats, retry_failed=retry_failed)
+    evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
+    result = method.refine(evaluate, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes, started=start,
+                           progress=progress)
+    result.runs.update(knn_computed=stats.computed, knn_reused=stats.reused)
+    return result
+
+
 def population_search(knn: KnnSettings, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None,
                       progress=None, stats=None, retry_failed=False):
     """The KNN stage with ``knn``'s settings: a :class:`~fracid.inverse.methods.knn.KnnResult` (population,
@@ -324,5 +333,5 @@ def population_search(knn: KnnSettings, operator, y_exp, C_exp, space: Parameter
                       executor=executor, store=store, progress=progress, stats=stats, retry_failed=retry_failed)
 
 
-__all__ = ["DEFAULT_GROUPS", "IdentificationResult", "KalmanSettings", "KnnKalman", "KnnSettings", "kalman_progress", "knn_output",
-           "knn_record", "named_groups", "population_search", "refine"]
+__all__ = ["DEFAULT_GROUPS", "IdentificationResult", "KalmanSettings", "KnnKalman", "KnnSettings", "kalman_progress",
+           "knn_output", "knn_record", "named_groups", "population_search", "refine", "search_then_refine"]

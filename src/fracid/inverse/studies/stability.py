@@ -104,17 +104,13 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     C_noise = as_covariance(C_exp if C_noise is None else C_noise, np.size(y_exp), name="C_noise")
     data = noisy_replicates(y_exp, C_noise, int(replicates), seed)
     estimates, errors = np.full((len(data), np.size(x0)), np.nan), []
-    stds, done = [], []
+    stds = []
+    fit_once = fit or partial(kalman_filter, **kalman)
 
     def run(y):
-        fit_once = fit or partial(kalman_filter, **kalman)
-        result = fit_once(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor)
-        done.append(result)
-        if progress is not None:
-            progress(len(done), len(data))
-        return result
+        return fit_once(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor)
 
-    for i, result in enumerate(concurrently(run, data, executor)):  # the replicates side by side
+    for i, result in enumerate(concurrently(run, data, executor, progress)):  # the replicates side by side
         if result.failed:  # a replicate that fails is recorded; the study goes on
             error = result.status
         else:

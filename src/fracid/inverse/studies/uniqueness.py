@@ -178,17 +178,12 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
     from fracid.inverse.methods.knn import objective
 
     starts, results, failed = np.atleast_2d(starts), [], []
-    done = []
+    fit_once = fit or partial(kalman_filter, **kalman)
 
     def run(x):
-        fit_once = fit or partial(kalman_filter, **kalman)
-        result = fit_once(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor)
-        done.append(x)
-        if progress is not None:
-            progress(len(done), len(starts))
-        return result
+        return fit_once(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor)
 
-    for x, result in zip(starts, concurrently(run, starts, executor)):  # the filters side by side
+    for x, result in zip(starts, concurrently(run, starts, executor, progress)):  # the fits side by side
         if result.failed:  # recorded; the other starts still tell
             failed.append(f"start {x.tolist()}: {result.status}")
         else:
