@@ -62,9 +62,10 @@ CASES = {
                                               config={"params": "kappa_i = 0.05"}, args=IDENTIFY),
     "model-kappa_i-9x-named-beside-control_unit": case(2, ["control_unit", "or model.parameters.kappa_i = 0.009"],
                                                        config={"params": "kappa_i = 0.009"}, args=IDENTIFY),
-    "study-of-another-method-warned": case(
-        4, ["fracid: warning", "method = 'knn-gauss-newton'", "not built yet", "taken is a file"],
-        files=_out_is_file, config={"identify": 'method = "knn-gauss-newton"'},
+    "settings-of-a-method-not-chosen-warned": case(
+        4, ["fracid: warning", "[identify.gauss-newton] is given but identify.method = 'knn-kalman'",
+            "not used", "taken is a file"],
+        files=_out_is_file, config={"tail": "[identify.gauss-newton]\nmax_iterations = 5\n"},
         args=("study", "cfg.toml", *REACHES_OUTPUT)),
     # ---- [posterior] settings warned about when the configuration is loaded
     "posterior-target_ess-below-floor-warned": case(
