@@ -26,6 +26,7 @@ from fracid.data.covariance_matrix import (
     block_diagonal,
 )
 from fracid.data.dataset import ExperimentalData, stack
+from fracid.data.dic import CameraPlacement, DicData, fit_placement, read_dic_frames, read_dic_vtk
 from fracid.data.experimental import (
     from_envelope,
     from_repeats,
@@ -38,11 +39,13 @@ from fracid.data.sampling import SAMPLINGS, decimate, sample_points
 
 __all__ = [
     "Block",
+    "CameraPlacement",
     "Covariance",
     "Curve",
     "DataError",
     "DataTypeError",
     "Dense",
+    "DicData",
     "Diagonal",
     "ExperimentalData",
     "LowRankPlusDiagonal",
@@ -51,12 +54,15 @@ __all__ = [
     "block_diagonal",
     "curve_from_arrays",
     "decimate",
+    "fit_placement",
     "from_envelope",
     "from_repeats",
     "gregoire2013_beam4",
     "gregoire2013_beam4_path",
     "local_block",
     "read_curve_csv",
+    "read_dic_frames",
+    "read_dic_vtk",
     "require_positive_force",
     "sample_points",
     "stack",
