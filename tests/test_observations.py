@@ -1,6 +1,8 @@
 """Observations as objects: the point-probe operator (fracid.fem.mesh.probes), the field observation kind
 and the curve kind behind the ObservationKind protocol of the forward operator."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -244,6 +246,6 @@ def test_probed_specimen_adds_functionals_and_names_bad_probes():
         ProbedSpecimen(beam, {"p": ((3, 2, 1.0),)}).describe()
     with pytest.raises(ValueError, match="triples"):
         ProbedSpecimen(beam, {"p": (3, 0, 1.0)})
-    one, other = (FieldObservation(beam, pts, [0.01], name="dic") for pts in ([[5.0, 30.0]], [[6.0, 30.0]]))
+    one, other = (SimpleNamespace(probes={"dic:ux[0]": ((node, 0, 1.0),)}) for node in (3, 4))
     with pytest.raises(ValueError, match="define the probe 'dic:ux\\[0\\]' differently"):
         merge_probes([one, other])

@@ -44,6 +44,9 @@ class PathDerivatives:
     observers : mapping {name: observer}, optional
         The run's observers; those with ``differentiable`` true are differentiated by their
         ``derivative(problem, history, history_rate, names)`` (the zone widths of the damage models).
+    probes : ProbeSampler, optional
+        (:class:`~fracid.fem.path.recorder.ProbeSampler`) Its sparse matrix is applied to dq/dx at the
+        steps it wants: ``result()["probed"]`` ``{step: ndarray (n_probes, p)}`` [mm per unit of x].
 
     Raises
     ------
@@ -53,7 +56,7 @@ class PathDerivatives:
         When a name is not a parameter the problem differentiates.
     """
 
-    def __init__(self, problem, names, observers=None):
+    def __init__(self, problem, names, observers=None, probes=None):
         if not callable(getattr(problem, "differentiate", None)):
             raise NotImplementedError(f"{type(problem).__name__} has no direct differentiation; "
                                       "use finite differences of runs (fracid.inverse.core.sensitivity.CentralDifferences)")
@@ -69,11 +72,12 @@ class PathDerivatives:
         keys = ["force", "load_point", "work", "elastic", *problem.functionals, *self.observers]
         self.records = {key: [np.zeros(p)] for key in keys}
         self._last = (0.0, 0.0)  # force and load-point displacement of the last step
+        self.probes, self.probed = probes, {}
 
-    def step(self, system, z, history_old, arrays, solver, stats):
+    def step(self, system, z, history_old, arrays, solver, stats, tau=None):
         """Differentiate the converged step z (history before the step ``history_old``, element arrays
-        ``arrays`` at z); returns the factorization of the converged tangent, to start the next
-        increment with."""
+        ``arrays`` at z, control value ``tau`` [mm], needed with probes); returns the factorization of
+        the converged tangent, to start the next increment with."""
         problem, rec = self.problem, self.records
         q = z[:-1]
         derivative = problem.differentiate(q, history_old, self.history_rate, self.names)
@@ -102,17 +106,21 @@ class PathDerivatives:
         for name, observer in self.observers.items():
             rec[name].append(observer.derivative(problem, arrays.history, self.history_rate, self.names))
         self._last = (force, displacement)
+        if self.probes is not None and self.probes.wanted(tau):
+            self.probed[len(rec["force"]) - 1] = self.probes.matrix @ dq
         return factor
 
     def result(self) -> dict:
         """``{quantity: ndarray (n_steps + 1, p)}`` for the force, every functional, the load-point
         displacement and the energies (the names of :class:`~fracid.fem.path.path_following.PathResult`),
-        and ``"names"``: the parameters."""
+        ``"names"``: the parameters, and with probes ``"probed"``: ``{step: ndarray (n_probes, p)}``."""
         rec = {key: np.array(values) for key, values in self.records.items()}
         out = {name: rec[name] for name in [*self.problem.functionals, *self.observers]}
         out.update(force=rec["force"], load_point_displacement=rec["load_point"], external_work=rec["work"],
                    elastic_energy=rec["elastic"], dissipated_energy=rec["work"] - rec["elastic"])
         out["names"] = self.names
+        if self.probes is not None:
+            out["probed"] = self.probed
         return out
 
 

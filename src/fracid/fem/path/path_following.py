@@ -10,7 +10,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from fracid.fem.path.ddm import PathDerivatives
-from fracid.fem.path.recorder import Recorder
+from fracid.fem.path.recorder import ProbeSampler, Recorder, probed_at
 from fracid.fem.path import linear_solvers
 from fracid.fem.path.linear_solvers import SingularMatrixError
 from fracid.fem.formulations.protocol import initial_history
@@ -43,7 +43,9 @@ class PathResult:
         With ``sensitivities`` asked: ``derivatives[name]`` (n_steps + 1, p) is d/dx of ``force`` or of
         the observable ``name`` at every step, x the parameters ``derivatives["names"]`` (the control
         is held; see :mod:`fracid.fem.path.ddm`), and of the observers that are differentiable (the
-        damaged-zone widths).
+        damaged-zone widths); with ``probes`` also ``derivatives["probed"]`` {step: (n_probes, p)}.
+    probed : dict {step: ndarray (n_probes,)}
+        With ``probes`` asked: the probes [mm] at the steps on the checkpoints (:meth:`probed_at`).
     """
 
     control_name: str
@@ -54,6 +56,7 @@ class PathResult:
     stats: SolverStatistics = field(default_factory=SolverStatistics)
     status: str = ""
     derivatives: dict | None = None
+    probed: dict = field(default_factory=dict)
 
     @property
     def n_steps(self) -> int:
@@ -68,6 +71,11 @@ class PathResult:
         """(displacement-like quantity, force): the control by default, or any observable."""
         x = self.control if name is None or name == self.control_name else self.observables[name]
         return x, self.force
+
+    def probed_at(self, controls) -> tuple:
+        """(values (n, n_probes), derivatives (n, n_probes, p) or None) of the probes at the checkpoints
+        ``controls`` [mm]; NaN beyond the last step (see :func:`~fracid.fem.path.recorder.probed_at`)."""
+        return probed_at(self, controls)
 
 
 class ConvergenceError(RuntimeError):
@@ -189,6 +197,7 @@ def follow_path(
     callback: Callable | None = None,
     checkpoints=None,
     sensitivities=None,
+    probes=None,
 ) -> PathResult:
     """Trace the equilibrium path by increasing the functional ``control`` up to ``target``.
 
@@ -222,6 +231,13 @@ def follow_path(
         Control values [mm] that must be steps of the analysis (the sampling points of measured
         data), so that the computed values there are not interpolated between steps and do not
         jitter with the adaptive step sequence.
+    sensitivities : sequence of str, optional
+        Parameters to differentiate the path with respect to (:mod:`fracid.fem.path.ddm`).
+    probes : scipy.sparse matrix (n_probes, n_u), optional
+        Point probes as weights of the nodal displacement vector (``fields[step]["u"]``); the run records
+        ``probes @ u`` at the steps on ``checkpoints`` (every step without checkpoints) in
+        ``PathResult.probed``, and with ``sensitivities`` ``probes @ du/dx`` in ``derivatives["probed"]``,
+        never forming a dense (n_probes x unknowns) array (full-field data: :class:`ProbeSampler`).
 
     Returns
     -------
@@ -235,7 +251,8 @@ def follow_path(
     """
     _check_request(problem, control, target, stop_force_fraction, max_steps)
     _check_steps(steps, target)
-    run = _Run(problem, control, linear_solver, newton, observers, field_steps, sensitivities)
+    sampler = None if probes is None else ProbeSampler(problem, probes, checkpoints)
+    run = _Run(problem, control, linear_solver, newton, observers, field_steps, sensitivities, sampler)
     return run.trace(_StepSizes(steps, target, checkpoints), max_steps, stop_force_fraction, callback)
 
 
@@ -300,14 +317,15 @@ class _StepSizes:
 class _Run:
     """One incremental analysis of :func:`follow_path`: the solver, the records and the derivatives."""
 
-    def __init__(self, problem, control, linear_solver, newton, observers, field_steps, sensitivities):
+    def __init__(self, problem, control, linear_solver, newton, observers, field_steps, sensitivities, probes=None):
         self.t_start = time.perf_counter()
         self.problem, self.control, self.newton = problem, control, newton
         self.solver = linear_solvers.linear_solver(linear_solver)
         self.system = ControlledSystem(problem, problem.functionals[control])
         self.stats = SolverStatistics()
-        self.recorder = Recorder(problem, dict(observers or {}), field_steps)
-        self.derivatives = PathDerivatives(problem, sensitivities, observers) if sensitivities is not None else None
+        self.recorder = Recorder(problem, dict(observers or {}), field_steps, probes)
+        self.derivatives = (PathDerivatives(problem, sensitivities, observers, probes)
+                            if sensitivities is not None else None)
 
     def trace(self, sizes: _StepSizes, max_steps, stop_force_fraction, callback) -> PathResult:
         """Converged steps up to the target or a stop criterion (see :func:`follow_path`)."""
@@ -350,7 +368,7 @@ class _Run:
     def differentiate(self, tau, z, history, arrays):
         """The derivatives' step at the converged ``z``; its factorization of the tangent (or None)."""
         try:
-            return self.derivatives.step(self.system, z, history, arrays, self.solver, self.stats)
+            return self.derivatives.step(self.system, z, history, arrays, self.solver, self.stats, tau=tau)
         except SingularMatrixError as err:
             message = (f"the tangent of the converged step at {self.control} = {tau:.6g} mm is singular, so the "
                        f"derivatives are not defined there (a bifurcation of the path): {err}")
@@ -361,7 +379,8 @@ class _Run:
         """The :class:`PathResult` of the steps recorded so far, ending with ``status``."""
         self.stats.time_total = time.perf_counter() - self.t_start
         control, force, observables, fields = self.recorder.curves()
-        out = PathResult(self.control, control, force, observables, fields, self.stats, status)
+        out = PathResult(self.control, control, force, observables, fields, self.stats, status,
+                         probed=self.recorder.probed)
         if self.derivatives is not None:
             out.derivatives = self.derivatives.result()
         return out

@@ -15,6 +15,7 @@ import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+import scipy.sparse as sp
 
 from fracid.inverse.core.observations import FieldObservation, Observation, ObservationKind, check_control_points
 from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
@@ -199,16 +200,18 @@ class ForwardOperator:
         checkpoints = np.unique(np.concatenate([obs.controls[:n] for (obs, _), n in zip(group, counts)]))
         observables = sorted({name for obs, _ in group for name in obs.observables})
         probes = merge_probes(obs for obs, _ in group)
+        matrix, kind_rows = stacked_probes([obs for obs, _ in group])
         run, error, retried = self._run(group[0][0], params, float(checkpoints[-1]), checkpoints, threshold,
-                                        observables, probes)
+                                        observables, probes, matrix)
         record.retried |= retried
         if run is None:
             record.status, record.error = "failed", error
             record.reached.append(0.0)
             return False
         record.reached.append(float(run.control[-1]))
-        for (obs, part), n in zip(group, counts):
-            y, S = obs.sample(run)
+        for (obs, part), n, own in zip(group, counts, kind_rows):
+            whole = own is None or matrix.shape[0] == own.stop - own.start
+            y, S = obs.sample(run if whole else probe_rows(run, own))
             rows = slice(part.start, part.start + n)
             record.y[rows] = np.asarray(y, float)[:n]
             if record.S is not None and S is None:  # a quantity the run did not differentiate: no S
@@ -217,8 +220,9 @@ class ForwardOperator:
                 record.S[rows] = np.asarray(S, float)[:n]
         return True
 
-    def _run(self, obs, params, target, checkpoints, threshold, observables, probes):
-        """Forward run to ``target``; one retry with smaller steps. Returns (result or partial, error, retried)."""
+    def _run(self, obs, params, target, checkpoints, threshold, observables, probes, matrix=None):
+        """Forward run to ``target`` (with the sparse probe ``matrix`` if not None); one retry with smaller
+        steps. Returns (result or partial, error, retried)."""
         error = ""
         specimen = ProbedSpecimen(obs.specimen, probes) if probes else obs.specimen
         for attempt, steps in enumerate(self._step_rules(obs, target)):
@@ -227,7 +231,8 @@ class ForwardOperator:
                                              stop_force_fraction=None, steps=steps, field_steps=None,
                                              checkpoints=checkpoints, damage_threshold=threshold,
                                              observables=observables,
-                                             **({"sensitivities": self.names} if self.sensitivities else {}))
+                                             **({"sensitivities": self.names} if self.sensitivities else {}),
+                                             **({} if matrix is None else {"probes": matrix}))
                 return result, "", attempt > 0
             except ConvergenceError as err:
                 error = str(err)
@@ -244,3 +249,36 @@ class ForwardOperator:
                           max_factor=first.max_factor / 4, onset_fraction=first.onset_fraction / 4)
         return (first, smaller)
 
+
+
+def stacked_probes(kinds) -> tuple:
+    """The probe matrices of the kinds of one run stacked, and each kind's rows (None: no ``probe_matrix``).
+
+    Returns
+    -------
+    matrix : scipy.sparse.csr_matrix or None
+        The kinds' ``probe_matrix()`` one under the other (None if no kind has one).
+    rows : list of slice or None
+        The rows of each kind in ``matrix``.
+    """
+    blocks, rows, start = [], [], 0
+    for kind in kinds:
+        make = getattr(kind, "probe_matrix", None)
+        if make is None:
+            rows.append(None)
+            continue
+        block = sp.csr_matrix(make())
+        blocks.append(block)
+        rows.append(slice(start, start + block.shape[0]))
+        start += block.shape[0]
+    return (sp.vstack(blocks, format="csr") if blocks else None), rows
+
+
+def probe_rows(run, rows: slice):
+    """``run`` (a :class:`~fracid.models.PathResult`) with its probed values and their derivatives cut to
+    ``rows``: what one kind of a shared run sees."""
+    probed = {step: values[rows] for step, values in run.probed.items()}
+    derivatives = run.derivatives
+    if derivatives is not None and "probed" in derivatives:
+        derivatives = {**derivatives, "probed": {step: d[rows] for step, d in derivatives["probed"].items()}}
+    return replace(run, probed=probed, derivatives=derivatives)

@@ -16,24 +16,29 @@ Two kinds are built in:
   pixels a camera follows) at given control values (frames), through the point-probe operator
   :func:`~fracid.fem.mesh.probes.probe_matrix` (through :mod:`fracid.models`, the inverse code's window on the model).
 
+A kind may also have ``probe_matrix()``: a scipy.sparse matrix (n_probes x n_u) over the nodal
+displacement vector; the operator stacks those of the kinds of one run and the run applies it to the
+state (and its derivatives) at the checkpoint steps only (``follow_path(probes=...)``,
+``PathResult.probed``), handing each kind its rows. :class:`FieldObservation` samples that way.
+
 A test file or a user module adds its own kind by writing a class with these members
-(``tests/test_extension_observation.py``: the crack-opening profile along the ligament).
+(``tests/test_extension_observation.py``: the crack-opening profile along the ligament, through ``probes``).
 
 Notes
 -----
-The probes become functionals of the run's problem: each is a dense vector over the unknowns, dotted
-with the state (and, with sensitivities, with its derivatives) at every step. That is exact and cheap
-for tens to hundreds of points; full-field data (thousands of points, digital image correlation) need
-the run to apply the sparse probe matrix to the nodal field at the frames only (a change of the
-path follower, not of the kinds: ``sample`` stays as it is).
+``probes`` (named terms) become functionals of the run's problem: each is a dense vector over the
+unknowns, dotted with the state (and, with sensitivities, its derivatives) at every step: exact and
+cheap for tens of values. ``probe_matrix`` stays sparse and is applied at the frames only: full-field
+data (thousands of points, digital image correlation) cost O(points) memory per frame.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+import scipy.sparse as sp
 
 from fracid.inverse.core.probed import describe, specimen_key
 
@@ -243,11 +248,11 @@ class FieldObservation:
 
     Notes
     -----
-    The probes (one displacement functional per point and component, the shape functions of the
-    point's element as weights: the rows of the probe matrix) are recorded and differentiated by the
-    run like the specimen's functionals, so ``sample`` gives exact sensitivities with a model that
-    differentiates its runs. Each probe is a dense vector of the unknowns in the run: meant for up to
-    a few hundred points (see the module's notes on full-field data).
+    The block's sparse probe matrix (:meth:`probe_matrix`: one row per component and point, the
+    shape functions of the point's element as weights) is applied by the run to the nodal
+    displacements and their derivatives at the frames only, so ``sample`` gives exact sensitivities
+    with a model that differentiates its runs and the cost stays O(points) per frame (digital image
+    correlation at thousands of points).
     """
 
     specimen: object
@@ -256,7 +261,6 @@ class FieldObservation:
     components: tuple = (0, 1)
     control: str | None = None
     name: str = "field"
-    _probes: dict = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self):
         from fracid.models import probe_matrix
@@ -269,16 +273,16 @@ class FieldObservation:
         d = describe(self.specimen)
         if d.dim != 2:
             raise ValueError(f"a field observation needs a plane specimen; {type(self.specimen).__name__} is {d.dim}D")
-        P = probe_matrix(d.nodes, d.cells, self.points).tocsr()
-        for c in self.components:
-            for i in range(len(self.points)):
-                row = slice(P.indptr[i], P.indptr[i + 1])
-                self._probes[self.probe_name(c, i)] = tuple(
-                    (int(n), c, float(w)) for n, w in zip(P.indices[row], P.data[row]))
+        P = probe_matrix(d.nodes, d.cells, self.points).tocoo()
+        rows = [sp.csr_matrix((P.data, (P.row, 2 * P.col + c)), shape=(P.shape[0], 2 * P.shape[1]))
+                for c in self.components]
+        object.__setattr__(self, "_matrix", sp.vstack(rows, format="csr"))
 
-    def probe_name(self, component: int, point: int) -> str:
-        """Name of the run's functional of ``component`` at point ``point``."""
-        return f"{self.name}:u{'xy'[component]}[{point}]"
+    def probe_matrix(self) -> sp.csr_matrix:
+        """The sparse matrix (n_components x n_points, n_u) over the nodal displacement vector (dof
+        ``2 j + c`` is component c of node j) whose rows give the block's values at one frame
+        (component, then point) [mm]."""
+        return self._matrix
 
     quantity = property(lambda self: "u")  # what the block measures, as a curve kind's ``quantity``
 
@@ -302,7 +306,7 @@ class FieldObservation:
 
     @property
     def probes(self) -> dict:
-        return dict(self._probes)
+        return {}  # no dense functionals: the run applies probe_matrix() at the frames
 
     def coordinates(self) -> dict:
         n_c, n_p = len(self.components), len(self.points)
@@ -321,10 +325,8 @@ class FieldObservation:
                 "name": self.name}
 
     def sample(self, run) -> tuple:
-        names = [self.probe_name(c, i) for c in self.components for i in range(len(self.points))]
-        parts = [interpolate(run, name, self.frames) for name in names]  # each (n_frames,), (n_frames, p)
-        y = np.stack([value for value, _ in parts], axis=1).ravel()  # frame-major
-        if any(d is None for _, d in parts):
-            return y, None
-        S = np.stack([d for _, d in parts], axis=1)  # (n_frames, n_probes, p)
-        return y, S.reshape(y.size, -1)
+        """``(y, S)`` from ``run.probed`` (a run with this block's probe matrix and its frames among the
+        checkpoints: the frames are steps, nothing is interpolated); NaN for frames not reached."""
+        values, derivatives = run.probed_at(self.frames)  # (n_frames, n_rows), (n_frames, n_rows, p)
+        y = values.ravel()  # frame-major
+        return y, None if derivatives is None else derivatives.reshape(y.size, -1)

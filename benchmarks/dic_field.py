@@ -1,0 +1,98 @@
+"""Cost of a full-field (DIC-scale) observation with exact sensitivities on the demo beam (fracid issue 27).
+
+On the demo configuration (the Grégoire notched beam, gradient damage, h_fine 2 mm, kappa_i, beta and c;
+src/fracid/data/gregoire2013_beam4/demo.toml) at the demo's estimate, one process, serial runs:
+
+- one plain forward run (the data's CMOD checkpoints),
+- one run with exact sensitivities (direct differentiation) for (kappa_i, beta, c),
+- one run with sensitivities and a displacement field of ``--points`` points (both components) at
+  ``--frames`` frames: a sparse probe matrix applied by the run at the frames only
+  (``follow_path(probes=...)``), the frames taken among the data's control points (the step sequence is
+  the data's; frames elsewhere add one step each).
+
+It prints the times, the ratios to the plain run (issue 27 asks: one identification iteration with the
+field <= 1.5 plain runs) and the load average (the machine is shared: read the ratios with it).
+
+    python benchmarks/dic_field.py [--points 2000] [--frames 8] [--repeat 1] [--h-fine 2.0]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import time
+
+import numpy as np
+
+from fracid.cli import demo_config_path
+from fracid.config import build_data, build_operator, load_config
+from fracid.inverse.core.observations import FieldObservation
+
+ESTIMATE = {"kappa_i": 4.798e-5, "beta": 1086.5, "c": 21.46}  # docs/demo/result.json (rounded)
+
+
+def best_time(function, repeat: int):
+    """(smallest wall time [s] of ``repeat`` calls, the last result)."""
+    times, out = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        out = function()
+        times.append(time.perf_counter() - start)
+    return min(times), out
+
+
+def dic_points(specimen, n: int, seed: int = 0) -> np.ndarray:
+    """``n`` random points [mm] over the modelled half beam's face above the notch tip, off the edges."""
+    nodes = specimen.describe().nodes
+    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+    depth = getattr(specimen, "notch_depth", 0.5 * (hi[1] - lo[1]))
+    rng = np.random.default_rng(seed)
+    return rng.uniform([lo[0] + 0.2, lo[1] + depth + 0.5], [hi[0] - 0.5, hi[1] - 0.5], (n, 2))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=2000)
+    parser.add_argument("--frames", type=int, default=8)
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--h-fine", type=float, default=None, help="override the demo mesh's h_fine [mm]")
+    args = parser.parse_args(argv)
+    cfg = load_config(demo_config_path(), purpose="identify")
+    if args.h_fine is not None:
+        options = tuple((k, v) for k, v in cfg.specimen.options if k != "h_fine") + (("h_fine", args.h_fine),)
+        cfg = dataclasses.replace(cfg, specimen=dataclasses.replace(cfg.specimen, options=options))
+    operator = build_operator(cfg, build_data(cfg))
+    exact = operator.differentiated()
+    assert exact.sensitivities, "the demo's model has no direct differentiation"
+    curve = operator.observations[0]
+    frames = curve.controls[np.linspace(0, curve.size - 1, args.frames).round().astype(int)]
+    field = FieldObservation(curve.specimen, dic_points(curve.specimen, args.points), frames, control=curve.control,
+                             name="dic")
+    with_field = dataclasses.replace(exact, observations=(*operator.observations, field))
+    x = np.array([ESTIMATE[name] for name in operator.names])
+
+    load_before = os.getloadavg()
+    t_run, plain = best_time(lambda: operator(x), args.repeat)
+    t_ddm, record = best_time(lambda: exact(x), args.repeat)
+    t_field, full = best_time(lambda: with_field(x), args.repeat)
+    load_after = os.getloadavg()
+    assert plain.ok and record.ok and full.ok and full.S is not None and np.all(np.isfinite(full.S))
+    out = {"points": args.points, "frames": args.frames, "field_outputs": field.size, "curve_outputs": plain.y.size,
+           "parameters": list(operator.names), "run_s": t_run, "run_with_ddm_s": t_ddm, "run_with_field_s": t_field,
+           "ratio_ddm_to_run": t_ddm / t_run, "ratio_field_to_run": t_field / t_run,
+           "ratio_field_to_ddm": t_field / t_ddm, "loadavg_before": load_before, "loadavg_after": load_after}
+    print(f"demo beam, {plain.y.size} curve outputs; field: {args.points} points x 2 components x {args.frames} "
+          f"frames = {field.size} outputs; x = {dict(zip(operator.names, x.tolist()))}")
+    print(f"one plain run                            {t_run:8.2f} s")
+    print(f"one run with DDM sensitivities           {t_ddm:8.2f} s   ratio to plain {t_ddm / t_run:.3f}")
+    print(f"one run with DDM and the field           {t_field:8.2f} s   ratio to plain {t_field / t_run:.3f}"
+          f"   (to DDM {t_field / t_ddm:.3f})")
+    print(f"load average (1, 5, 15 min) before {load_before}, after {load_after}")
+    print(json.dumps(out))
+    return out
+
+
+if __name__ == "__main__":
+    main()
