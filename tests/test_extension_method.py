@@ -18,7 +18,9 @@ from hostile import TRUTH, bar_config, synthetic_curve, write_csv
 import fracid
 from fracid import cli
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+from fracid.inverse.core import settings
 from fracid.inverse.methods.knn_kalman import KnnSettings, population_search
+from fracid.inverse.methods.knn_settings import knn_from_table
 from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
 from fracid.inverse.methods.registry import METHODS, StudyMethod
 from fracid.inverse.core.runs import StoredOperator
@@ -65,17 +67,18 @@ class KnnNelderMead:
     name: ClassVar[str] = "knn-nelder-mead"
     stages: ClassVar[dict] = {"knn": "KNN", "nelder_mead": "Nelder-Mead"}
 
+    #: the tables of [identify] it reads: the shared [identify.knn] and its own [identify.knn-nelder-mead]
+    config_tables: ClassVar[tuple] = ("knn", "knn-nelder-mead")
+
     @classmethod
-    def from_config(cls, identify, n_y):
-        """Population from [identify.knn]; ``max_evaluations`` from this method's own [identify.knn-nelder-mead]."""
-        table = dict(identify.methods.get(cls.name, {}))
-        unknown = sorted(set(table) - {"max_evaluations"})
-        if unknown:
-            raise ValueError(f"unknown key {unknown[0]!r}; allowed: max_evaluations")
-        value = table.get("max_evaluations", cls.max_evaluations)
-        if not (isinstance(value, int) and value >= 10):
-            raise ValueError(f"max_evaluations = {value!r}: give an integer >= 10")
-        return cls(n=identify.knn.n, k=identify.knn.k, max_evaluations=value)
+    def from_config(cls, tables, context):
+        """Population from [identify.knn] (the built-in methods' checks); ``max_evaluations`` from this method's
+        own [identify.knn-nelder-mead], checked with the configuration's checkers."""
+        knn = knn_from_table(tables["knn"], context)
+        own = settings.table(cls.name, tables[cls.name], ("max_evaluations",))
+        value = settings.integer(f"{cls.name}.max_evaluations", own.get("max_evaluations", cls.max_evaluations),
+                                 "must be an integer >= 10", lambda v: v >= 10)
+        return cls(n=knn.n, k=knn.k, max_evaluations=value)
 
     def search(self, operator, y_exp, C_exp, space, **options):
         return population_search(KnnSettings(n=self.n, k=self.k), operator, y_exp, C_exp, space, **options)
@@ -182,4 +185,4 @@ def test_a_bad_key_of_the_methods_own_table_is_named(tmp_path, monkeypatch, caps
     config = _configured(tmp_path, table="max_evaluations = 3")
     assert cli.main(["identify", str(config), "--out", str(tmp_path / "id"), "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert "identify.knn-nelder-mead" in err and "max_evaluations = 3" in err and "Traceback" not in err
+    assert "identify.knn-nelder-mead.max_evaluations = 3: must be an integer >= 10" in err and "Traceback" not in err

@@ -19,6 +19,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+from fracid.inverse.core.settings import COMMENT_COLUMN, toml_line
+
 #: the parameters a first identification looks for, per ``[model] type`` (others: the two after E and nu)
 IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("kappa_i", "beta", "c"),
               "local-damage": ("kappa_i", "beta"), "cohesive-crack": ("ft", "Gf"), "crack-band": ("ft", "Gf")}
@@ -29,7 +31,7 @@ _ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
 PAIR_SPECIMEN = {("wedge-splitting", "crack-band"): ({"h_fine": 4.0}, "at h_fine = 5 the crack band stops converging "
                                                       "after the peak (cmod 0.046 mm); 4 runs through")}
 #: comment column of the written ``key = value`` lines
-_COLUMN = 36
+_COLUMN = COMMENT_COLUMN
 
 _EXPERIMENT_COMMENTS = {
     "file": "REPLACE with your data file (CSV with a header row; relative paths start from this file)",
@@ -115,20 +117,8 @@ def runnable_pairs() -> list:
     return pairs
 
 
-def toml_value(value) -> str:
-    """``value`` (number, string, bool or list of them) as TOML."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(toml_value(v) for v in value) + "]"
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    return repr(value)
-
-
-def _line(key: str, value, comment: str = "", commented: bool = False) -> str:
-    text = f"{'# ' if commented else ''}{key} = {toml_value(value)}"
-    return f"{text.ljust(_COLUMN - 1)} # {comment}" if comment else text
+#: ``key = value  # comment`` (:func:`fracid.inverse.core.settings.toml_line`)
+_line = toml_line
 
 
 def _comments(text: str, width: int = 100) -> list:
@@ -209,23 +199,33 @@ def _bounds(cls, name: str, value: float) -> list:
 
 
 def _identify_lines(model_type: str, demo: dict | None, params) -> list:
-    """``[identify]``: the demo's, or the pair's usual parameters with bounds from their ranges."""
+    """``[identify]``: the demo's, or the pair's usual parameters with bounds from their ranges; the tables of
+    the default inverse method's settings are written by the method (its ``config_template``), with the demo's
+    values or its own for a first run."""
     if demo is not None:
         names, bounds = demo["parameters"], {k: v for k, v in demo["bounds"].items() if k != "log"}
-        log, n, k, groups = demo["bounds"].get("log", []), demo["knn"]["n"], demo["knn"]["k"], demo["kalman"]["groups"]
+        log = demo["bounds"].get("log", [])
     else:
         names = list(IDENTIFIED.get(model_type, params.names()[2:4]))
         bounds = {name: _bounds(type(params), name, getattr(params, name)) for name in names}
-        log, n, k, groups = [name for name in names if name == "beta"], 32, 5, 4
+        log = [name for name in names if name == "beta"]
     return ["[identify]                          # for `fracid identify` (needs [[experiments]])",
             _line("parameters", names, "identified; the others keep their [model.parameters] value"),
             "[identify.bounds]                   # [lower, upper], inside the valid range of each"] + [
         _line(name, bounds[name], f"valid: {type(params).ranges[name].describe(name)}") for name in names] + [
-        _line("log", log, "sampled uniformly in log(x)"),
-        "[identify.knn]", _line("n", n, "population of forward runs (the bulk of the cost)"),
-        _line("method", "sobol", '"sobol" | "lhs" | "grid"'), _line("k", k, "neighbours giving the Kalman prior"),
-        "[identify.kalman]", _line("groups", groups, "filter steps per pass (one run each with exact sensitivities)"),
-        _line("max_iterations", 10, "passes at most")]
+        _line("log", log, "sampled uniformly in log(x)")] + _method_lines(demo or {})
+
+
+def _method_lines(tables: dict) -> list:
+    """The default inverse method's tables (:data:`fracid.inverse.methods.registry.DEFAULT_METHOD`), written by
+    its ``config_template`` with the values of ``tables``; none for a method without one."""
+    from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS, config_tables
+
+    cls = METHODS[DEFAULT_METHOD]
+    template = getattr(cls, "config_template", None)  # an optional hook of the method
+    if template is None:
+        return []
+    return template({name: tables.get(name, {}) for name in config_tables(cls)})
 
 
 def _tail_lines() -> list:

@@ -11,6 +11,7 @@ import numpy as np
 from fracid.config.checker import show
 from fracid.config.registry import model_of, model_parameters, specimen_class
 from fracid.config.schema import Config, ConfigError, ExperimentConfig
+from fracid.inverse.core.settings import SettingError
 
 
 def _require(cfg: Config, section: str):
@@ -225,7 +226,7 @@ def posterior_settings(cfg: Config):
 
 
 def build_space(cfg: Config):
-    """The parameter space of the KNN population: identified names, bounds, log flags."""
+    """The parameter space of the identification: identified names, bounds, log flags."""
     from fracid.inverse.core.space import ParameterSpace
 
     identify = _require(cfg, "identify")
@@ -235,9 +236,9 @@ def build_space(cfg: Config):
 
 def build_method(cfg: Config):
     """The configured inverse method: the class that ``[identify] method`` names in
-    :data:`fracid.inverse.methods.registry.METHODS`, built by its ``from_config(identify, n_y)`` from the validated
-    ``[identify]`` (the sections of its settings; a method's own ``[identify.<name>]`` table is in
-    ``identify.methods``). Give it to :func:`fracid.inverse.methods.strategy.identify_data` as ``method=``.
+    :data:`fracid.inverse.methods.registry.METHODS`, built by its ``from_config(tables, context)`` from the tables of
+    the validated ``[identify]`` it reads (``identify.tables``; :func:`fracid.config.identify.method_from_config`).
+    Give it to :func:`fracid.inverse.methods.strategy.identify_data` as ``method=``.
 
     Raises
     ------
@@ -249,6 +250,8 @@ def build_method(cfg: Config):
     identify = _require(cfg, "identify")
     try:
         return method_from_config(identify, cfg.n_y)
+    except SettingError as err:
+        raise ConfigError(f"{cfg.path}: identify.{err.key} = {show(err.value)}: {err.allowed}") from None
     except (TypeError, ValueError) as err:
         raise ConfigError(f"{cfg.path}: identify.{identify.method}: {err}") from None
 

@@ -3,29 +3,16 @@ the value given and what is allowed."""
 
 from __future__ import annotations
 
-import math
 import os
 import stat
 import tomllib
 from pathlib import Path
 
 from fracid.config.schema import ConfigError
+from fracid.inverse.core import settings
+from fracid.inverse.core.settings import SettingError, bytes_text, show
 
-
-def bytes_text(n: float) -> str:
-    """A memory size in words: ``18.6 GiB``, ``195 MiB``, ``12 KiB``."""
-    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if n >= size:
-            return f"{n / size:.3g} {unit}"
-    return f"{n:.0f} bytes"
-
-
-def show(value) -> str:
-    if isinstance(value, dict):
-        text = "a table {" + ", ".join(value) + "}"
-    else:
-        text = repr(value)
-    return text if len(text) <= 200 else text[:197] + "..."
+__all__ = ["Checker", "MAX_CONFIG_BYTES", "STDIN", "bytes_text", "read_toml", "show"]
 
 
 class Checker:
@@ -46,24 +33,25 @@ class Checker:
     def missing(self, key: str, allowed: str):
         raise ConfigError(f"{self.path}: {key} is missing (no value given); it is required: {allowed}")
 
+    def checked(self, check, *args):
+        """``check(*args)`` (a checker of :mod:`fracid.inverse.core.settings`), its SettingError as this file's
+        ConfigError."""
+        try:
+            return check(*args)
+        except SettingError as err:
+            self.fail(err.key, err.value, err.allowed)
+
     def table(self, key: str, value, allowed_keys) -> dict:
-        if not isinstance(value, dict):
-            self.fail(key, value, f"must be a table (section) with keys {', '.join(allowed_keys)}")
-        prefix = f"{key}." if key else ""
-        for k, v in value.items():
-            if k not in allowed_keys:
-                self.fail(prefix + k, v, f"unknown key; allowed keys here: {', '.join(allowed_keys)}")
-        return value
+        """``value``, a table with keys among ``allowed_keys`` (:func:`fracid.inverse.core.settings.table`)."""
+        return self.checked(settings.table, key, value, allowed_keys)
 
     def number(self, key, value, allowed="must be a number", ok=lambda v: True) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not ok(value):
-            self.fail(key, value, allowed)
-        return float(value)
+        """A finite number (not a bool) with ``ok(value)`` (:func:`fracid.inverse.core.settings.number`)."""
+        return self.checked(settings.number, key, value, allowed, ok)
 
     def integer(self, key, value, allowed="must be an integer", ok=lambda v: True) -> int:
-        if isinstance(value, bool) or not isinstance(value, int) or not ok(value):
-            self.fail(key, value, allowed)
-        return int(value)
+        """An int (not a bool) with ``ok(value)`` (:func:`fracid.inverse.core.settings.integer`)."""
+        return self.checked(settings.integer, key, value, allowed, ok)
 
     def string(self, key, value, allowed="must be a string") -> str:
         if not isinstance(value, str) or not value:
@@ -71,18 +59,13 @@ class Checker:
         return value
 
     def choice(self, key, value, choices) -> str:
-        text = "must be one of " + ", ".join(repr(c) for c in choices)
-        if not isinstance(value, str) or value not in choices:
-            self.fail(key, value, text)
-        return value
+        """One of the strings ``choices`` (:func:`fracid.inverse.core.settings.choice`)."""
+        return self.checked(settings.choice, key, value, choices)
 
     def pair(self, key, value, allowed) -> tuple[float, float]:
         """Two finite numbers [a, b]; any defect names the whole list."""
-        if not (isinstance(value, list) and len(value) == 2):
+        if not (isinstance(value, list) and len(value) == 2) or not all(settings.is_number(v) for v in value):
             self.fail(key, value, allowed)
-        for v in value:
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                self.fail(key, value, allowed)
         return float(value[0]), float(value[1])
 
     def strings(self, key, value, what="column names") -> tuple:

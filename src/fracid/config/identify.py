@@ -1,33 +1,18 @@
-"""Validation of the ``[identify]`` section: identified parameters, their bounds and log flags,
-the inverse method and the sections of the registered methods' settings: ``[identify.knn]`` (with the
-population limit), ``[identify.kalman]``, ``[identify.gauss-newton]`` and a registered method's own
-``[identify.<name>]`` table, checked by the method's ``from_config`` (:func:`method_from_config`)."""
+"""Validation of the ``[identify]`` section: identified parameters, their bounds and log flags, the inverse
+method, and the tables of its settings ``[identify.<table>]``, which the configuration does not know: every table
+a registered method declares is allowed (:func:`fracid.inverse.methods.registry.known_tables`), and the chosen
+method reads and checks its own by its ``from_config`` (:func:`method_from_config`); a table the chosen method
+does not read is checked by a method that reads it and warned about."""
 
 from __future__ import annotations
 
-import dataclasses
-
-from fracid.config.checker import Checker, bytes_text
+from fracid.config.checker import Checker
 from fracid.config.registry import model_of
-from fracid.config.schema import (
-    MAX_POPULATION,
-    GaussNewtonConfig,
-    IdentifyConfig,
-    KalmanConfig,
-    KnnConfig,
-    ModelConfig,
-)
+from fracid.config.schema import IdentifyConfig, ModelConfig
 from fracid.config.sections import range_text, valid_parameter
-from fracid.config.vocabulary import (
-    DEFAULT_INVERSE_METHOD,
-    GAUSS_NEWTON_KEYS,
-    IDENTIFY_KEYS,
-    KALMAN_KEYS,
-    KNN_KEYS,
-    KNN_METHODS,
-    RESTARTS,
-    SECTION_METHODS,
-)
+from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD, IDENTIFY_KEYS
+from fracid.inverse.core.settings import SettingError, SettingsContext
+from fracid.inverse.methods import registry
 
 
 def _check_plausible(ck: Checker, key: str, pair, name: str, bounds, units: dict) -> None:
@@ -45,25 +30,47 @@ def _check_plausible(ck: Checker, key: str, pair, name: str, bounds, units: dict
 
 
 def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:
+    """The validated ``[identify]`` (``raw``, None when absent: an error if ``needed``); ``n_y``, the data
+    values calibrated on, bounds the settings that count them (e.g. groups of observations)."""
     if raw is None:
         if needed:
             ck.missing("identify", "an [identify] section with parameters and [identify.bounds]")
         return None
-    from fracid.inverse.methods.registry import METHODS
-
-    ck.table("identify", raw, (*IDENTIFY_KEYS, *(name for name in METHODS if name not in IDENTIFY_KEYS)))
+    ck.table("identify", raw, (*IDENTIFY_KEYS, *(t for t in registry.known_tables() if t not in IDENTIFY_KEYS)))
     cls = model_of(model.type, model.law).parameters
     names = _identified(ck, raw, cls, model)
-    inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(METHODS))
+    inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(registry.METHODS))
     lower, upper, log = _bounds(ck, raw, cls, names)
-    identify = IdentifyConfig(parameters=names, lower=lower, upper=upper, log=log, knn=_knn(ck, raw, names, n_y),
-                              kalman=_kalman(ck, raw, n_y), method=inverse,
-                              gauss_newton=_gauss_newton(ck, raw, inverse), methods=_method_tables(ck, raw, inverse))
-    try:
-        method_from_config(identify, n_y)
-    except (TypeError, ValueError) as err:
-        ck.fail(f"identify.{inverse}", raw.get(inverse, inverse), str(err))
+    tables = {name: value for name, value in raw.items() if name not in IDENTIFY_KEYS}
+    identify = IdentifyConfig(parameters=names, lower=lower, upper=upper, log=log, method=inverse, tables=tables)
+    context = SettingsContext(n_y=n_y, parameters=names)
+    _checked(ck, raw, inverse, tables, context, inverse)
+    read = registry.config_tables(registry.METHODS[inverse])
+    for table in (table for table in tables if table not in read):
+        reader = registry.table_readers(table)[0]
+        _checked(ck, raw, reader, {table: tables[table]}, context, table)
+        _warn_unread(ck, table, inverse)
     return identify
+
+
+def _checked(ck: Checker, raw, name: str, tables: dict, context: SettingsContext, key: str) -> None:
+    """Build the registered method ``name`` from ``tables`` (:func:`~fracid.inverse.methods.registry.
+    method_from_tables`): a refused setting is this file's error, named ``identify.<key>`` (a
+    :class:`~fracid.inverse.core.settings.SettingError`'s own key, else ``identify.<key>`` with the table)."""
+    try:
+        registry.method_from_tables(registry.METHODS[name], tables, context)
+    except SettingError as err:
+        ck.fail(f"identify.{err.key}", err.value, err.allowed)
+    except (TypeError, ValueError) as err:
+        ck.fail(f"identify.{key}", raw.get(key, key), str(err))
+
+
+def _warn_unread(ck: Checker, table: str, inverse: str) -> None:
+    """Warn that ``[identify.<table>]`` is given but the chosen method ``inverse`` does not read it, naming
+    the registered method(s) that do."""
+    readers = " or ".join(f'"{name}"' for name in registry.table_readers(table))
+    ck.warn(f"[identify.{table}] is given but identify.method = {inverse!r}: its settings are not used "
+            f"(set method = {readers} to use them)")
 
 
 def _identified(ck: Checker, raw, cls, model: ModelConfig) -> tuple:
@@ -125,102 +132,16 @@ def _bound_pair(ck: Checker, bounds: dict, cls, name: str) -> tuple[float, float
     return lo, hi
 
 
-def _knn(ck: Checker, raw, names: tuple, n_y: int | None) -> KnnConfig:
-    """``[identify.knn]``, with the population limit."""
-    raw_knn = ck.table("identify.knn", raw.get("knn", {}), KNN_KEYS)
-    n = ck.integer("identify.knn.n", raw_knn.get("n", 64), "must be an integer >= 2", lambda v: v >= 2)
-    method = ck.choice("identify.knn.method", raw_knn.get("method", "sobol"), KNN_METHODS)
-    seed = ck.integer("identify.knn.seed", raw_knn.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0)
-    knn = KnnConfig(n=n, method=method, k=5, seed=seed)
-    population = knn.population(len(names))
-    how = f"n**p = {n}**{len(names)}" if method == "grid" else f"n = {n}"
-    if population > MAX_POPULATION:
-        values = population * (len(names) + (n_y or 0))
-        ck.fail("identify.knn.n", n, f"the population of {population:,} points ({how}, method {method!r}) is above the "
-                                     f"limit of {MAX_POPULATION:,}: each point is one forward run (seconds to minutes "
-                                     f"each), and the points and their outputs alone take {values:,} x 8 bytes = "
-                                     f"{bytes_text(8.0 * values)} (p = {len(names)} parameters + n_y = {n_y or 0} outputs "
-                                     "per point); a few hundred points are enough to start the Kalman filter")
-    k = ck.integer("identify.knn.k" + ("" if "k" in raw_knn else " (default)"), raw_knn.get("k", 5),
-                   f"must be an integer with 1 <= k <= the population size {population} ({how}, method {method!r})",
-                   lambda v: 1 <= v <= population)
-    return dataclasses.replace(knn, k=k)
-
-
-def _kalman(ck: Checker, raw, n_y: int | None) -> KalmanConfig:
-    """``[identify.kalman]``."""
-    raw_kf = ck.table("identify.kalman", raw.get("kalman", {}), KALMAN_KEYS)
-    groups = None
-    if "groups" in raw_kf:
-        top = n_y if n_y else None
-        allowed = (f"must be an integer with 1 <= groups <= n_y = {top} (the total n_points of the experiments)"
-                   if top else "must be an integer >= 1")
-        groups = ck.integer("identify.kalman.groups", raw_kf["groups"], allowed,
-                            lambda v: v >= 1 and (top is None or v <= top))
-    return KalmanConfig(
-        groups=groups,
-        max_iterations=ck.integer("identify.kalman.max_iterations", raw_kf.get("max_iterations", 10),
-                                  "must be an integer >= 1", lambda v: v >= 1),
-        tol=ck.number("identify.kalman.tol", raw_kf.get("tol", 0.01), "must be a number > 0 [standard deviations]",
-                      lambda v: v > 0),
-        restart=ck.choice("identify.kalman.restart", raw_kf.get("restart", "linearize"), RESTARTS),
-        max_starts=ck.integer("identify.kalman.max_starts", raw_kf.get("max_starts", 3),
-                              "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1),
-    )
-
-
-def _gauss_newton(ck: Checker, raw, inverse: str) -> GaussNewtonConfig:
-    """``[identify.gauss-newton]``."""
-    raw_gn = ck.table("identify.gauss-newton", raw.get("gauss-newton", {}), GAUSS_NEWTON_KEYS)
-    if raw_gn:
-        _warn_if_unused(ck, "gauss-newton", inverse)
-    return GaussNewtonConfig(
-        max_iterations=ck.integer("identify.gauss-newton.max_iterations", raw_gn.get("max_iterations", 20),
-                                  "must be an integer >= 1 (linearisations at most)", lambda v: v >= 1),
-        tol=ck.number("identify.gauss-newton.tol", raw_gn.get("tol", 0.01),
-                      "must be a number > 0 [standard deviations]", lambda v: v > 0),
-    )
-
-
-def _method_tables(ck: Checker, raw, inverse: str) -> dict:
-    """The registered methods' own tables ``[identify.<name>]``, as read (the method's ``from_config``
-    checks its own); a warning for one of a method not chosen."""
-    from fracid.inverse.methods.registry import METHODS
-
-    methods = {}
-    for name in (name for name in METHODS if name in raw):
-        if not isinstance(raw[name], dict):
-            ck.fail(f"identify.{name}", raw[name], f"must be a table (section) of the settings of the method {name!r}")
-        methods[name] = dict(raw[name])
-        _warn_if_unused(ck, name, inverse)
-    return methods
-
-
-def _warn_if_unused(ck: Checker, section: str, inverse: str) -> None:
-    """Warn that ``[identify.<section>]`` is given for a method other than the chosen ``inverse``: a built-in
-    section is read by its method of :data:`~fracid.config.vocabulary.SECTION_METHODS`, a registered method's
-    own table by the method of its name."""
-    method = SECTION_METHODS.get(section, section)
-    if method != inverse:
-        ck.warn(f"[identify.{section}] is given but identify.method = {inverse!r}: its settings are not used "
-                f"(set method = \"{method}\" to use them)")
-
-
 def method_from_config(identify: IdentifyConfig, n_y: int | None):
-    """The inverse method of a validated ``[identify]``: ``METHODS[identify.method].from_config(identify,
-    n_y)``; a method class without ``from_config`` is built with its defaults (and takes no table).
+    """The inverse method of a validated ``[identify]``: the class ``identify.method`` names in
+    :data:`~fracid.inverse.methods.registry.METHODS`, built from the tables ``identify.tables`` it reads
+    (:func:`~fracid.inverse.methods.registry.method_from_tables`); ``n_y`` is the data's size.
 
     Raises
     ------
     ValueError, TypeError
-        The method's refusal of its settings (the message names the setting and what is allowed).
+        The method's refusal of its settings (a :class:`~fracid.inverse.core.settings.SettingError` names the
+        setting and what is allowed).
     """
-    from fracid.inverse.methods.registry import METHODS
-
-    cls = METHODS[identify.method]
-    from_config = getattr(cls, "from_config", None)  # an optional hook of the method
-    if from_config is not None:
-        return from_config(identify, n_y)
-    if identify.methods.get(identify.method):
-        raise ValueError(f"the method {identify.method!r} takes no settings from the configuration")
-    return cls()
+    context = SettingsContext(n_y=n_y, parameters=identify.parameters)
+    return registry.method_from_tables(registry.METHODS[identify.method], identify.tables, context)

@@ -104,6 +104,10 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     beta = [100.0, 2000.0]
     c = [1.0, 30.0]                     # mm^2
     log = ["beta"]                      # optional: sampled uniformly in log(x); needs lower > 0
+    # The tables below are the built-in methods' settings: the configuration allows every table a
+    # registered method declares (its config_tables) and the method's from_config checks its own
+    # ([identify.knn]: fracid.inverse.methods.knn_settings; [identify.kalman]: knn_kalman.KnnKalman;
+    # [identify.gauss-newton]: knn_gauss_newton.KnnGaussNewton); a method's own table is [identify.<name>].
     [identify.knn]                      # optional
     n = 64                              # integer >= 2 (grid: points per parameter), default 64
     method = "sobol"                    # "sobol" (default) | "lhs" | "grid"
@@ -111,7 +115,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     seed = 0                            # integer >= 0, default 0
     [identify.kalman]                   # optional
     groups = 4                          # consecutive observation groups, 1 <= groups <= n_y (total
-                                        #   n_points); omitted: one observation per step
+                                        #   n_points); default 4 (n_y if fewer)
     max_iterations = 10                 # integer >= 1, default 10
     tol = 0.01                          # > 0, in standard deviations, default 0.01
     restart = "linearize"               # "linearize" (default) | "prior-mean"
@@ -161,6 +165,7 @@ from pathlib import Path
 
 from fracid.config.registry import model_of
 from fracid.config.vocabulary import CONTROL_UNITS, DEFAULT_INVERSE_METHOD, FORCE_UNITS, LOCAL_UNITS
+from fracid.inverse.methods.knn_settings import MAX_POPULATION  # noqa: F401 (re-exported: a limit of the configuration)
 from fracid.inverse.sampling.posterior import PosteriorSettings
 from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
     BAR_BYTES_PER_ELEMENT,
@@ -178,10 +183,8 @@ class ConfigError(ValueError):
 # A configuration asking for more than a workstation can hold is refused when it is loaded, with
 # the estimate, instead of failing (or swapping for hours) in the middle of a study.
 
-#: largest KNN population (n, or n**p for a grid): each member is one forward run (seconds to
-#: minutes each), so 1e5 is already days of computing; n = 1e9 allocated 23.5 GB before the first run
-MAX_POPULATION = 100_000
-
+# The largest KNN population (MAX_POPULATION) is the KNN settings' (fracid.inverse.methods.knn_settings), checked
+# by the methods that read [identify.knn]; imported above and re-exported.
 # The limits of a forward run's memory (MAX_BAR_ELEMENTS, BAR_BYTES_PER_ELEMENT, MAX_UNKNOWNS,
 # BYTES_PER_UNKNOWN) are the specimens' (fracid.specimens.protocol), imported above and re-exported.
 
@@ -271,54 +274,18 @@ class ExperimentConfig:
 
 
 @dataclass(frozen=True)
-class KnnConfig:
-    """``[identify.knn]``."""
-
-    n: int = 64
-    method: str = "sobol"
-    k: int = 5
-    seed: int = 0
-
-    def population(self, p: int) -> int:
-        """Number of forward runs for p parameters."""
-        return self.n**p if self.method == "grid" else self.n
-
-
-@dataclass(frozen=True)
-class KalmanConfig:
-    """``[identify.kalman]``; ``groups`` None = one observation per step."""
-
-    groups: int | None = None
-    max_iterations: int = 10
-    tol: float = 0.01
-    restart: str = "linearize"
-    max_starts: int = 3
-
-
-@dataclass(frozen=True)
-class GaussNewtonConfig:
-    """``[identify.gauss-newton]``: the Gauss-Newton stage of ``method = "knn-gauss-newton"``."""
-
-    max_iterations: int = 20
-    tol: float = 0.01
-
-
-@dataclass(frozen=True)
 class IdentifyConfig:
     """``[identify]``: identified parameters, their bounds and log flags, the inverse method (a key of
-    :data:`fracid.inverse.methods.registry.METHODS`) and the sections of the registered methods' settings."""
+    :data:`fracid.inverse.methods.registry.METHODS`) and the tables of the methods' settings."""
 
     parameters: tuple
     lower: tuple
     upper: tuple
     log: tuple = ()  # names sampled in log scale
-    knn: KnnConfig = KnnConfig()
-    kalman: KalmanConfig = KalmanConfig()
     method: str = DEFAULT_INVERSE_METHOD
-    gauss_newton: GaussNewtonConfig = GaussNewtonConfig()
-    #: a registered method's own table ``[identify.<name>]`` by method name, as read (its ``from_config``
-    #: checks it)
-    methods: dict = field(default_factory=dict)
+    #: the tables of the methods' settings ``[identify.<table>]`` given, by name, as read (the methods that
+    #: read them check them: :func:`fracid.config.identify.method_from_config`)
+    tables: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

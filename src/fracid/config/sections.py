@@ -28,6 +28,7 @@ from fracid.config.vocabulary import (
     SIMULATE_KEYS,
     STUDY_KEYS,
 )
+from fracid.inverse.core.settings import is_integer
 
 
 def range_text(cls, name: str) -> str:
@@ -224,11 +225,8 @@ def read_output(ck: Checker, raw, base: Path) -> OutputConfig:
     path = ck.location("output.directory", raw.get("directory", "results"), base, "must be a directory path (string)")
     steps = raw.get("vtk_steps", [])
     allowed = "must be a list of step numbers (integers >= 0)"
-    if not isinstance(steps, list):
+    if not isinstance(steps, list) or not all(is_integer(step) and step >= 0 for step in steps):
         ck.fail("output.vtk_steps", steps, allowed)
-    for step in steps:
-        if isinstance(step, bool) or not isinstance(step, int) or step < 0:
-            ck.fail("output.vtk_steps", steps, allowed)
     return OutputConfig(directory=path, vtk_steps=tuple(sorted(set(steps))))
 
 

@@ -6,6 +6,8 @@ The schema itself, with every key explained, is the docstring of :mod:`fracid.co
 
 from __future__ import annotations
 
+from fracid.inverse.methods.registry import DEFAULT_METHOD
+
 # ------------------------------------------------------------------------------------ values
 
 #: ``control_unit`` -> multiplier to mm
@@ -18,9 +20,6 @@ FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 #: ``force_unit`` of a local quantity (a length) -> multiplier to mm
 LOCAL_UNITS = dict(CONTROL_UNITS)
 KINDS = ("repeats", "envelope", "single")
-#: ``[identify.knn] method``: how the KNN population is sampled
-KNN_METHODS = ("sobol", "lhs", "grid")
-RESTARTS = ("linearize", "prior-mean")
 PURPOSES = ("identify", "simulate")
 ROLES = ("calibration", "prediction")
 
@@ -38,10 +37,9 @@ KIND_KEYS = {
     "envelope": ("mean_column", "lower_column", "upper_column"),
     "single": ("force_columns", "std", "relative_std"),
 }
-IDENTIFY_KEYS = ("parameters", "method", "bounds", "knn", "kalman", "gauss-newton")
-KNN_KEYS = ("n", "method", "k", "seed")
-KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
-GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
+#: the keys of [identify] itself; it also allows every table of a registered inverse method's settings
+#: (fracid.inverse.methods.registry.known_tables), which the method checks
+IDENTIFY_KEYS = ("parameters", "method", "bounds")
 OUTPUT_KEYS = ("directory", "vtk_steps")
 SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
@@ -49,8 +47,5 @@ POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components",
 
 # ------------------------------------------------------------------------------------ inverse methods
 
-#: the default of [identify] method (a key of fracid.inverse.methods.registry.METHODS)
-DEFAULT_INVERSE_METHOD = "knn-kalman"
-#: a built-in ``[identify.<section>]`` of one method's settings -> the method that reads it; a section given
-#: for another method is warned of. A registered method's own table ``[identify.<name>]`` is its name's.
-SECTION_METHODS = {"gauss-newton": "knn-gauss-newton"}
+#: the default of [identify] method: the registry's (fracid.inverse.methods.registry.DEFAULT_METHOD)
+DEFAULT_INVERSE_METHOD = DEFAULT_METHOD

@@ -60,8 +60,9 @@ def runs_per_linearisation(operator, p: int) -> tuple[int, str]:
 
 
 def population_plan(knn, p: int, stage: str = "knn", label: str = "KNN") -> StagePlan:
-    """The population of a KNN search with the settings ``knn`` (n, method, k) for ``p`` parameters."""
-    runs = knn.n**p if knn.method == "grid" else knn.n
+    """The population of a KNN search with the settings ``knn`` (a :class:`~fracid.inverse.methods.knn_settings.
+    KnnSettings`: n, method, k) for ``p`` parameters."""
+    runs = knn.population(p)
     return StagePlan(stage, label, runs, True, float(runs), f"{runs} forward runs side by side ({knn.method}, k = {knn.k})",
                      f"[identify.knn] n = {knn.n}")
 

@@ -1,7 +1,8 @@
 """KNN over a population, then bounded Gauss-Newton on the Kalman filter's Bayesian objective.
 
 :class:`KnnGaussNewton` meets :class:`~fracid.inverse.core.method.InverseMethod` and the study's
-:class:`~fracid.inverse.methods.registry.StudyMethod`; it returns a :class:`GaussNewtonResult`.
+:class:`~fracid.inverse.methods.registry.StudyMethod`; it returns a :class:`GaussNewtonResult`. Its settings
+come from the configuration's ``[identify.knn]`` and ``[identify.gauss-newton]`` (:meth:`KnnGaussNewton.from_config`).
 """
 
 from __future__ import annotations
@@ -13,11 +14,18 @@ from typing import ClassVar
 import numpy as np
 
 from fracid.inverse.methods.gauss_newton import gauss_newton
-from fracid.inverse.methods.knn_kalman import KnnSettings, knn_record, population_search, search_then_refine
+from fracid.inverse.methods.knn_kalman import knn_record, population_search, search_then_refine
+from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table, knn_template
 from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
 from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
+from fracid.inverse.core import settings
+from fracid.inverse.core.settings import SettingsContext, toml_line
 from fracid.inverse.core.space import ParameterSpace
+
+#: the table of the Gauss-Newton stage's settings in ``[identify]``, and its keys
+GAUSS_NEWTON_TABLE = "gauss-newton"
+GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
 
 
 def _stages() -> dict:
@@ -72,15 +80,37 @@ class KnnGaussNewton:
     name: ClassVar[str] = "knn-gauss-newton"
     stages: ClassVar[dict] = {"knn": "KNN", "gauss_newton": "Gauss-Newton"}
 
+    #: the tables of [identify] this method reads (:meth:`from_config`)
+    config_tables: ClassVar[tuple] = ("knn", GAUSS_NEWTON_TABLE)
+
     @classmethod
-    def from_config(cls, identify, n_y: int | None) -> KnnGaussNewton:
-        """The method of a validated ``[identify]``: its ``knn`` and ``gauss_newton`` sections."""
-        if getattr(identify, "methods", {}).get(cls.name):
-            raise ValueError(f"the settings of {cls.name} are those of [identify.knn] and [identify.gauss-newton], "
-                             "not a table of its own")
-        knn, gn = identify.knn, identify.gauss_newton
-        return cls(KnnSettings(n=knn.n, method=knn.method, seed=knn.seed, k=knn.k), max_iterations=gn.max_iterations,
-                   tol=gn.tol)
+    def from_config(cls, tables: dict, context: SettingsContext) -> KnnGaussNewton:
+        """The method of the configuration's tables ``[identify.knn]`` (:func:`~fracid.inverse.methods.knn_settings.
+        knn_from_table`) and ``[identify.gauss-newton]`` (``max_iterations``: integer >= 1, default 20; ``tol``:
+        > 0 standard deviations, default 0.01), ``tables`` by name (empty when absent).
+
+        Raises
+        ------
+        fracid.inverse.core.settings.SettingError
+            A key or value refused (named relative to ``[identify]``: ``gauss-newton.tol``).
+        """
+        knn = knn_from_table(tables.get("knn", {}), context)
+        raw = settings.table(GAUSS_NEWTON_TABLE, tables.get(GAUSS_NEWTON_TABLE, {}), GAUSS_NEWTON_KEYS)
+        return cls(knn, max_iterations=settings.integer(
+            "gauss-newton.max_iterations", raw.get("max_iterations", 20),
+            "must be an integer >= 1 (linearisations at most)", lambda v: v >= 1),
+            tol=settings.number("gauss-newton.tol", raw.get("tol", 0.01), "must be a number > 0 [standard deviations]",
+                                lambda v: v > 0))
+
+    @classmethod
+    def config_template(cls, tables: dict) -> list[str]:
+        """The ``[identify.knn]`` and ``[identify.gauss-newton]`` lines of a configuration ``fracid init``
+        writes, with the values of ``tables`` (by table name; a first run's where absent)."""
+        gn = tables.get(GAUSS_NEWTON_TABLE, {})
+        return knn_template(tables.get("knn", {}), "the prior") + [
+            f"[identify.{GAUSS_NEWTON_TABLE}]",
+            toml_line("max_iterations", gn.get("max_iterations", 20), "linearisations at most"),
+            toml_line("tol", gn.get("tol", 0.01), "convergence: the largest step in standard deviations")]
 
     def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
         """The forward runs of both stages: the population side by side, then at most ``max_iterations``
@@ -136,4 +166,4 @@ class KnnGaussNewton:
                                   progress=progress, retry_failed=retry_failed, blocks=blocks, notes=notes)
 
 
-__all__ = ["GaussNewtonResult", "KnnGaussNewton"]
+__all__ = ["GAUSS_NEWTON_KEYS", "GAUSS_NEWTON_TABLE", "GaussNewtonResult", "KnnGaussNewton"]

@@ -3,14 +3,16 @@
 
 :class:`KnnKalman` meets :class:`~fracid.inverse.core.method.InverseMethod` and the study's
 :class:`~fracid.inverse.methods.registry.StudyMethod` (``search``, ``refine``, ``fit_from``); its settings are
-:class:`KnnSettings` and :class:`KalmanSettings`.
+:class:`~fracid.inverse.methods.knn_settings.KnnSettings` and :class:`KalmanSettings`, which
+:meth:`KnnKalman.from_config` reads (and checks) from the configuration's ``[identify.knn]`` and
+``[identify.kalman]``.
 """
 
 from __future__ import annotations
 
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
@@ -18,10 +20,13 @@ import numpy as np
 from fracid.inverse.methods.kalman import kalman_filter
 from fracid.inverse.methods.kalman_status import DEFAULT_MAX_STARTS, restarted
 from fracid.inverse.methods.knn import knn_search
+from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table, knn_template
 from fracid.inverse.core.method import MethodResult, check_problem, identification_bounds, result_fields
 from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
+from fracid.inverse.core import settings
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
+from fracid.inverse.core.settings import SettingsContext, toml_line
 from fracid.inverse.core.space import ParameterSpace
 from fracid.batch import BatchStats
 
@@ -64,28 +69,6 @@ DEFAULT_GROUPS = 4
 
 
 @dataclass(frozen=True)
-class KnnSettings:
-    """The KNN population search (:func:`~fracid.inverse.methods.knn.knn_search`).
-
-    Attributes
-    ----------
-    n : int
-        Population size (for ``method="grid"``: points per parameter).
-    method : {"sobol", "lhs", "grid"}
-        Design of the population over the parameter space (:func:`~fracid.inverse.methods.knn.design`).
-    seed : int
-        Seed of the design.
-    k : int
-        Nearest neighbours whose mean and spread are the Kalman filter's prior.
-    """
-
-    n: int = 64
-    method: str = "sobol"
-    seed: int = 0
-    k: int = 5
-
-
-@dataclass(frozen=True)
 class KalmanSettings:
     """The Kalman filter (:func:`~fracid.inverse.methods.kalman.kalman_filter`).
 
@@ -118,6 +101,38 @@ class KalmanSettings:
         ``blocks`` (``(name, start, stop)``; a named ``groups`` is resolved with them)."""
         return {"groups": named_groups(self.groups, n_y, blocks), "max_iterations": self.max_iterations,
                 "tol": self.tol, "restart": self.restart}
+
+
+#: the keys of ``[identify.kalman]`` and the values of its ``restart``
+KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
+RESTARTS = ("linearize", "prior-mean")
+
+
+def kalman_from_table(raw, n_y: int | None) -> KalmanSettings:
+    """The :class:`KalmanSettings` of the table ``[identify.kalman]`` (``raw``, a dict; empty: the defaults),
+    ``groups`` still a count (or None): ``1 <= groups <= n_y`` (the total data values, when known).
+
+    Raises
+    ------
+    fracid.inverse.core.settings.SettingError
+        Naming ``kalman.<key>``, the value and what is allowed.
+    """
+    raw = settings.table("kalman", raw, KALMAN_KEYS)
+    groups = None
+    if "groups" in raw:
+        top = n_y if n_y else None
+        allowed = (f"must be an integer with 1 <= groups <= n_y = {top} (the total n_points of the experiments)"
+                   if top else "must be an integer >= 1")
+        groups = settings.integer("kalman.groups", raw["groups"], allowed, lambda v: v >= 1 and (top is None or v <= top))
+    return KalmanSettings(
+        groups=groups,
+        max_iterations=settings.integer("kalman.max_iterations", raw.get("max_iterations", 10),
+                                        "must be an integer >= 1", lambda v: v >= 1),
+        tol=settings.number("kalman.tol", raw.get("tol", 0.01), "must be a number > 0 [standard deviations]",
+                            lambda v: v > 0),
+        restart=settings.choice("kalman.restart", raw.get("restart", "linearize"), RESTARTS),
+        max_starts=settings.integer("kalman.max_starts", raw.get("max_starts", DEFAULT_MAX_STARTS),
+                                    "must be an integer >= 1 (starts of the filter in all)", lambda v: v >= 1))
 
 
 def named_groups(groups, n_y: int, blocks=()):
@@ -157,22 +172,37 @@ class KnnKalman:
         return population_search(self.knn, operator, y_exp, C_exp, space, executor=executor, store=store,
                                  progress=progress, stats=stats, retry_failed=retry_failed)
 
+    #: the tables of [identify] this method reads (:meth:`from_config`)
+    config_tables: ClassVar[tuple] = ("knn", "kalman")
+
     @classmethod
-    def from_config(cls, identify, n_y: int | None) -> KnnKalman:
-        """The method of a validated ``[identify]`` (its ``knn`` and ``kalman`` sections, as
-        :class:`fracid.config.KnnConfig` and :class:`fracid.config.KalmanConfig`); ``groups`` (a count)
-        becomes that many consecutive index arrays over the ``n_y`` observations, :data:`DEFAULT_GROUPS`
-        when not given."""
-        if getattr(identify, "methods", {}).get(cls.name):
-            raise ValueError(f"the settings of {cls.name} are those of [identify.knn] and [identify.kalman], not a "
-                             "table of its own")
-        knn, kalman = identify.knn, identify.kalman
-        n_y = max(int(n_y or 1), 1)
+    def from_config(cls, tables: dict, context: SettingsContext) -> KnnKalman:
+        """The method of the configuration's tables ``[identify.knn]`` (:func:`~fracid.inverse.methods.knn_settings.
+        knn_from_table`) and ``[identify.kalman]`` (:func:`kalman_from_table`), ``tables`` by name (empty when
+        absent). ``groups`` (a count) becomes that many consecutive index arrays over the ``context.n_y``
+        observations, :data:`DEFAULT_GROUPS` when not given.
+
+        Raises
+        ------
+        fracid.inverse.core.settings.SettingError
+            A key or value refused (named relative to ``[identify]``: ``kalman.groups``).
+        """
+        knn = knn_from_table(tables.get("knn", {}), context)
+        kalman = kalman_from_table(tables.get("kalman", {}), context.n_y)
+        n_y = max(int(context.n_y or 1), 1)
         count = kalman.groups if kalman.groups is not None else min(DEFAULT_GROUPS, n_y)
         groups = [np.asarray(g) for g in np.array_split(np.arange(n_y), count)]
-        return cls(KnnSettings(n=knn.n, method=knn.method, seed=knn.seed, k=knn.k),
-                   KalmanSettings(groups=groups, max_iterations=kalman.max_iterations, tol=kalman.tol,
-                                  restart=kalman.restart, max_starts=kalman.max_starts))
+        return cls(knn, replace(kalman, groups=groups))
+
+    @classmethod
+    def config_template(cls, tables: dict) -> list[str]:
+        """The ``[identify.knn]`` and ``[identify.kalman]`` lines of a configuration ``fracid init`` writes,
+        with the values of ``tables`` (by table name; a first run's where absent: n 32, k 5, groups 4)."""
+        kalman = tables.get("kalman", {})
+        return knn_template(tables.get("knn", {}), "the Kalman prior") + [
+            "[identify.kalman]", toml_line("groups", kalman.get("groups", DEFAULT_GROUPS),
+                                           "filter steps per pass (one run each with exact sensitivities)"),
+            toml_line("max_iterations", kalman.get("max_iterations", 10), "passes at most")]
 
     def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
         """The forward runs of both stages (:class:`~fracid.inverse.core.plans.StagePlan`): the population side by
@@ -333,5 +363,6 @@ def population_search(knn: KnnSettings, operator, y_exp, C_exp, space: Parameter
                       executor=executor, store=store, progress=progress, stats=stats, retry_failed=retry_failed)
 
 
-__all__ = ["DEFAULT_GROUPS", "IdentificationResult", "KalmanSettings", "KnnKalman", "KnnSettings", "kalman_progress",
-           "knn_output", "knn_record", "named_groups", "population_search", "refine", "search_then_refine"]
+__all__ = ["DEFAULT_GROUPS", "KALMAN_KEYS", "RESTARTS", "IdentificationResult", "KalmanSettings", "KnnKalman",
+           "KnnSettings", "kalman_from_table", "kalman_progress", "knn_output", "knn_record", "named_groups",
+           "population_search", "refine", "search_then_refine"]

@@ -7,9 +7,13 @@ counters and records in the result, the report's sections). A method meets
 :class:`~fracid.inverse.core.method.InverseMethod` (``fracid identify``); one that also meets
 :class:`StudyMethod` runs every check of ``fracid study`` through its own stages.
 
-A new method is a class and one line here (or ``METHODS[name] = cls`` from the user's code); its
-settings come from ``[identify.<name>]`` of the configuration through its ``from_config`` class method
-(see :func:`fracid.config.build_method`).
+A new method is a class and one line here (or ``METHODS[name] = cls`` from the user's code). Its settings
+come from the configuration's tables ``[identify.<table>]`` that it declares in ``config_tables`` (without it:
+the table of its name, ``[identify.<name>]``), read and checked by its ``from_config(tables, context)`` class
+method (:func:`method_from_tables`; the checkers and their :class:`~fracid.inverse.core.settings.SettingError`
+are in :mod:`fracid.inverse.core.settings`); ``config_template(tables)`` writes them for ``fracid init``. The
+configuration knows no method: it allows every table a registered method declares (:func:`known_tables`) and
+warns of one the chosen method does not read (:func:`table_readers`).
 """
 
 from __future__ import annotations
@@ -86,10 +90,57 @@ def with_settings(method, **changes):
     return dataclasses.replace(method, **{**top, **nested})
 
 
+def config_tables(cls) -> tuple:
+    """The ``[identify.<table>]`` tables the method class ``cls`` reads: its ``config_tables``, else the table
+    of its name (``(cls.name,)``)."""
+    return tuple(getattr(cls, "config_tables", None) or (cls.name,))
+
+
+def known_tables() -> tuple:
+    """Every table a registered method reads, each once, in the order of :data:`METHODS`."""
+    return tuple(dict.fromkeys(table for cls in METHODS.values() for table in config_tables(cls)))
+
+
+def table_readers(table: str) -> tuple:
+    """The names of the registered methods that read the table ``table``."""
+    return tuple(name for name, cls in METHODS.items() if table in config_tables(cls))
+
+
+def method_from_tables(cls, given: dict, context):
+    """The method ``cls`` with the settings of the tables ``given`` (table name -> the table as read; those it
+    does not read are left out, those absent are empty): ``cls.from_config(tables, context)``; a class without
+    ``from_config`` is built with its defaults and takes no table.
+
+    Parameters
+    ----------
+    cls : type
+        An inverse method class.
+    given : dict
+        The ``[identify.<table>]`` tables given, by name.
+    context : fracid.inverse.core.settings.SettingsContext
+        The data's size ``n_y`` and the identified ``parameters``.
+
+    Raises
+    ------
+    fracid.inverse.core.settings.SettingError
+        A setting refused by the method, named relative to ``[identify]``.
+    ValueError, TypeError
+        Another refusal of the method; settings given to a method that takes none.
+    """
+    tables = {table: given.get(table, {}) for table in config_tables(cls)}
+    from_config = getattr(cls, "from_config", None)  # an optional hook of the method
+    if from_config is not None:
+        return from_config(tables, context)
+    if any(tables.values()):
+        raise ValueError(f"the method {cls.name!r} takes no settings from the configuration")
+    return cls()
+
+
 def method_stages(name: str) -> dict:
     """The stages (name -> label) of the registered method ``name``; empty for an unknown name."""
     cls = METHODS.get(name)
     return dict(getattr(cls, "stages", None) or {})
 
 
-__all__ = ["DEFAULT_METHOD", "METHODS", "KnnGaussNewton", "KnnKalman", "StudyMethod", "method_stages", "with_settings"]
+__all__ = ["DEFAULT_METHOD", "METHODS", "KnnGaussNewton", "KnnKalman", "StudyMethod", "config_tables", "known_tables",
+           "method_from_tables", "method_stages", "table_readers", "with_settings"]

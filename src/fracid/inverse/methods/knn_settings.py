@@ -1,0 +1,102 @@
+"""The settings of a KNN population search (:class:`KnnSettings`) and their table ``[identify.knn]`` of the
+configuration, shared by every KNN-started method: :func:`knn_from_table` checks it (with the population
+limit :data:`MAX_POPULATION`), :func:`knn_template` writes it for ``fracid init``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fracid.inverse.core import settings
+from fracid.inverse.core.settings import SettingError, SettingsContext, bytes_text, toml_line
+
+
+@dataclass(frozen=True)
+class KnnSettings:
+    """The KNN population search (:func:`~fracid.inverse.methods.knn.knn_search`).
+
+    Attributes
+    ----------
+    n : int
+        Population size (for ``method="grid"``: points per parameter).
+    method : {"sobol", "lhs", "grid"}
+        Design of the population over the parameter space (:func:`~fracid.inverse.methods.knn.design`).
+    seed : int
+        Seed of the design.
+    k : int
+        Nearest neighbours whose mean and spread are the Kalman filter's prior.
+    """
+
+    n: int = 64
+    method: str = "sobol"
+    seed: int = 0
+    k: int = 5
+
+    def population(self, p: int) -> int:
+        """Number of forward runs of the population for ``p`` parameters (``n``, or ``n**p`` for a grid)."""
+        return self.n**p if self.method == "grid" else self.n
+
+
+#: largest KNN population (n, or n**p for a grid): each member is one forward run (seconds to
+#: minutes each), so 1e5 is already days of computing; n = 1e9 allocated 23.5 GB before the first run
+MAX_POPULATION = 100_000
+
+#: the table of the population's settings in ``[identify]``, and its keys
+KNN_TABLE = "knn"
+KNN_KEYS = ("n", "method", "k", "seed")
+#: ``[identify.knn] method``: how the KNN population is sampled (:func:`~fracid.inverse.methods.knn.design`)
+KNN_METHODS = ("sobol", "lhs", "grid")
+
+
+def knn_from_table(raw, context: SettingsContext) -> KnnSettings:
+    """The :class:`KnnSettings` of the table ``[identify.knn]`` (``raw``, a dict; empty: the defaults).
+
+    Parameters
+    ----------
+    raw : dict
+        The table as given: ``n`` (integer >= 2, default 64), ``method`` (:data:`KNN_METHODS`, default
+        ``"sobol"``), ``seed`` (integer >= 0, default 0), ``k`` (1 <= k <= the population, default 5).
+    context : SettingsContext
+        ``parameters`` (their count p sets a grid's population n**p) and ``n_y`` (the data values, for the
+        memory of the population in the message of the limit).
+
+    Raises
+    ------
+    SettingError
+        Naming ``knn.<key>``, the value and what is allowed; ``knn.n`` for a population above
+        :data:`MAX_POPULATION` (with its memory).
+    """
+    raw = settings.table(KNN_TABLE, raw, KNN_KEYS)
+    n = settings.integer("knn.n", raw.get("n", 64), "must be an integer >= 2", lambda v: v >= 2)
+    method = settings.choice("knn.method", raw.get("method", "sobol"), KNN_METHODS)
+    seed = settings.integer("knn.seed", raw.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0)
+    p = len(context.parameters)
+    knn = KnnSettings(n=n, method=method, seed=seed)
+    population = knn.population(p)
+    how = f"n**p = {n}**{p}" if method == "grid" else f"n = {n}"
+    if population > MAX_POPULATION:
+        raise SettingError("knn.n", n, _population_text(population, how, method, p, context.n_y or 0))
+    k = settings.integer("knn.k" + ("" if "k" in raw else " (default)"), raw.get("k", 5),
+                         f"must be an integer with 1 <= k <= the population size {population} ({how}, method "
+                         f"{method!r})", lambda v: 1 <= v <= population)
+    return KnnSettings(n=n, method=method, seed=seed, k=k)
+
+
+def _population_text(population: int, how: str, method: str, p: int, n_y: int) -> str:
+    """Why a population above :data:`MAX_POPULATION` is refused: its runs and its memory."""
+    values = population * (p + n_y)
+    return (f"the population of {population:,} points ({how}, method {method!r}) is above the limit of "
+            f"{MAX_POPULATION:,}: each point is one forward run (seconds to minutes each), and the points and their "
+            f"outputs alone take {values:,} x 8 bytes = {bytes_text(8.0 * values)} (p = {p} parameters + n_y = {n_y} "
+            "outputs per point); a few hundred points are enough to start the Kalman filter")
+
+
+def knn_template(raw: dict, prior: str = "the prior") -> list[str]:
+    """The lines of ``[identify.knn]`` in a generated configuration: ``n`` (default 32, a first run's),
+    ``method`` and ``k`` of ``raw`` (the values to write), each with its comment; ``prior`` names what the
+    neighbours give."""
+    return [f"[identify.{KNN_TABLE}]", toml_line("n", raw.get("n", 32), "population of forward runs (the bulk of the cost)"),
+            toml_line("method", raw.get("method", "sobol"), " | ".join(f'"{m}"' for m in KNN_METHODS)),
+            toml_line("k", raw.get("k", 5), f"neighbours giving {prior}")]
+
+
+__all__ = ["KNN_KEYS", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]
