@@ -249,3 +249,60 @@ def test_probed_specimen_adds_functionals_and_names_bad_probes():
     one, other = (SimpleNamespace(probes={"dic:ux[0]": ((node, 0, 1.0),)}) for node in (3, 4))
     with pytest.raises(ValueError, match="define the probe 'dic:ux\\[0\\]' differently"):
         merge_probes([one, other])
+
+
+# ------------------------------------------------------------------------------------------------
+# missing values: the keep mask of a field observation
+
+
+def _fake_run(values, derivatives):
+    return SimpleNamespace(probed_at=lambda frames: (values, derivatives))
+
+
+def test_keep_restricts_size_controls_coordinates_and_sample(beam_case):
+    beam, *_ = beam_case
+    frames = [0.01, 0.02, 0.03]
+    full = FieldObservation(beam, POINTS, frames, name="dic")
+    keep = np.ones((3, 2, len(POINTS)), dtype=bool)
+    keep[0, :, 1] = False  # a hole at point 1 in frame 0 (both components)
+    keep[2, 1, 3] = False  # v of point 3 in frame 2
+    kept = FieldObservation(beam, POINTS, frames, name="dic", keep=keep)
+    flat = keep.ravel()
+    assert kept.size == full.size - 3 == int(flat.sum())
+    np.testing.assert_array_equal(kept.controls, full.controls[flat])
+    assert np.all(np.diff(kept.controls) >= 0)
+    for name, values in full.coordinates().items():
+        np.testing.assert_array_equal(kept.coordinates()[name], values[flat])
+    dropped = kept.coordinates()
+    assert (0, 1) not in set(zip(dropped["frame"][dropped["component"] == 0].tolist(),
+                                 dropped["point"][dropped["component"] == 0].tolist()))
+    values = np.arange(full.size, dtype=float).reshape(3, -1)  # (frames, components x points)
+    derivatives = np.stack([values, -2 * values], axis=-1)
+    y, S = kept.sample(_fake_run(values, derivatives))
+    np.testing.assert_array_equal(y, np.flatnonzero(flat))  # the entry numbers of the kept entries
+    np.testing.assert_array_equal(S, np.column_stack([y, -2 * y]))
+    y, S = kept.sample(_fake_run(values, None))
+    assert S is None and y.size == kept.size
+    assert kept.key() != full.key() and full.keep is None
+
+
+def test_keep_is_checked(beam_case):
+    beam, *_ = beam_case
+    with pytest.raises(ValueError, match=r"keep has dtype int64 and shape \(3,\); give booleans of shape \(1, 2, 4\)"):
+        FieldObservation(beam, POINTS, [0.01], keep=np.ones(3, dtype=int))
+    with pytest.raises(ValueError, match="keep holds no True value"):
+        FieldObservation(beam, POINTS, [0.01], keep=np.zeros(8, dtype=bool))
+
+
+def test_a_kept_field_through_the_operator_is_the_full_field_restricted(beam_case):
+    beam, model, params, steps, control, field, operator, x, record = beam_case
+    keep = np.ones(field.size, dtype=bool)
+    keep[[1, 5, 9, 20]] = False
+    kept = FieldObservation(beam, POINTS, field.frames, name="dic", keep=keep)
+    partial = ForwardOperator([operator.observations[0], kept], params, NAMES, model=model, steps=steps,
+                              sensitivities=True)(x)
+    full_block, kept_block = operator.slices()[1], slice(N_STEPS, N_STEPS + kept.size)
+    np.testing.assert_allclose(partial.y[kept_block], record.y[full_block][keep], rtol=0,
+                               atol=1e-8 * np.abs(record.y[full_block]).max())
+    np.testing.assert_allclose(partial.S[kept_block], record.S[full_block][keep], rtol=1e-6,
+                               atol=1e-8 * np.abs(record.S[full_block]).max())

@@ -1,7 +1,8 @@
 """Regenerate examples/dic/: synthetic DIC data of the demo's notched beam with gradient damage.
 
 Run from anywhere: ``python examples/dic/make_data.py`` (about 5 s). It writes frame_0001.csv ...
-frame_0006.csv and frames.csv beside this file and prints what it made (README.md describes it).
+frame_0006.csv and frames.csv beside this file, and load_cmod.csv (the force-CMOD curve of the same run
+settings, 40 points, with 5 N noise), and prints what it made (README.md describes it).
 """
 
 from pathlib import Path
@@ -25,6 +26,22 @@ PLACEMENT = CameraPlacement(scale=0.1, rotation=np.radians(1.5), origin_camera=(
                             origin_specimen=(0.0, 0.0))
 #: the specimen settles on its supports: a rigid motion growing with the frames (tx, ty [mm], theta [rad])
 RIGID = np.outer(np.linspace(0.2, 1.0, len(FRAMES)), [0.004, -0.012, 5e-5])
+#: the force-CMOD curve: CMOD of its points [mm] and the std of its noise [N]
+CURVE_CMOD = np.linspace(0.005, 0.2, 40)
+CURVE_STD = 5.0
+
+
+def write_curve() -> Path:
+    """Write load_cmod.csv: the force [N] against CMOD [mm] of a run at PARAMS, plus Gaussian noise of CURVE_STD."""
+    from fracid.forward import simulate
+
+    run = simulate(BEAM, PARAMS, target=float(CURVE_CMOD[-1]), checkpoints=CURVE_CMOD)
+    force = np.interp(CURVE_CMOD, run.control, run.force)
+    noisy = force + np.random.default_rng(2028).normal(0.0, CURVE_STD, CURVE_CMOD.size)
+    path = HERE / "load_cmod.csv"
+    rows = "".join(f"{c:.10g},{f:.10g}\n" for c, f in zip(CURVE_CMOD, noisy))
+    path.write_text("cmod_mm,force_N\n" + rows)
+    return path
 
 
 def main() -> None:
@@ -36,6 +53,7 @@ def main() -> None:
           f"{len(files)} files, {size / 1e3:.0f} kB in {HERE}")
     for cmod, force in zip(data.control, data.force):
         print(f"  CMOD {cmod:.3f} mm  force {force:7.1f} N")
+    print(f"force-CMOD curve: {write_curve()}")
 
 
 if __name__ == "__main__":

@@ -44,7 +44,16 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
     return specimen_class(cfg.specimen.type)(**options)
 
 
+def _field_block(cfg: Config, exp):
+    """The DIC field block of a ``kind = "field"`` experiment (:mod:`fracid.config.field_experiments`)."""
+    from fracid.config.field_experiments import field_block
+
+    return field_block(exp, build_specimen(cfg, exp))
+
+
 def _experiment_data(cfg: Config, exp: ExperimentConfig):
+    if exp.kind == "field":
+        return _field_block(cfg, exp).data
     from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
 
     if exp.kind == "envelope":
@@ -178,6 +187,9 @@ def _operator(cfg: Config, experiments, data):
                           f"has {len(experiments)} such [[experiments]] entries; build the data with build_data(cfg)")
     observations = []
     for exp, (name, start, stop) in zip(experiments, data.blocks):
+        if exp.kind == "field":
+            observations.append(_field_observation(cfg, exp, name, data.control[start:stop]))
+            continue
         try:
             observations.append(Observation(build_specimen(cfg, exp), data.control[start:stop], quantity=exp.quantity,
                                             control=cfg.specimen.control, name=name,
@@ -186,6 +198,19 @@ def _operator(cfg: Config, experiments, data):
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
                               f"{show(exp.control_range and list(exp.control_range))}: {err}") from None
     return ForwardOperator(observations, build_parameters(cfg), identify.parameters, model=build_model(cfg))
+
+
+def _field_observation(cfg: Config, exp, name: str, control):
+    """The FieldObservation of a field experiment, checked against its block of the data (``control``)."""
+    block = _field_block(cfg, exp)
+    from fracid.inverse.core.observations import field_observation
+
+    field = field_observation(block, build_specimen(cfg, exp), control=cfg.specimen.control, name=name)
+    if field.size != len(control) or not np.array_equal(field.controls, control):
+        raise ConfigError(f"{cfg.path}: experiments[{exp.index}]: the data's block {name!r} does not match the field "
+                          f"of {exp.file} ({len(control)} values, the field {field.size}); build the data with "
+                          "build_data(cfg)")
+    return field
 
 
 def build_operator(cfg: Config, data):

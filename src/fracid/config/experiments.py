@@ -8,6 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from fracid.config.checker import Checker
+from fracid.config.field_experiments import read_field_experiment
 from fracid.config.registry import section_reader, specimen_class, specimen_observables
 from fracid.config.schema import (
     ExperimentConfig,
@@ -66,6 +67,8 @@ def _experiment(ck: Checker, i: int, raw, base: Path, specimen: SpecimenConfig) 
     """The validated ``[[experiments]]`` block ``i``; its keys are checked in a fixed order (the first
     problem is the one reported): units and kind, then the file's format and columns, then the rest."""
     prefix = f"experiments[{i}]"
+    if isinstance(raw, dict) and raw.get("kind") == "field":
+        return read_field_experiment(ck, i, raw, base, specimen)
     ck.table(prefix, raw, EXPERIMENT_KEYS)
     observables = specimen_observables(specimen)
     quantity = ck.choice(f"{prefix}.quantity", raw.get("quantity", "force"), ("force", *observables))

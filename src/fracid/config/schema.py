@@ -91,6 +91,23 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     backtrack_tolerance = 0.002         # optional number >= 0 in control_unit: the largest backtrack of the
                                         #   control column dropped as noise (default 1 % of its range)
 
+    [[experiments]]                     # a DIC displacement field (fracid.config.field_experiments):
+    kind = "field"                      #   its own keys, read while checking; examples/dic/identify.toml
+    frames_file = "frames.csv"          # required: frame table (frame, file, load columns), relative here
+    control_column = "cmod_mm"          # required: the table's control value of each frame [mm]
+    # x, y, u, v = "X", "Y", "U", "V"  # point-cloud columns (these defaults); sigma, quality optional
+    # min_quality = 0.9                 # points of lower quality dropped (needs quality)
+    coordinate_unit = "px"              # "mm" (default) | "px" (needs the placement)
+    scale = 0.1                         # placement: mm per camera unit, rotation_deg, origin_camera [X, Y],
+                                        #   origin_specimen [x, y] mm; or marked_camera and marked_specimen
+                                        #   (lists of the same points in both frames, fitted)
+    # frames = [1, 2, 3]                # frame numbers used (default all), control increasing
+    # components = ["u", "v"]           # "u" | "v" | both (default)
+    # std = 0.001                       # mm, every value; default the files' sigma (scaled to mm)
+    # subset_size = 6.0                 # mm: errors correlated over a subset (low rank + diagonal)
+    # exclude_near = 4.0                # mm: points nearer the specimen's crack path dropped
+    # name = "field", weight = 1.0, role = "calibration"
+
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,
                                             #   no duplicates

@@ -19,7 +19,7 @@ DECIMALS = (".", ",")
 FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 #: ``force_unit`` of a local quantity (a length) -> multiplier to mm
 LOCAL_UNITS = dict(CONTROL_UNITS)
-KINDS = ("repeats", "envelope", "single")
+KINDS = ("repeats", "envelope", "single", "field")
 PURPOSES = ("identify", "simulate")
 ROLES = ("calibration", "prediction")
 
@@ -36,6 +36,7 @@ KIND_KEYS = {
     "repeats": ("force_columns",),
     "envelope": ("mean_column", "lower_column", "upper_column"),
     "single": ("force_columns", "std", "relative_std"),
+    "field": (),  # a DIC field: its own keys (fracid.config.field_experiments.FIELD_KEYS)
 }
 #: the keys of [identify] itself; it also allows every table of a registered inverse method's settings
 #: (fracid.inverse.methods.registry.known_tables), which the method checks

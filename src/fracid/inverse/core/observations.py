@@ -221,6 +221,22 @@ def _positions(points) -> np.ndarray:
     return positions
 
 
+def _kept(keep, shape: tuple) -> np.ndarray | None:
+    """``keep`` as a flat boolean mask of ``prod(shape)`` entries (frame, component, point order), or None."""
+    if keep is None:
+        return None
+    mask = np.asarray(keep)
+    n = int(np.prod(shape))
+    if mask.dtype != bool or mask.shape not in (shape, (n,)):
+        raise ValueError(f"keep has dtype {mask.dtype} and shape {mask.shape}; give booleans of shape {shape} "
+                         f"(frames, components, points) or ({n},), True for the entries the data have")
+    if not mask.any():
+        raise ValueError("keep holds no True value: the field block would be empty; keep at least one entry")
+    mask = mask.reshape(-1).copy()
+    mask.setflags(write=False)
+    return mask
+
+
 @dataclass(frozen=True, eq=False)
 class FieldObservation:
     """Displacement components at given points and control values (frames): a block of size
@@ -240,11 +256,15 @@ class FieldObservation:
         The specimen's control quantity (its default if None).
     name : str
         Label of the block (and prefix of its probes' names in the run).
+    keep : array_like of bool, shape (n_frames, n_components, n_points) or (n_frames * n_components * n_points,), optional
+        The entries the data have (NaN holes, points of low quality, a region of interest dropped): ``size``,
+        ``controls``, ``coordinates()`` and ``sample`` then cover the kept entries only, in the same order.
+        None (default): every entry.
 
     Raises
     ------
     ValueError
-        For points outside the mesh (named), bad frames or components.
+        For points outside the mesh (named), bad frames, components or keep.
 
     Notes
     -----
@@ -261,6 +281,7 @@ class FieldObservation:
     components: tuple = (0, 1)
     control: str | None = None
     name: str = "field"
+    keep: np.ndarray | None = None
 
     def __post_init__(self):
         from fracid.models import probe_matrix
@@ -270,6 +291,8 @@ class FieldObservation:
         object.__setattr__(self, "points", _positions(self.points))
         object.__setattr__(self, "frames", check_control_points(self.frames, "frames"))
         object.__setattr__(self, "components", _components(self.components))
+        shape = (len(self.frames), len(self.components), len(self.points))
+        object.__setattr__(self, "keep", _kept(self.keep, shape))
         d = describe(self.specimen)
         if d.dim != 2:
             raise ValueError(f"a field observation needs a plane specimen; {type(self.specimen).__name__} is {d.dim}D")
@@ -290,13 +313,18 @@ class FieldObservation:
     def run_key(self) -> tuple:
         return (specimen_key(self.specimen), self.control, None)
 
+    def _kept_entries(self, values: np.ndarray) -> np.ndarray:
+        """``values`` over all entries (first axis) restricted to the kept ones."""
+        return values if self.keep is None else values[self.keep]
+
     @property
     def size(self) -> int:
-        return len(self.frames) * len(self.components) * len(self.points)
+        full = len(self.frames) * len(self.components) * len(self.points)
+        return full if self.keep is None else int(np.count_nonzero(self.keep))
 
     @property
     def controls(self) -> np.ndarray:
-        return np.repeat(self.frames, len(self.components) * len(self.points))
+        return self._kept_entries(np.repeat(self.frames, len(self.components) * len(self.points)))
 
     control_points = controls  # the control value of every entry, as a curve kind's
 
@@ -313,8 +341,9 @@ class FieldObservation:
         frame = np.repeat(np.arange(len(self.frames)), n_c * n_p)
         component = np.tile(np.repeat(self.components, n_p), len(self.frames))
         point = np.tile(np.arange(n_p), len(self.frames) * n_c)
-        return {"control": self.frames[frame], "frame": frame, "component": component,
+        full = {"control": self.frames[frame], "frame": frame, "component": component, "point": point,
                 "x": self.points[point, 0], "y": self.points[point, 1]}
+        return {name: self._kept_entries(values) for name, values in full.items()}
 
     def differentiable_with(self, model) -> bool:
         return True  # functionals of the displacements
@@ -322,11 +351,20 @@ class FieldObservation:
     def key(self) -> dict:
         return {"kind": "field", "specimen": self.specimen, "points": self.points.tolist(),
                 "frames": self.frames.tolist(), "components": list(self.components), "control": self.control,
-                "name": self.name}
+                "name": self.name, "keep": None if self.keep is None else np.flatnonzero(~self.keep).tolist()}
 
     def sample(self, run) -> tuple:
         """``(y, S)`` from ``run.probed`` (a run with this block's probe matrix and its frames among the
-        checkpoints: the frames are steps, nothing is interpolated); NaN for frames not reached."""
+        checkpoints: the frames are steps, nothing is interpolated); NaN for frames not reached; the kept
+        entries only."""
         values, derivatives = run.probed_at(self.frames)  # (n_frames, n_rows), (n_frames, n_rows, p)
         y = values.ravel()  # frame-major
-        return y, None if derivatives is None else derivatives.reshape(y.size, -1)
+        S = None if derivatives is None else self._kept_entries(derivatives.reshape(y.size, -1))
+        return self._kept_entries(y), S
+
+
+def field_observation(block, specimen, *, control: str | None = None, name: str | None = None) -> FieldObservation:
+    """The :class:`FieldObservation` of a DIC data block (:func:`fracid.data.dic.field_block`: its points,
+    frames as control values, components and mask of the values present) on ``specimen``."""
+    return FieldObservation(specimen, block.points, block.frames, block.components, control=control,
+                            name=block.data.blocks[0][0] if name is None else name, keep=block.keep)

@@ -1,0 +1,216 @@
+"""``[[experiments]] kind = "field"``: a DIC displacement field (frame table + point clouds) as a data block.
+
+Keys (see :mod:`fracid.config.schema`): ``frames_file`` (the frame table, CSV: frame, file and load columns),
+``control_column`` (the table's column giving each frame's control value [mm], e.g. "cmod_mm"), the point-cloud
+columns ``x``, ``y``, ``u``, ``v`` (default "X", "Y", "U", "V"), ``sigma`` and ``quality`` (optional),
+``min_quality``, ``coordinate_unit`` ("mm" | "px"), the placement of the camera on the specimen (``scale``
+[mm per camera unit], ``rotation_deg``, ``origin_camera``, ``origin_specimen``; or ``marked_camera`` and
+``marked_specimen``, the same points in both frames, fitted), ``frames`` (frame numbers, default all),
+``components`` ("u" | "v" | ["u", "v"]), ``std`` [mm] (else the files' sigma), ``subset_size`` [mm] (correlated
+errors), ``exclude_near`` [mm] (points nearer the specimen's crack path dropped), ``name``, ``weight``, ``role``.
+The data are read while the configuration is checked: every problem names its key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from fracid.config.checker import Checker
+from fracid.config.registry import specimen_class
+from fracid.config.schema import SpecimenConfig
+from fracid.config.vocabulary import ROLES
+
+#: the keys of a field block
+FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "min_quality",
+              "coordinate_unit", "scale", "rotation_deg", "origin_camera", "origin_specimen", "marked_camera",
+              "marked_specimen", "frames", "components", "std", "subset_size", "exclude_near", "name", "weight",
+              "role")
+#: point-cloud column keys and their defaults (those of :func:`fracid.data.dic.read_dic_frames`)
+COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None}
+PLACEMENT_KEYS = ("scale", "rotation_deg", "origin_camera", "origin_specimen")
+
+
+@dataclass(frozen=True)
+class FieldExperimentConfig:
+    """One ``[[experiments]]`` block of kind "field" (``file`` is the frame table, absolute)."""
+
+    index: int
+    file: Path
+    control_column: str
+    columns: tuple  # ((key, column name or None), ...) of COLUMN_KEYS
+    n_points: int  # number of kept values: the block's size
+    placement: object = None  # CameraPlacement or None
+    min_quality: float | None = None
+    coordinate_unit: str = "mm"
+    frames: tuple | None = None
+    components: tuple = ("u", "v")
+    std: float | None = None
+    subset_size: float | None = None
+    exclude_near: float | None = None
+    name: str = "field"
+    weight: float = 1.0
+    role: str = "calibration"
+    kind: str = "field"
+    quantity: str = "displacement"  # not a curve quantity: studies of force curves skip the block
+    specimen: tuple = ()  # no per-experiment specimen overrides
+    damage_threshold: float = 0.0
+
+
+def field_block(exp: FieldExperimentConfig, specimen):
+    """The :class:`~fracid.data.dic.FieldBlock` of the block on the specimen object ``specimen`` (whose crack path
+    ``exclude_near`` refers to). Raises :class:`~fracid.data.DataError` for bad data."""
+    from fracid.data.dic import field_block as block_of, read_dic_frames
+
+    dic = read_dic_frames(exp.file, **dict(exp.columns), min_quality=exp.min_quality,
+                          coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
+                          placement=exp.placement)
+    return block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
+                    subset_size=exp.subset_size, region=_away_from_crack(specimen, exp.exclude_near), name=exp.name)
+
+
+def _away_from_crack(specimen, distance):
+    """None, or the region function keeping the points at least ``distance`` [mm] from the crack path (the
+    straight crack line of the specimen's description, from the mesh's edge to its end)."""
+    if distance is None:
+        return None
+    from fracid.inverse.studies.dic_twin import crack_distance
+
+    d = specimen.describe()
+    if d.crack is None or d.crack.nodes is None:
+        raise ValueError(f"the specimen {type(specimen).__name__} has no straight crack path (Description.crack)")
+    along = 1 - d.crack.normal
+    line = d.nodes[d.nodes_of(d.crack.nodes)]
+    span = (float(d.nodes[:, along].min()), float(line[:, along].max()))
+    return lambda points: crack_distance(d, points, span) >= distance
+
+
+def _optional_number(ck: Checker, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
+    return ck.number(key, raw[name], allowed, ok) if name in raw else None
+
+
+def _point_list(ck: Checker, key: str, value) -> list:
+    """A list of [x, y] pairs of numbers."""
+    allowed = "must be a list of [x, y] points, e.g. [[0, 0], [100, 0], [0, 50]]"
+    if not isinstance(value, list) or not value:
+        ck.fail(key, value, allowed)
+    return [ck.pair(key, point, allowed) for point in value]
+
+
+def _placement(ck: Checker, prefix: str, raw: dict, unit: str):
+    """The CameraPlacement of the keys (scale, rotation_deg, origins; or marked points fitted), or None."""
+    from fracid.data import DataError
+    from fracid.data.dic import CameraPlacement, fit_placement
+
+    marked = [k for k in ("marked_camera", "marked_specimen") if k in raw]
+    direct = [k for k in PLACEMENT_KEYS if k in raw]
+    if marked and direct:
+        ck.fail(f"{prefix}.{direct[0]}", raw[direct[0]], f"give the placement either by {', '.join(PLACEMENT_KEYS)} "
+                "or by marked_camera and marked_specimen (fitted), not both")
+    if marked:
+        for k in ("marked_camera", "marked_specimen"):
+            if k not in raw:
+                ck.missing(f"{prefix}.{k}", "the marked points in the other frame, in the same order")
+        camera = _point_list(ck, f"{prefix}.marked_camera", raw["marked_camera"])
+        specimen = _point_list(ck, f"{prefix}.marked_specimen", raw["marked_specimen"])
+        try:
+            placement = fit_placement(camera, specimen)
+        except DataError as err:
+            ck.fail(f"{prefix}.marked_camera", raw["marked_camera"], str(err))
+        for note in placement.notes:
+            if note.startswith("WARNING"):
+                ck.warn(f"{prefix}.marked_camera: {note}")
+        return placement
+    if not direct:
+        if unit == "px":
+            ck.missing(f"{prefix}.scale", "coordinate_unit = 'px' needs the placement: scale [mm per px] (with "
+                       "rotation_deg, origin_camera, origin_specimen), or marked_camera and marked_specimen")
+        return None
+    if "scale" not in raw:
+        ck.missing(f"{prefix}.scale", "a number > 0 [mm per camera unit] (1 if the camera data are in mm)")
+    scale = ck.number(f"{prefix}.scale", raw["scale"], "must be a number > 0 [mm per camera unit]", lambda v: v > 0)
+    rotation = ck.number(f"{prefix}.rotation_deg", raw.get("rotation_deg", 0.0), "must be an angle [deg]")
+    origins = [ck.pair(f"{prefix}.{k}", raw.get(k, [0.0, 0.0]), "must be a point [x, y]")
+               for k in ("origin_camera", "origin_specimen")]
+    return CameraPlacement(scale, math.radians(rotation), tuple(origins[0]), tuple(origins[1]))
+
+
+def _frames(ck: Checker, key: str, raw: dict) -> tuple | None:
+    if "frames" not in raw:
+        return None
+    value = raw["frames"]
+    if (not isinstance(value, list) or not value or any(isinstance(v, bool) or not isinstance(v, int) for v in value)
+            or len(set(value)) != len(value)):
+        ck.fail(key, value, "must be a list of distinct frame numbers (integers) of the frame table, e.g. [1, 2, 4]")
+    return tuple(value)
+
+
+def _components(ck: Checker, key: str, raw: dict) -> tuple:
+    value = raw.get("components", ["u", "v"])
+    values = [value] if isinstance(value, str) else value
+    if (not isinstance(values, list) or not values or len(set(map(str, values))) != len(values)
+            or any(v not in ("u", "v") for v in values)):
+        ck.fail(key, value, 'must be "u" (x), "v" (y) or ["u", "v"] (both, the default)')
+    return tuple(values)
+
+
+def _columns(ck: Checker, prefix: str, raw: dict) -> tuple:
+    columns = tuple((k, ck.string(f"{prefix}.{k}", raw[k], "must be a column name (string)") if k in raw else d)
+                    for k, d in COLUMN_KEYS.items())
+    if "min_quality" in raw and "quality" not in raw:
+        ck.fail(f"{prefix}.min_quality", raw["min_quality"], "needs quality = the point clouds' quality column")
+    return columns
+
+
+def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
+    """The key a DataError of the reader or of field_block is about (a column, the frames, the std ...)."""
+    if message.startswith(("frames", "control column")):
+        return "frames"
+    for name, column in (("control_column", exp.control_column), *exp.columns):
+        if column is not None and f"column {column!r}" in message:
+            return name
+    for name in ("std", "subset_size"):
+        if message.startswith(f"{name} "):
+            return name
+    if "no per-point sigma" in message:
+        return "sigma"
+    return "exclude_near" if "no value left" in message and exp.exclude_near is not None else "frames_file"
+
+
+def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: SpecimenConfig):
+    """The validated field block ``i`` of ``[[experiments]]``, its data read (their size is ``n_points``)."""
+    from fracid.data import DataError
+
+    prefix = f"experiments[{i}]"
+    ck.table(prefix, raw, FIELD_KEYS)
+    if "frames_file" not in raw:
+        ck.missing(f"{prefix}.frames_file", "the frame table (CSV with frame, file and load columns), relative to "
+                   "the config file")
+    file = ck.file(f"{prefix}.frames_file", raw["frames_file"], base)
+    if "control_column" not in raw:
+        ck.missing(f"{prefix}.control_column", "the frame table's column of the control value [mm], e.g. 'cmod_mm'")
+    control_column = ck.string(f"{prefix}.control_column", raw["control_column"], "must be a column name (string)")
+    columns = _columns(ck, prefix, raw)
+    min_quality = _optional_number(ck, f"{prefix}.min_quality", raw, "min_quality", "must be a number", lambda v: True)
+    unit = ck.choice(f"{prefix}.coordinate_unit", raw.get("coordinate_unit", "mm"), ("mm", "px"))
+    positive = "must be a number > 0 [mm]"
+    exp = FieldExperimentConfig(
+        index=i, file=file, control_column=control_column, columns=columns, n_points=0,
+        placement=_placement(ck, prefix, raw, unit), min_quality=min_quality, coordinate_unit=unit,
+        frames=_frames(ck, f"{prefix}.frames", raw), components=_components(ck, f"{prefix}.components", raw),
+        std=_optional_number(ck, f"{prefix}.std", raw, "std", positive, lambda v: v > 0),
+        subset_size=_optional_number(ck, f"{prefix}.subset_size", raw, "subset_size", positive, lambda v: v > 0),
+        exclude_near=_optional_number(ck, f"{prefix}.exclude_near", raw, "exclude_near", "must be a number >= 0 [mm]",
+                                      lambda v: v >= 0),
+        name=ck.string(f"{prefix}.name", raw.get("name", "field"), "must be a non-empty string"),
+        weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
+        role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))
+    try:
+        block = field_block(exp, specimen_class(specimen.type)(**dict(specimen.options)))
+    except DataError as err:
+        key = _blamed_key(exp, str(err))
+        ck.fail(f"{prefix}.{key}", raw.get(key, COLUMN_KEYS.get(key)), str(err))
+    except ValueError as err:
+        ck.fail(f"{prefix}.exclude_near", raw.get("exclude_near"), str(err))
+    return replace(exp, n_points=block.data.n_y)

@@ -1,0 +1,185 @@
+"""The data block of a DIC displacement field: y, covariance, control and the mask of the values the data have.
+
+:func:`field_block` turns a :class:`~fracid.data.dic.data.DicData` (in the specimen frame, mm) into the
+:class:`~fracid.data.dataset.ExperimentalData` of one field block and what the matching
+:class:`~fracid.inverse.core.observations.FieldObservation` needs (its points, frames as control values,
+components and ``keep`` mask). Entries are ordered frame slowest, then component, point fastest; the missing
+ones (NaN: holes, low quality) are dropped from y and from the covariance, and flagged False in ``keep``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fracid.data.arguments import real_number
+from fracid.data.covariance_matrix import Covariance, Diagonal, block_diagonal
+from fracid.data.dataset import ExperimentalData
+from fracid.data.dic.data import DicData
+from fracid.data.errors import DataError, DataTypeError
+
+#: component names -> indices (0: u_x, 1: u_y)
+COMPONENTS = {"u": 0, "v": 1}
+
+
+@dataclass(frozen=True, eq=False)
+class FieldBlock:
+    """A field's data block and the geometry of its observation.
+
+    Attributes
+    ----------
+    data : ExperimentalData
+        One block: y the kept displacements [mm], their covariance [mm^2], the frame's control value of every
+        entry [mm].
+    points : ndarray (n_points, 2)
+        The points used [mm] in the specimen frame (points with no kept value dropped).
+    frames : ndarray (n_frames,)
+        Control value of each frame [mm], strictly increasing.
+    frame_numbers : tuple of int
+        The frames' numbers in the data.
+    components : tuple of int
+        0 (u_x), 1 (u_y) or both.
+    keep : ndarray of bool (n_frames * n_components * n_points,)
+        True for the entries in ``data.y`` (the ``keep`` of the FieldObservation).
+    """
+
+    data: ExperimentalData
+    points: np.ndarray
+    frames: np.ndarray
+    frame_numbers: tuple
+    components: tuple
+    keep: np.ndarray
+
+
+
+def component_indices(components) -> tuple[int, ...]:
+    """``components`` ("u", "v", 0, 1 or a sequence of them) as distinct indices 0 (u_x) / 1 (u_y)."""
+    values = [components] if isinstance(components, (str, int, np.integer)) else list(components)
+    indices = [COMPONENTS.get(c, -1) if isinstance(c, str) else c for c in values]
+    if not indices or len(set(indices)) != len(indices) or any(i not in (0, 1) for i in indices):
+        raise DataError(f"components = {components!r}: give \"u\" (x), \"v\" (y) or both, e.g. [\"u\", \"v\"] "
+                        "(or 0, 1)")
+    return tuple(int(i) for i in indices)
+
+
+def frame_controls(dic: DicData, frame_indices: np.ndarray, control: str) -> np.ndarray:
+    """The control value [mm] of the selected frames: the load column ``control``, strictly increasing."""
+    if control not in dic.load:
+        raise DataError(f"control = {control!r} is not a load column of the frame table; its columns are "
+                        f"{sorted(dic.load)}")
+    values = np.asarray(dic.load[control][frame_indices], dtype=float)
+    if not np.all(np.isfinite(values)):
+        raise DataError(f"control column {control!r}: a selected frame has no value (NaN)")
+    steps = np.diff(values)
+    if np.any(steps <= 0):
+        k = int(np.argmax(steps <= 0))
+        numbers = [dic.frames[i] for i in frame_indices]
+        raise DataError(f"control column {control!r} must increase strictly over the frames used, but frame "
+                        f"{numbers[k + 1]} ({values[k + 1]:.6g} mm) does not exceed frame {numbers[k]} "
+                        f"({values[k]:.6g} mm)")
+    return values
+
+
+def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -> tuple[np.ndarray, str]:
+    """The standard deviation [mm] of every entry (frame, component, point order) and a note on its origin:
+    the declared ``std`` [mm], else the files' per-point sigma."""
+    n = len(frame_indices) * len(components) * dic.n_points
+    if std is not None:
+        value = real_number(std, "std")
+        if not (np.isfinite(value) and value > 0):
+            raise DataError(f"std = {std!r} [mm]: give a finite number > 0 (the DIC displacement error)")
+        return np.full(n, value), f"std {value:g} mm declared for every value"
+    if dic.std is None:
+        raise DataError("the DIC data have no per-point sigma: give std [mm] (the displacement error), or read "
+                        "the files with the sigma column")
+    sigma = dic.std[frame_indices][:, :, list(components)].transpose(0, 2, 1).reshape(-1)
+    return sigma, "std: the per-point sigma of the files"
+
+
+def field_covariance(points, sigma: np.ndarray, n_blocks: int, subset_size) -> tuple[Covariance, str]:
+    """The covariance [mm^2] of all entries: diag(sigma^2), or with ``subset_size`` [mm] the spatially
+    correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per frame and component, scaled by
+    sigma: C = D K D, D = diag(sigma)). ``sigma`` NaN (missing values) are set to 1: those entries are dropped."""
+    sigma = np.where(np.isnan(sigma), 1.0, sigma)
+    if subset_size is None:
+        return Diagonal(sigma**2), "independent errors (diagonal covariance)"
+    from fracid.data.dic_noise import dic_covariance
+
+    size = real_number(subset_size, "subset_size")
+    if not (np.isfinite(size) and size > 0):
+        raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
+    correlation = dic_covariance(points, 1.0, size)
+    cov = block_diagonal([correlation] * n_blocks).scaled(sigma)
+    return cov, (f"errors correlated over the subset size {size:g} mm (Gaussian kernel, l = {size / 2:g} mm, "
+                 f"{correlation.U.shape[1]} modes per frame and component; independent between them)")
+
+
+def _selected(dic: DicData, frames, region) -> tuple[DicData, np.ndarray]:
+    """The data in the region (a mask of the points or a function of them) and the positions of ``frames``."""
+    if not isinstance(dic, DicData):
+        raise DataTypeError(f"dic must be a DicData (read_dic_frames, read_dic_vtk), got {type(dic).__name__}")
+    if region is not None:
+        dic = dic.region(region)
+    indices = np.arange(dic.n_frames) if frames is None else dic.frame_indices(frames)
+    return dic, indices
+
+
+def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: str = "cmod_mm", std=None,
+                subset_size=None, region=None, name: str = "field") -> FieldBlock:
+    """The data block of a DIC field and the geometry of its FieldObservation.
+
+    Parameters
+    ----------
+    dic : DicData
+        The DIC data in the specimen frame [mm].
+    frames : sequence of int or None
+        Frame numbers to use (all if None), in increasing control.
+    components : str, int or sequence
+        "u" (x), "v" (y) or both.
+    control : str
+        The load column giving each frame's control value [mm] (e.g. "cmod_mm").
+    std : float or None
+        Standard deviation of every displacement [mm]; None: the files' per-point sigma.
+    subset_size : float or None
+        DIC subset size [mm]: errors correlated over it (:mod:`fracid.data.dic_noise`); None: independent.
+    region : array_like of bool (n_points,) or callable or None
+        Points to keep (a region of interest, or points away from the crack); a callable gets the points
+        (n, 2) [mm] and returns the mask.
+    name : str
+        Name of the block.
+
+    Returns
+    -------
+    FieldBlock
+
+    Raises
+    ------
+    DataError
+        Naming the argument: unknown frames or control column, a control not increasing, no kept value, a
+        missing sigma (with no std), std or subset_size <= 0.
+    """
+    dic, indices = _selected(dic, frames, region)
+    comps = component_indices(components)
+    controls = frame_controls(dic, indices, control)
+    values, missing = dic.values(indices, comps)
+    sigma, std_note = entry_std(dic, indices, comps, std)
+    missing = missing | ~(sigma > 0)  # no usable sigma: no value
+    per_point = (~missing).reshape(len(indices), len(comps), dic.n_points).any(axis=(0, 1))
+    if not per_point.any():
+        raise DataError(f"field {name!r}: no value left in the frames and region used (all NaN or without sigma)")
+    full = (len(indices), len(comps), dic.n_points)
+    keep = (~missing).reshape(full)[:, :, per_point].reshape(-1)
+    points = dic.points[per_point]
+    sigma = sigma.reshape(full)[:, :, per_point].reshape(-1)
+    cov, cov_note = field_covariance(points, sigma, len(indices) * len(comps), subset_size)
+    kept = np.flatnonzero(keep)
+    n_c, n_p = len(comps), len(points)
+    notes = (*dic.notes, f"field {name!r}: frames {[dic.frames[i] for i in indices]} at {control} = "
+             f"{np.round(controls, 6).tolist()} mm, components {[('u', 'v')[c] for c in comps]}, {n_p} points",
+             f"{kept.size} of {keep.size} values kept ({keep.size - kept.size} missing dropped)", std_note, cov_note)
+    data = ExperimentalData(control=np.repeat(controls, n_c * n_p)[kept],
+                            y=values.reshape(full)[:, :, per_point].reshape(-1)[kept], covariance=cov.take(kept),
+                            blocks=((name, 0, kept.size),), notes=notes)
+    frame_numbers = tuple(dic.frames[i] for i in indices)
+    return FieldBlock(data, points, controls, frame_numbers, comps, keep)
