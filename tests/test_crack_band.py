@@ -119,8 +119,8 @@ def test_assembled_tangent_matches_finite_differences_after_the_peak():
     q_k, q_next = (problem.restrict(result.fields[i]["u"]) for i in (k, k + 1))
     q = q_k + np.random.default_rng(3).uniform(-1.0, 2.0, size=q_k.size) * (q_next - q_k)
     residual, arrays, _ = problem.evaluate(q, kappa_old)
-    assert np.any((arrays.kappa > kappa_old) & (arrays.omega > 0)), "no cracked point loading"
-    assert np.any((arrays.kappa == kappa_old) & (arrays.omega > 0)), "no cracked point unloading"
+    assert np.any((arrays.history > kappa_old) & (arrays.omega > 0)), "no cracked point loading"
+    assert np.any((arrays.history == kappa_old) & (arrays.omega > 0)), "no cracked point unloading"
     tangent = SparsePattern(problem.n_free, problem.element_dofs).matrix(arrays.tangent)
     rng = np.random.default_rng(4)
     for _ in range(3):  # directional derivatives: the full Jacobian would take n evaluations

@@ -174,7 +174,7 @@ def test_pseudo_load_and_completion_match_finite_differences_at_fixed_displaceme
             h_k = history + sign * step * history_rate[..., k]
             residual, _, _ = shifted.evaluate(q, h_k)
             _, arrays, _ = shifted.evaluate(q_k, h_k)
-            results.append((residual, arrays.kappa, shifted.elastic_energy(q_k, arrays.kappa, arrays.omega)))
+            results.append((residual, arrays.history, shifted.elastic_energy(q_k, arrays.history, arrays)))
         (r_plus, k_plus, e_plus), (r_minus, k_minus, e_minus) = results
         fd_load = (r_plus - r_minus) / (2.0 * step)
         fd_rate = (k_plus - k_minus) / (2.0 * step)

@@ -151,10 +151,11 @@ def test_history_is_allocated_from_its_declaration():
 def test_element_arrays_carry_history_and_named_outputs():
     history, omega, stress = np.ones((2, 3)), np.full((2, 3), 0.5), np.full((2, 3), 7.0)
     arrays = ElementArrays(np.zeros((2, 4)), np.zeros((2, 4, 4)), {}, history, outputs={"stress": stress})
-    assert arrays.history is history and arrays.kappa is history and arrays.outputs == {"stress": stress}
+    assert arrays.history is history and arrays.outputs == {"stress": stress}
+    assert not hasattr(ElementArrays, "kappa")  # the history has no formulation's name
     with pytest.raises(AttributeError, match="no point output 'omega'"):
         arrays.omega
-    legacy = ElementArrays(np.zeros((2, 4)), np.zeros((2, 4, 4)), {}, history, omega)  # as the crack band builds them
-    assert legacy.omega is omega and legacy.outputs == {"omega": omega}
-    replaced = legacy._replace(kappa=2 * history)
+    damaged = ElementArrays(np.zeros((2, 4)), np.zeros((2, 4, 4)), {}, history, outputs={"omega": omega})
+    assert damaged.omega is omega and damaged.outputs == {"omega": omega}
+    replaced = damaged._replace(history=2 * history)
     assert np.all(replaced.history == 2.0) and replaced.omega is omega

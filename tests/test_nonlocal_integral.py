@@ -131,8 +131,8 @@ def assembled(problem, arrays, coupling=True):
 
 def check_tangent(problem, q, kappa_old, params):
     _, arrays, _ = problem.evaluate(q, kappa_old)
-    loading = arrays.kappa > kappa_old
-    damaged = arrays.kappa > params.kappa_i
+    loading = arrays.history > kappa_old
+    damaged = arrays.history > params.kappa_i
     assert np.any(loading & damaged) and np.any(~loading & (kappa_old > params.kappa_i)) and np.any(~damaged)
     assert arrays.coupling is not None
     # before the finite differences: arrays.tangent is the problem's buffer, which they overwrite

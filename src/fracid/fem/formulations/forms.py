@@ -33,8 +33,6 @@ class ElementArrays:
     history : ndarray or dict of ndarray
         The trial history at this state, in the layout the problem declares (its ``history_spec``):
         the solver carries it opaquely to the next step.
-    omega : ndarray, optional
-        Shorthand for ``outputs["omega"]`` (the damage of the damage formulations).
     coupling : sparse matrix (n_free, n_free), optional
         Tangent entries between points of different elements (the integral model) [N/mm].
     outputs : dict {name: ndarray}, optional
@@ -43,23 +41,16 @@ class ElementArrays:
 
     __slots__ = ("residual", "_tangent", "reference", "history", "outputs", "coupling")
 
-    def __init__(self, residual, tangent, reference, history, omega=None, coupling=None, *, outputs=None):
+    def __init__(self, residual, tangent, reference, history, *, coupling=None, outputs=None):
         self.residual, self._tangent, self.reference = residual, tangent, reference
         self.history, self.coupling = history, coupling
         self.outputs = dict(outputs or {})
-        if omega is not None:
-            self.outputs["omega"] = omega
 
     @property
     def tangent(self) -> np.ndarray:
         if callable(self._tangent):
             self._tangent = self._tangent()
         return self._tangent
-
-    @property
-    def kappa(self):
-        """The history (the name of the damage formulations' history variable)."""
-        return self.history
 
     @property
     def omega(self) -> np.ndarray:
@@ -69,9 +60,7 @@ class ElementArrays:
         return self.outputs["omega"]
 
     def _replace(self, **changes) -> "ElementArrays":
-        """A copy with some of the constructor's arguments changed (``kappa`` is ``history``)."""
-        if "kappa" in changes:
-            changes["history"] = changes.pop("kappa")
+        """A copy with some of the constructor's arguments changed."""
         values = dict(residual=self.residual, tangent=self._tangent, reference=self.reference, history=self.history,
                       coupling=self.coupling, outputs=self.outputs)
         values.update(changes)
