@@ -26,9 +26,9 @@ import time
 
 import numpy as np
 
-from fracid.cli import demo_config_path
-from fracid.config import build_data, build_operator, load_config
+from fracid.config import build_data, build_operator
 from fracid.inverse.core.observations import FieldObservation
+from demo_setup import demo_config
 
 ESTIMATE = {"kappa_i": 4.798e-5, "beta": 1086.5, "c": 21.46}  # docs/demo/result.json (rounded)
 
@@ -59,10 +59,7 @@ def main(argv=None):
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--h-fine", type=float, default=None, help="override the demo mesh's h_fine [mm]")
     args = parser.parse_args(argv)
-    cfg = load_config(demo_config_path(), purpose="identify")
-    if args.h_fine is not None:
-        options = tuple((k, v) for k, v in cfg.specimen.options if k != "h_fine") + (("h_fine", args.h_fine),)
-        cfg = dataclasses.replace(cfg, specimen=dataclasses.replace(cfg.specimen, options=options))
+    cfg = demo_config(args.h_fine)
     operator = build_operator(cfg, build_data(cfg))
     exact = operator.differentiated()
     assert exact.sensitivities, "the demo's model has no direct differentiation"
