@@ -7,7 +7,9 @@ columns ``x``, ``y``, ``u``, ``v`` (default "X", "Y", "U", "V"), ``sigma`` and `
 [mm per camera unit], ``rotation_deg``, ``origin_camera``, ``origin_specimen``; or ``marked_camera`` and
 ``marked_specimen``, the same points in both frames, fitted), ``frames`` (frame numbers, default all),
 ``components`` ("u" | "v" | ["u", "v"]), ``std`` [mm] (else the files' sigma), ``subset_size`` [mm] (correlated
-errors), ``exclude_near`` [mm] (points nearer the specimen's crack path dropped), ``name``, ``weight``, ``role``.
+errors), ``rigid_motion`` (true, the default: the rigid motion of every frame removed from data and model by a
+vague prior of std ``rigid_std`` [mm], default 1; false: the data have none), ``exclude_near`` [mm] (points
+nearer the specimen's crack path dropped), ``name``, ``weight``, ``role``.
 The data are read while the configuration is checked: every problem names its key.
 """
 
@@ -25,8 +27,8 @@ from fracid.config.vocabulary import ROLES
 #: the keys of a field block
 FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "min_quality",
               "coordinate_unit", "scale", "rotation_deg", "origin_camera", "origin_specimen", "marked_camera",
-              "marked_specimen", "frames", "components", "std", "subset_size", "exclude_near", "name", "weight",
-              "role")
+              "marked_specimen", "frames", "components", "std", "subset_size", "rigid_motion", "rigid_std",
+              "exclude_near", "name", "weight", "role")
 #: point-cloud column keys and their defaults (those of :func:`fracid.data.dic.read_dic_frames`)
 COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None}
 PLACEMENT_KEYS = ("scale", "rotation_deg", "origin_camera", "origin_specimen")
@@ -48,6 +50,7 @@ class FieldExperimentConfig:
     components: tuple = ("u", "v")
     std: float | None = None
     subset_size: float | None = None
+    rigid_std: float | None = 1.0  # None: no rigid motion removed
     exclude_near: float | None = None
     name: str = "field"
     weight: float = 1.0
@@ -67,7 +70,7 @@ def field_block(exp: FieldExperimentConfig, specimen):
                           coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
                           placement=exp.placement)
     return block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
-                    subset_size=exp.subset_size, region=_away_from_crack(specimen, exp.exclude_near), name=exp.name)
+                    subset_size=exp.subset_size, rigid_std=exp.rigid_std, region=_away_from_crack(specimen, exp.exclude_near), name=exp.name)
 
 
 def _away_from_crack(specimen, distance):
@@ -136,6 +139,23 @@ def _placement(ck: Checker, prefix: str, raw: dict, unit: str):
     return CameraPlacement(scale, math.radians(rotation), tuple(origins[0]), tuple(origins[1]))
 
 
+def _rigid_std(ck: Checker, prefix: str, raw: dict) -> float | None:
+    """The prior std of the rigid motion [mm], or None when ``rigid_motion = false``."""
+    from fracid.data.dic.rigid import RIGID_STD
+
+    removed = raw.get("rigid_motion", True)
+    if not isinstance(removed, bool):
+        ck.fail(f"{prefix}.rigid_motion", removed, "must be true (the rigid motion of every frame removed from data "
+                "and model, the default) or false (the data have none: the camera is fixed to the supports)")
+    if not removed:
+        if "rigid_std" in raw:
+            ck.fail(f"{prefix}.rigid_std", raw["rigid_std"], "is the prior std of the rigid motion removed: it needs "
+                    "rigid_motion = true")
+        return None
+    return ck.number(f"{prefix}.rigid_std", raw.get("rigid_std", RIGID_STD),
+                     "must be a number > 0 [mm], larger than the rigid motion (e.g. 1)", lambda v: v > 0)
+
+
 def _frames(ck: Checker, key: str, raw: dict) -> tuple | None:
     if "frames" not in raw:
         return None
@@ -201,6 +221,7 @@ def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: 
         frames=_frames(ck, f"{prefix}.frames", raw), components=_components(ck, f"{prefix}.components", raw),
         std=_optional_number(ck, f"{prefix}.std", raw, "std", positive, lambda v: v > 0),
         subset_size=_optional_number(ck, f"{prefix}.subset_size", raw, "subset_size", positive, lambda v: v > 0),
+        rigid_std=_rigid_std(ck, prefix, raw),
         exclude_near=_optional_number(ck, f"{prefix}.exclude_near", raw, "exclude_near", "must be a number >= 0 [mm]",
                                       lambda v: v >= 0),
         name=ck.string(f"{prefix}.name", raw.get("name", "field"), "must be a non-empty string"),

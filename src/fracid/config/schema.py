@@ -105,6 +105,8 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     # components = ["u", "v"]           # "u" | "v" | both (default)
     # std = 0.001                       # mm, every value; default the files' sigma (scaled to mm)
     # subset_size = 6.0                 # mm: errors correlated over a subset (low rank + diagonal)
+    # rigid_motion = true               # the rigid motion of every frame removed from data and model (default;
+    # rigid_std = 1.0                   #   false: none), by a vague prior of this std [mm] (default 1)
     # exclude_near = 4.0                # mm: points nearer the specimen's crack path dropped
     # name = "field", weight = 1.0, role = "calibration"
 

@@ -97,22 +97,50 @@ def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -
     return sigma, "std: the per-point sigma of the files"
 
 
-def field_covariance(points, sigma: np.ndarray, n_blocks: int, subset_size) -> tuple[Covariance, str]:
-    """The covariance [mm^2] of all entries: diag(sigma^2), or with ``subset_size`` [mm] the spatially
-    correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per frame and component, scaled by
-    sigma: C = D K D, D = diag(sigma)). ``sigma`` NaN (missing values) are set to 1: those entries are dropped."""
-    sigma = np.where(np.isnan(sigma), 1.0, sigma)
-    if subset_size is None:
-        return Diagonal(sigma**2), "independent errors (diagonal covariance)"
-    from fracid.data.dic_noise import dic_covariance
+def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple, subset_size,
+                     rigid_std=None) -> tuple[Covariance, str]:
+    """The covariance [mm^2] of all entries (frame, component, point order): diag(sigma^2), or with
+    ``subset_size`` [mm] the spatially correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per
+    frame and component, scaled by sigma: C = D K D, D = diag(sigma)); with ``rigid_std`` [mm] the rigid motion
+    of every frame marginalised (:mod:`fracid.data.dic.rigid`). ``sigma`` NaN (missing values) are set to 1:
+    those entries are dropped."""
+    from fracid.data.dic.rigid import with_rigid_motion
 
-    size = real_number(subset_size, "subset_size")
-    if not (np.isfinite(size) and size > 0):
-        raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
-    correlation = dic_covariance(points, 1.0, size)
-    cov = block_diagonal([correlation] * n_blocks).scaled(sigma)
-    return cov, (f"errors correlated over the subset size {size:g} mm (Gaussian kernel, l = {size / 2:g} mm, "
-                 f"{correlation.U.shape[1]} modes per frame and component; independent between them)")
+    sigma = np.where(np.isnan(sigma), 1.0, sigma)
+    n_blocks = n_frames * len(components)
+    if subset_size is None:
+        cov, note = Diagonal(sigma**2), "independent errors (diagonal covariance)"
+    else:
+        from fracid.data.dic_noise import dic_covariance
+
+        size = real_number(subset_size, "subset_size")
+        if not (np.isfinite(size) and size > 0):
+            raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
+        correlation = dic_covariance(points, 1.0, size)
+        cov = block_diagonal([correlation] * n_blocks).scaled(sigma)
+        note = (f"errors correlated over the subset size {size:g} mm (Gaussian kernel, l = {size / 2:g} mm, "
+                f"{correlation.U.shape[1]} modes per frame and component; independent between them)")
+    if rigid_std is None:
+        return cov, note
+    std = real_number(rigid_std, "rigid_std")
+    if not (np.isfinite(std) and std > 0):
+        raise DataError(f"rigid_std = {rigid_std!r} [mm]: give a finite number > 0 (the prior std of the rigid motion)")
+    n = len(components) * len(points)
+    frames = [with_rigid_motion(_merged(cov.take(np.arange(k * n, (k + 1) * n))), points, components, std)
+              for k in range(n_frames)]
+    return block_diagonal(frames), (f"{note}; the rigid motion of every frame (t_x, t_y, theta) marginalised: "
+                                    f"prior std {std:g} mm, removed from data and model alike")
+
+
+def _merged(cov: Covariance) -> Covariance:
+    """A block diagonal of low-rank-plus-diagonal blocks as one LowRankPlusDiagonal (U block diagonal)."""
+    from fracid.data.covariance_matrix import Block, LowRankPlusDiagonal
+    import scipy.linalg
+
+    if not isinstance(cov, Block):
+        return cov
+    return LowRankPlusDiagonal(scipy.linalg.block_diag(*[b.U for b in cov.blocks]),
+                               np.concatenate([b.D.var for b in cov.blocks]))
 
 
 def _selected(dic: DicData, frames, region) -> tuple[DicData, np.ndarray]:
@@ -126,7 +154,7 @@ def _selected(dic: DicData, frames, region) -> tuple[DicData, np.ndarray]:
 
 
 def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: str = "cmod_mm", std=None,
-                subset_size=None, region=None, name: str = "field") -> FieldBlock:
+                subset_size=None, rigid_std=None, region=None, name: str = "field") -> FieldBlock:
     """The data block of a DIC field and the geometry of its FieldObservation.
 
     Parameters
@@ -143,6 +171,10 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
         Standard deviation of every displacement [mm]; None: the files' per-point sigma.
     subset_size : float or None
         DIC subset size [mm]: errors correlated over it (:mod:`fracid.data.dic_noise`); None: independent.
+    rigid_std : float or None
+        Prior std [mm] of the rigid motion of every frame (:mod:`fracid.data.dic.rigid`, e.g. ``RIGID_STD`` = 1
+        mm): the specimen's motion on its supports removed from data and model alike; None: the data have no
+        rigid motion (the model's supports are the camera's reference).
     region : array_like of bool (n_points,) or callable or None
         Points to keep (a region of interest, or points away from the crack); a callable gets the points
         (n, 2) [mm] and returns the mask.
@@ -172,7 +204,7 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     keep = (~missing).reshape(full)[:, :, per_point].reshape(-1)
     points = dic.points[per_point]
     sigma = sigma.reshape(full)[:, :, per_point].reshape(-1)
-    cov, cov_note = field_covariance(points, sigma, len(indices) * len(comps), subset_size)
+    cov, cov_note = field_covariance(points, sigma, len(indices), comps, subset_size, rigid_std)
     kept = np.flatnonzero(keep)
     n_c, n_p = len(comps), len(points)
     notes = (*dic.notes, f"field {name!r}: frames {[dic.frames[i] for i in indices]} at {control} = "
