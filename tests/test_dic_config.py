@@ -211,6 +211,9 @@ def _field_config(tmp_path, **changes) -> Path:
     ({"coordinate_unit": '"cm"'}, "experiments[1].coordinate_unit = 'cm'", "'mm', 'px'"),
     ({"min_quality": "0.5"}, "experiments[1].min_quality", "needs quality"),
     ({"n_points": "3"}, "experiments[1]", "n_points"),
+    ({"rigid_motion": '"yes"'}, "experiments[1].rigid_motion = 'yes'", "must be true"),
+    ({"rigid_motion": "false", "rigid_std": "1.0"}, "experiments[1].rigid_std = 1", "needs rigid_motion = true"),
+    ({"rigid_std": "0"}, "experiments[1].rigid_std = 0", "must be a number > 0"),
 ])
 def test_bad_field_keys_are_named(tmp_path, changes, key, message):
     from fracid.config import ConfigError, load_config
@@ -250,17 +253,17 @@ def test_fracid_check_exits_2_naming_the_key(tmp_path, capsys, changes, key):
     assert f"experiments[1].{key}" in err and "Traceback" not in err
 
 
-def _remove_rigid_motion(residual, coordinates, n_frames):
-    """The residual minus its least-squares rigid motion (tx, ty, small rotation) per frame, and those motions."""
-    out, motions = residual.copy(), []
-    for k in range(n_frames):
-        m = coordinates["frame"] == k
-        comp, x, y = coordinates["component"][m], coordinates["x"][m], coordinates["y"][m]
-        A = np.column_stack([comp == 0, comp == 1, np.where(comp == 0, -y, x)]).astype(float)
-        coef = np.linalg.lstsq(A, residual[m], rcond=None)[0]
-        out[m] -= A @ coef
-        motions.append(coef)
-    return out, np.array(motions)
+def _remove_rigid_motion(residual, field):
+    """The residual minus its least-squares rigid motion (fracid.data.dic.rigid.fit_rigid_motion) per frame, and
+    those motions."""
+    from fracid.data.dic.rigid import fit_rigid_motion
+
+    full = np.full(field.keep.size if field.keep is not None else residual.size, np.nan)
+    full[slice(None) if field.keep is None else field.keep] = residual
+    frames = full.reshape(len(field.frames), -1)
+    fits = [fit_rigid_motion(field.points, field.components, frame) for frame in frames]
+    removed = (frames - np.array([fitted for _, fitted in fits])).reshape(-1)
+    return removed[np.isfinite(removed)], np.array([motion for motion, _ in fits])
 
 
 def test_the_configured_field_is_the_twin_at_its_true_parameters(config):
@@ -273,10 +276,13 @@ def test_the_configured_field_is_the_twin_at_its_true_parameters(config):
     record = operator(np.array([getattr(operator.base, n) for n in operator.names]))
     assert record.ok
     field, block = operator.observations[1], data.block("field")
-    residual, motions = _remove_rigid_motion((data.y - record.y)[block], field.coordinates(), len(field.frames))
+    residual, motions = _remove_rigid_motion((data.y - record.y)[block], field)
     rigid = np.outer(np.linspace(0.2, 1.0, 6), [0.004, -0.012, 5e-5])  # make_data.RIGID
     assert np.all(np.abs(motions - rigid) <= [5e-4, 5e-4, 1e-5])  # mm, mm, rad
     white = data.covariance.take(np.arange(block.start, block.stop)).whiten(residual)
     assert 0.9 < white @ white / residual.size < 1.1  # the noise, as its covariance says (1 um, correlated)
     white = data.covariance.take(np.arange(0, 20)).whiten((data.y - record.y)[:20])
     assert white @ white / 20 < 2.0
+    # the covariance marginalises the rigid motion (rigid_motion = true, the default): the raw residual is noise
+    field_cov = data.covariance.take(np.arange(block.start, block.stop))
+    assert 0.9 < field_cov.quadratic((data.y - record.y)[block]) / residual.size < 1.1
