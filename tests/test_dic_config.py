@@ -286,3 +286,31 @@ def test_the_configured_field_is_the_twin_at_its_true_parameters(config):
     # the covariance marginalises the rigid motion (rigid_motion = true, the default): the raw residual is noise
     field_cov = data.covariance.take(np.arange(block.start, block.stop))
     assert 0.9 < field_cov.quadratic((data.y - record.y)[block]) / residual.size < 1.1
+
+
+def test_a_field_in_vtu_files_reads_as_the_csv_one(tmp_path):
+    """frames_file may list VTU files (displacement, sigma: point-data arrays): the same data block as the CSV."""
+    meshio = pytest.importorskip("meshio")
+    from fracid.config import build_data, load_config
+
+    table = (EXAMPLE / "frames.csv").read_text().splitlines()
+    rows = [table[0]]
+    for line in table[1:]:
+        cells = line.split(",")
+        cloud = np.genfromtxt(EXAMPLE / cells[1], delimiter=",", names=True)
+        points = np.column_stack([cloud["X"], cloud["Y"], np.zeros(cloud.size)])
+        meshio.write(str(tmp_path / cells[1].replace(".csv", ".vtu")),
+                     meshio.Mesh(points, [("vertex", np.arange(cloud.size)[:, None])],
+                                 point_data={"disp": np.column_stack([cloud["U"], cloud["V"]]), "sigma": cloud["sigma"]}))
+        rows.append(",".join([cells[0], cells[1].replace(".csv", ".vtu"), *cells[2:]]))
+    (tmp_path / "frames.csv").write_text("\n".join(rows) + "\n")
+    path = _field_config(tmp_path, displacement='"disp"')
+    path.write_text(path.read_text().replace(str(EXAMPLE / "frames.csv"), str(tmp_path / "frames.csv")))
+    vtu, csv = build_data(load_config(path)), build_data(load_config(CONFIG))
+    np.testing.assert_allclose(vtu.y, csv.y, rtol=1e-12)
+    np.testing.assert_allclose(vtu.std, csv.std, rtol=1e-12)
+    from fracid.config import ConfigError
+
+    path.write_text(path.read_text().replace('displacement = "disp"', 'displacement = "U"'))
+    with pytest.raises(ConfigError, match=r"experiments\[1\].displacement = 'U'.*arrays found: 'disp'"):
+        load_config(path)

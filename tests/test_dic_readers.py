@@ -310,3 +310,23 @@ def test_dic_data_refuses_fields_of_the_wrong_shape_and_repeated_frames():
         DicData(points, (1, 1), np.zeros((2, 24, 2)))
     with pytest.raises(DataError, match=r"load\['force_N'\] must have one value per frame"):
         DicData(points, (0, 1), np.zeros((2, 24, 2)), load={"force_N": [1.0]})
+
+
+def test_a_frame_table_may_list_vtu_files(tmp_path):
+    """The configuration's reader (read_dic_frames) takes VTU frames from the table's file column: same data as the
+    CSV clouds; a missing array names the key ``displacement``."""
+    p = placement()
+    table, points, fields = write_export(tmp_path, frames=(0, 3))
+    lines = ["frame,file,cmod_mm,force_N"]
+    for f, u in zip((0, 3), fields):
+        X, U = to_camera(points, u, p)
+        write_vtu(tmp_path / f"f{f}.vtu", X, U, name="disp")
+        lines.append(f"{f},f{f}.vtu,{0.01 * f},{100.0 * f}")
+    (tmp_path / "vtu_frames.csv").write_text("\n".join(lines) + "\n")
+    from_csv = read_dic_frames(table, coordinate_unit="px", placement=p)
+    from_vtu = read_dic_frames(tmp_path / "vtu_frames.csv", coordinate_unit="px", placement=p, displacement="disp")
+    np.testing.assert_allclose(from_vtu.points, from_csv.points, atol=1e-12)
+    np.testing.assert_allclose(from_vtu.u, from_csv.u, atol=1e-12)
+    np.testing.assert_allclose(from_vtu.load["cmod_mm"], [0.0, 0.03])
+    with pytest.raises(DataError, match=r"f0\.vtu: no point-data array 'displacement' or 'U'.*'disp'"):
+        read_dic_frames(tmp_path / "vtu_frames.csv", coordinate_unit="px", placement=p)

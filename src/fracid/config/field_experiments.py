@@ -2,7 +2,8 @@
 
 Keys (see :mod:`fracid.config.schema`): ``frames_file`` (the frame table, CSV: frame, file and load columns),
 ``control_column`` (the table's column giving each frame's control value [mm], e.g. "cmod_mm"), the point-cloud
-columns ``x``, ``y``, ``u``, ``v`` (default "X", "Y", "U", "V"), ``sigma`` and ``quality`` (optional),
+columns ``x``, ``y``, ``u``, ``v`` (default "X", "Y", "U", "V"), ``sigma`` and ``quality`` (optional; point-data
+arrays when the table lists VTU/VTK files, whose displacement array is ``displacement``),
 ``min_quality``, ``coordinate_unit`` ("mm" | "px"), the placement of the camera on the specimen (``scale``
 [mm per camera unit], ``rotation_deg``, ``origin_camera``, ``origin_specimen``; or ``marked_camera`` and
 ``marked_specimen``, the same points in both frames, fitted), ``frames`` (frame numbers, default all),
@@ -25,12 +26,13 @@ from fracid.config.schema import SpecimenConfig
 from fracid.config.vocabulary import ROLES
 
 #: the keys of a field block
-FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "min_quality",
+FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "displacement",
+              "min_quality",
               "coordinate_unit", "scale", "rotation_deg", "origin_camera", "origin_specimen", "marked_camera",
               "marked_specimen", "frames", "components", "std", "subset_size", "rigid_motion", "rigid_std",
               "exclude_near", "name", "weight", "role")
 #: point-cloud column keys and their defaults (those of :func:`fracid.data.dic.read_dic_frames`)
-COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None}
+COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None, "displacement": None}
 PLACEMENT_KEYS = ("scale", "rotation_deg", "origin_camera", "origin_specimen")
 
 
@@ -195,6 +197,10 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
             return name
     if "no per-point sigma" in message:
         return "sigma"
+    for name, what in (("displacement", "(the displacements)"), ("sigma", "(the displacement std)"),
+                       ("quality", "(the correlation quality)")):
+        if what in message:  # a VTU/VTK frame without the point-data array
+            return name
     return "exclude_near" if "no value left" in message and exp.exclude_near is not None else "frames_file"
 
 

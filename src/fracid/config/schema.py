@@ -96,6 +96,8 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     frames_file = "frames.csv"          # required: frame table (frame, file, load columns), relative here
     control_column = "cmod_mm"          # required: the table's control value of each frame [mm]
     # x, y, u, v = "X", "Y", "U", "V"  # point-cloud columns (these defaults); sigma, quality optional
+    # displacement = "U"                # frames listed as .vtu/.vtk files: their displacement array (default
+                                        #   "displacement", else "U"); sigma, quality name point-data arrays
     # min_quality = 0.9                 # points of lower quality dropped (needs quality)
     coordinate_unit = "px"              # "mm" (default) | "px" (needs the placement)
     scale = 0.1                         # placement: mm per camera unit, rotation_deg, origin_camera [X, Y],

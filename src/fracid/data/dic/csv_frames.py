@@ -6,6 +6,8 @@ a header row and the columns X, Y (reference coordinates in the camera frame), U
 camera frame), optionally a per-point displacement std and a correlation quality; the unit of all of them is
 ``coordinate_unit`` ("mm" or "px"). A missing displacement, std or quality is an empty cell, ``NaN`` or
 ``nan``; the reference coordinates must be numbers. Every frame holds the same points in the same order.
+A frame table may also list VTU/VTK files (``.vtu``, ``.vtk``: read by
+:func:`fracid.data.dic.vtk_frames.read_vtk_cloud`, the displacement array named by ``displacement``).
 The CSV cells are read by :mod:`fracid.data.table` (its separators, comments above the header, messages).
 """
 
@@ -20,6 +22,7 @@ import numpy as np
 from fracid.data.arguments import column_name, file_path
 from fracid.data.cells import check_cell_count, parse_cell
 from fracid.data.dic.assemble import FrameCloud, assemble
+from fracid.data.dic.vtk_frames import read_vtk_cloud
 from fracid.data.errors import DataError
 from fracid.data.table import column_indices, parse_table, read_table
 
@@ -96,7 +99,7 @@ def read_frame_table(path: str, frame_column: str, file_column: str, load_column
 
 def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quality=None, min_quality=None,
                     coordinate_unit="mm", load_columns=None, placement=None, frame_column="frame",
-                    file_column="file", point_tolerance=1e-6):
+                    file_column="file", point_tolerance=1e-6, displacement=None):
     """Read a DIC export: a frame table and the point cloud of every frame, placed on the specimen.
 
     Parameters
@@ -120,6 +123,9 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
         Column names of the frame number and of the point-cloud file in the frame table.
     point_tolerance : float
         Largest difference of X or Y of a point between frames [camera units].
+    displacement : str or None
+        For frames in VTU/VTK files: the point-data array of the displacements (None: "displacement", else
+        "U"); ``sigma`` and ``quality`` then name point-data arrays, ``x``, ``y``, ``u``, ``v`` are not used.
 
     Returns
     -------
@@ -148,7 +154,8 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
         if not os.path.isfile(path):
             raise DataError(f"{table_path}: row {line}, column {file_column!r}: the point-cloud file {path} does "
                             "not exist (paths are relative to the frame table's folder)")
-        clouds.append(read_cloud(path, columns))
+        vtk = path.lower().endswith((".vtu", ".vtk"))
+        clouds.append(read_vtk_cloud(path, displacement, sigma, quality) if vtk else read_cloud(path, columns))
     data = assemble(clouds, frames, load, placement=placement, coordinate_unit=coordinate_unit,
                     min_quality=min_quality, point_tolerance=point_tolerance, notes=notes)
     return replace(data, source=(table_path, *data.source))

@@ -45,11 +45,12 @@ def _array(mesh, path: str, names: tuple, what: str) -> np.ndarray:
                     f"arrays found: {found}")
 
 
-def _cloud(path: str, displacement: tuple, sigma, quality) -> FrameCloud:
-    """The point cloud of one VTU/VTK file."""
+def read_vtk_cloud(path: str, displacement: str | None, sigma, quality) -> FrameCloud:
+    """The point cloud of one VTU/VTK file: its points, the point-data array ``displacement`` (None: the first
+    of :data:`DISPLACEMENT_NAMES`), and the arrays ``sigma`` and ``quality`` if named."""
     mesh = _read_mesh(path)
     points = np.asarray(mesh.points, dtype=float)[:, :2]
-    u = _array(mesh, path, displacement, "the displacements")
+    u = _array(mesh, path, DISPLACEMENT_NAMES if displacement is None else (displacement,), "the displacements")
     if u.shape[1] < 2:
         raise DataError(f"VTK file {path}: the displacement array has {u.shape[1]} component; give U, V (2 or 3)")
     std = None if sigma is None else _array(mesh, path, (sigma,), "the displacement std")[:, 0]
@@ -101,7 +102,6 @@ def read_dic_vtk(paths, frames, *, displacement=None, sigma=None, quality=None, 
         raise DataError(f"{len(paths)} files but {len(frames)} frame numbers: give one frame number per file")
     if min_quality is not None and quality is None:
         raise DataError("min_quality is given but no quality array: give quality = the array's name")
-    names = DISPLACEMENT_NAMES if displacement is None else (displacement,)
-    clouds = [_cloud(path, names, sigma, quality) for path in paths]
+    clouds = [read_vtk_cloud(path, displacement, sigma, quality) for path in paths]
     return assemble(clouds, frames, dict(load or {}), placement=placement, coordinate_unit=coordinate_unit,
                     min_quality=min_quality, point_tolerance=point_tolerance)
