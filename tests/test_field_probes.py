@@ -93,6 +93,22 @@ def test_kinds_sharing_a_run_get_their_own_rows_of_the_stacked_matrix(case):
     np.testing.assert_allclose(together.S, np.concatenate([r.S for r in alone]), rtol=1e-7, atol=1e-10)
 
 
+def test_a_run_for_part_of_the_outputs_samples_the_frames_it_passes(case):
+    """The step-by-step Kalman filter asks for the first entries only: the curve's run goes to its end, past
+    frames whose entries are not needed; they are steps too (regression: 'no probe values at control')."""
+    beam, model, params, target, _ = case
+    steps, control = _fixed_steps(target)
+    frames = 0.5 * (control[[1, 4, 6]] + control[[2, 5, 7]])  # not points of the curve
+    curve, field = Observation(beam, control), FieldObservation(beam, POINTS, frames)
+    operator = ForwardOperator([curve, field], params, NAMES[:2], model=model, steps=steps, sensitivities=True)
+    x = np.array([getattr(params, n) for n in NAMES[:2]])
+    needed = curve.size + 2 * len(POINTS)  # the curve and the first frame's entries
+    part, whole = operator(x, needed=needed), operator(x)
+    assert part.ok, part.error
+    np.testing.assert_allclose(part.y[:needed], whole.y[:needed], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(part.S[:needed], whole.S[:needed], rtol=1e-7, atol=1e-10)
+
+
 def test_five_thousand_points_on_the_default_beam_stay_sparse():
     beam = SPECIMENS["notched-beam"]()
     model = DamageModel("gradient")

@@ -10,7 +10,8 @@ arrays when the table lists VTU/VTK files, whose displacement array is ``displac
 ``components`` ("u" | "v" | ["u", "v"]), ``std`` [mm] (else the files' sigma), ``subset_size`` [mm] (correlated
 errors), ``rigid_motion`` (true, the default: the rigid motion of every frame removed from data and model by a
 vague prior of std ``rigid_std`` [mm], default 1; false: the data have none), ``exclude_near`` [mm] (points
-nearer the specimen's crack path dropped), ``name``, ``weight``, ``role``.
+nearer the specimen's crack path dropped), ``point_spacing`` [mm] (the points thinned to one per square of this
+side, :mod:`fracid.data.dic.reduction`), ``name``, ``weight``, ``role``.
 The data are read while the configuration is checked: every problem names its key.
 """
 
@@ -30,7 +31,7 @@ FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigm
               "min_quality",
               "coordinate_unit", "scale", "rotation_deg", "origin_camera", "origin_specimen", "marked_camera",
               "marked_specimen", "frames", "components", "std", "subset_size", "rigid_motion", "rigid_std",
-              "exclude_near", "name", "weight", "role")
+              "exclude_near", "point_spacing", "name", "weight", "role")
 #: point-cloud column keys and their defaults (those of :func:`fracid.data.dic.read_dic_frames`)
 COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None, "displacement": None}
 PLACEMENT_KEYS = ("scale", "rotation_deg", "origin_camera", "origin_specimen")
@@ -54,6 +55,7 @@ class FieldExperimentConfig:
     subset_size: float | None = None
     rigid_std: float | None = 1.0  # None: no rigid motion removed
     exclude_near: float | None = None
+    point_spacing: float | None = None
     name: str = "field"
     weight: float = 1.0
     role: str = "calibration"
@@ -72,7 +74,8 @@ def field_block(exp: FieldExperimentConfig, specimen):
                           coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
                           placement=exp.placement)
     return block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
-                    subset_size=exp.subset_size, rigid_std=exp.rigid_std, region=_away_from_crack(specimen, exp.exclude_near), name=exp.name)
+                    subset_size=exp.subset_size, rigid_std=exp.rigid_std,
+                    region=_away_from_crack(specimen, exp.exclude_near), point_spacing=exp.point_spacing, name=exp.name)
 
 
 def _away_from_crack(specimen, distance):
@@ -230,6 +233,7 @@ def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: 
         rigid_std=_rigid_std(ck, prefix, raw),
         exclude_near=_optional_number(ck, f"{prefix}.exclude_near", raw, "exclude_near", "must be a number >= 0 [mm]",
                                       lambda v: v >= 0),
+        point_spacing=_optional_number(ck, f"{prefix}.point_spacing", raw, "point_spacing", positive, lambda v: v > 0),
         name=ck.string(f"{prefix}.name", raw.get("name", "field"), "must be a non-empty string"),
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
         role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))

@@ -110,6 +110,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     # rigid_motion = true               # the rigid motion of every frame removed from data and model (default;
     # rigid_std = 1.0                   #   false: none), by a vague prior of this std [mm] (default 1)
     # exclude_near = 4.0                # mm: points nearer the specimen's crack path dropped
+    # point_spacing = 3.0               # mm: thin a dense field to one point per square of this side
     # name = "field", weight = 1.0, role = "calibration"
 
     [identify]                          # required for identification

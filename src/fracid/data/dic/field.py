@@ -143,18 +143,23 @@ def _merged(cov: Covariance) -> Covariance:
                                np.concatenate([b.D.var for b in cov.blocks]))
 
 
-def _selected(dic: DicData, frames, region) -> tuple[DicData, np.ndarray]:
-    """The data in the region (a mask of the points or a function of them) and the positions of ``frames``."""
+def _selected(dic: DicData, frames, region, spacing) -> tuple[DicData, np.ndarray]:
+    """The data in the region (a mask of the points or a function of them), thinned to ``spacing`` [mm] if not
+    None, and the positions of ``frames``."""
     if not isinstance(dic, DicData):
         raise DataTypeError(f"dic must be a DicData (read_dic_frames, read_dic_vtk), got {type(dic).__name__}")
     if region is not None:
         dic = dic.region(region)
+    if spacing is not None:
+        from fracid.data.dic.reduction import thinned
+
+        dic = dic.region(thinned(dic.points, real_number(spacing, "point_spacing")))
     indices = np.arange(dic.n_frames) if frames is None else dic.frame_indices(frames)
     return dic, indices
 
 
 def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: str = "cmod_mm", std=None,
-                subset_size=None, rigid_std=None, region=None, name: str = "field") -> FieldBlock:
+                subset_size=None, rigid_std=None, region=None, point_spacing=None, name: str = "field") -> FieldBlock:
     """The data block of a DIC field and the geometry of its FieldObservation.
 
     Parameters
@@ -178,6 +183,9 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     region : array_like of bool (n_points,) or callable or None
         Points to keep (a region of interest, or points away from the crack); a callable gets the points
         (n, 2) [mm] and returns the mask.
+    point_spacing : float or None
+        Thin the points (in the region) to at most one per square of this side [mm]
+        (:mod:`fracid.data.dic.reduction`: the covariance is the marginal at the kept points); None: all points.
     name : str
         Name of the block.
 
@@ -191,7 +199,7 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
         Naming the argument: unknown frames or control column, a control not increasing, no kept value, a
         missing sigma (with no std), std or subset_size <= 0.
     """
-    dic, indices = _selected(dic, frames, region)
+    dic, indices = _selected(dic, frames, region, point_spacing)
     comps = component_indices(components)
     controls = frame_controls(dic, indices, control)
     values, missing = dic.values(indices, comps)

@@ -197,7 +197,10 @@ class ForwardOperator:
     def _fill(self, record, group, params, limit, threshold) -> bool:
         """Run one group's analysis to its largest needed control value and sample its blocks."""
         counts = [min(part.stop, limit) - part.start for _, part in group]
-        checkpoints = np.unique(np.concatenate([obs.controls[:n] for (obs, _), n in zip(group, counts)]))
+        target = max(float(obs.controls[n - 1]) for (obs, _), n in zip(group, counts))
+        # every control a kind samples within the run's range is a step: a kind samples all of them (a
+        # field's frames past the needed entries too), and the extra rows are dropped below
+        checkpoints = np.unique(np.concatenate([obs.controls[obs.controls <= target] for obs, _ in group]))
         observables = sorted({name for obs, _ in group for name in obs.observables})
         probes = merge_probes(obs for obs, _ in group)
         matrix, kind_rows = stacked_probes([obs for obs, _ in group])
