@@ -95,3 +95,40 @@ def test_field_block_marginalises_every_frame_on_request():
     with pytest.raises(Exception, match="rigid_std"):
         field_block(dic, std=1e-3, rigid_std=-1.0)
     assert n_frames == len(marginal.frames)
+
+
+def _hinge(points, phi):
+    """Both halves of a beam turning by -+phi about the crack tip (0, 25) mm: the opening of a crack at x = 0,
+    mirror-symmetric (u_x odd, u_y even in x) [mm]; (n, 2)."""
+    x, y = points.T
+    turn = np.where(x >= 0, phi, -phi)  # the right half turns clockwise as the crack opens at the bottom
+    return np.column_stack([turn * (y - 25.0), -turn * x])
+
+
+def test_a_camera_on_both_halves_keeps_the_opening_a_rigid_motion_of_one_half_would_hide():
+    both = np.vstack([POINTS, POINTS * [-1.0, 1.0]])  # the right half and its mirror image
+    load = {"cmod_mm": np.array([0.05])}
+
+    def block(points, symmetry):
+        u = (_hinge(points, 2e-4) + (rigid_modes(points, (0, 1)) @ MOTION).reshape(2, -1).T)[None]
+        return field_block(DicData(points, (1,), u, None, load), std=1e-3, subset_size=6.0, rigid_std=RIGID_STD,
+                           symmetry=symmetry)
+
+    folded, half = block(both, (0, 0.0)), block(POINTS, None)
+    n = len(POINTS)
+    assert folded.mirrored.sum() == n and np.all(folded.points[:, 0] >= 0)
+    np.testing.assert_allclose(folded.points[n:], POINTS)  # folded onto the modelled half
+    # the mirror image's values: (-u_x, u_y) of where the camera saw the point
+    left = POINTS * [-1.0, 1.0]
+    seen = _hinge(left, 2e-4) + (rigid_modes(left, (0, 1)) @ MOTION).reshape(2, -1).T
+    y = folded.data.y.reshape(2, 2 * n)  # (u, v) x (right, folded left)
+    np.testing.assert_allclose(y[0, n:], -seen[:, 0], atol=1e-15)
+    np.testing.assert_allclose(y[1, n:], seen[:, 1], atol=1e-15)
+    # a model that computes no opening: on one half the hinge is a rigid rotation and is absorbed, on both it is not
+    assert half.data.covariance.quadratic(half.data.y) < 1.0
+    assert folded.data.covariance.quadratic(folded.data.y) > 1e3
+    hinge = _hinge(POINTS, 2e-4)  # the model's hinge on the half: the folded points see the same
+    model = np.concatenate([hinge[:, 0], hinge[:, 0], hinge[:, 1], hinge[:, 1]])
+    assert folded.data.covariance.quadratic(folded.data.y - model) < 1e-2  # the rigid motion alone: marginalised
+    with pytest.raises(Exception, match="symmetry"):
+        field_block(DicData(POINTS, (1,), np.zeros((1, n, 2)), None, load), std=1e-3, symmetry=(2, 0.0))
