@@ -8,8 +8,10 @@ point data, and the camera frame placed on the specimen.
 
 from fracid.data.dic.csv_frames import read_dic_frames
 from fracid.data.dic.data import DicData
+from fracid.data.dic.derived import DerivedBlock, frame_rigid_motions, opening_profile, process_zone_width
 from fracid.data.dic.field import FieldBlock, field_block
 from fracid.data.dic.placement import CameraPlacement, fit_placement
 from fracid.data.dic.vtk_frames import read_dic_vtk
 
-__all__ = ["CameraPlacement", "DicData", "FieldBlock", "field_block", "fit_placement", "read_dic_frames", "read_dic_vtk"]
+__all__ = ["CameraPlacement", "DerivedBlock", "DicData", "FieldBlock", "field_block", "fit_placement", "frame_rigid_motions",
+           "opening_profile", "process_zone_width", "read_dic_frames", "read_dic_vtk"]
