@@ -142,6 +142,7 @@ def _identification(args, job, store, executor):
 
 def _write_identification(args, job, out, result) -> None:
     """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
+    from fracid.report.field_figures import block_views
     from fracid.report.html import write_report
     from fracid.tables import write_csv_table
 
@@ -152,9 +153,10 @@ def _write_identification(args, job, out, result) -> None:
         block_of[a:b] = name
     write_csv_table(out / "fit.csv", ("control_mm", "measured", "std", "computed", "block"),
                     zip(data.control.tolist(), data.y.tolist(), data.std.tolist(), result.y_fit.tolist(), block_of))
+    views = block_views(result, _field_coordinates(job))
     write_report(out / "report.html", result, control=data.control,
-                 title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes)
-    _write_figures(out / "figures", result, data.control)
+                 title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes, views=views)
+    _write_figures(out / "figures", result, data.control, views=views)
     say(args, result.summary())
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
                         for stage, c in result.stage_runs().items())
@@ -224,17 +226,40 @@ def _stage_plans(method, operator, n_y: int, p: int) -> list[str]:
     return [stage.line() for stage in plan(operator, n_y, p)]
 
 
-def _write_figures(directory: Path, result, control) -> None:
-    """The report's figures as PNG files too."""
+def _field_coordinates(job) -> dict:
+    """The coordinates of every displacement-field block, by name, for the report's maps: the operator's field
+    observation kinds' ``coordinates()`` (frame, component, point, x, y [mm], control [mm]) with the block's data
+    covariance [mm^2] (the noise the residual is measured against)."""
+    from fracid.inverse.core.observations import FieldObservation
+
+    blocks = {name: (start, stop) for name, start, stop in job.data.blocks}
+    fields = {}
+    for kind in job.operator.observations:
+        if isinstance(kind, FieldObservation) and kind.name in blocks:
+            start, stop = blocks[kind.name]
+            fields[kind.name] = {**kind.coordinates(), "kind": "field",
+                                 "covariance": job.data.covariance.take(np.arange(start, stop))}
+    return fields
+
+
+def _write_figures(directory: Path, result, control, fields=None, views=None) -> None:
+    """The report's figures as PNG files too; a displacement field's as ``field_<name>_summary.png`` and
+    ``field_<name>_frame<k>.png`` (``fields``: the coordinates of the field blocks, or ``views``: the views
+    built from them)."""
     from fracid.report import figures
+    from fracid.report.field_figures import block_views_and_skipped
     from fracid.report.stage_figures import stage_figures
 
     directory.mkdir(parents=True, exist_ok=True)
-    drawn = {"fit": figures.fit_figure(result, control), **stage_figures(result),
+    views, skip = block_views_and_skipped(result, fields, views)
+    drawn = {"fit": figures.fit_figure(result, control, skip=skip), **stage_figures(result),
              "correlation": figures.correlation_figure(result)}
     for name, fig in drawn.items():
         if fig is not None:
             (directory / f"{name}.png").write_bytes(figures.to_png(fig))
+    for view in views:
+        for stem in view.figures:
+            (directory / f"{stem}.png").write_bytes(view.png(stem))
 
 
 def main(argv=None) -> int:

@@ -135,7 +135,7 @@ def covariance_ellipse(centre, cov, n_std=2.0, n=200) -> np.ndarray:
 
 
 
-def fit_figure(result, control=None, control_label=None) -> Figure:
+def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | None:
     """Measured points with their +/- 2 std band and the curve computed at the estimate, per block.
 
     The computed values are known at the data points only: the computed curve is the line through
@@ -150,14 +150,21 @@ def fit_figure(result, control=None, control_label=None) -> Figure:
         of the point in its block.
     control_label : str, optional
         The x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
+    skip : collection of str
+        Blocks not drawn: displacement fields (:func:`fracid.report.field_figures.field_block_names`), which
+        are no curves against the control and have maps of their own. None is returned when no block is left.
     """
     y_exp = float_array(result.y_exp, np.nan)
     std = float_array(result.std_exp, np.nan)
     y_fit = float_array(result.y_fit, np.nan) if result.y_fit is not None else np.full_like(y_exp, np.nan)
     control = getattr(result, "control", None) if control is None else control
     blocks = result_blocks(result)
-    fig, panels = block_panels(blocks, None if control is None else float_array(control, np.nan), y_exp.size)
     labels = block_control_labels(result, len(blocks), control_label)
+    drawn_blocks = [(block, label) for block, label in zip(blocks, labels) if block[0] not in set(skip)]
+    if not drawn_blocks:
+        return None
+    blocks, labels = zip(*drawn_blocks)
+    fig, panels = block_panels(blocks, None if control is None else float_array(control, np.nan), y_exp.size)
     for (ax, name, part, x), label in zip(panels, labels):
         y, s, fit = y_exp[part], std[part], y_fit[part]
         sort = np.argsort(x, kind="stable")

@@ -17,8 +17,15 @@ from fracid.report.markup import esc, generated_now, html_image, num, provenance
 from fracid.report.stages import stage_sections, runs_section, status_label
 
 
-def fit_metrics(result) -> list[dict]:
+def fit_metrics(result, skip=()) -> list[dict]:
     """Fit of the curve computed at the estimate to the measured one, per data block.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    skip : collection of str
+        Blocks left out: displacement fields (peaks and a diagonal objective share mean nothing for them; their
+        own section gives their fit, :mod:`fracid.report.field_figures`).
 
     Returns
     -------
@@ -38,6 +45,8 @@ def fit_metrics(result) -> list[dict]:
     std = float_array(result.std_exp, np.nan)
     metrics = []
     for name, start, stop in result_blocks(result):
+        if name in set(skip):
+            continue
         y, fit, s = y_exp[start:stop], y_fit[start:stop], std[start:stop]
         both = np.isfinite(y) & np.isfinite(fit)
         im = block_peak(y)
@@ -99,8 +108,10 @@ def correlation_section(result, figures) -> str:
     return f"<h2>Correlation</h2>\n{table}\n{image}"
 
 
-def fit_section(result, control, figures, control_label=None) -> str:
-    metrics = fit_metrics(result)
+def fit_section(result, control, figures, control_label=None, skip=()) -> str:
+    """The fit of the curve blocks: figure, table and diagnostics; the blocks ``skip`` (displacement fields, shown
+    in sections of their own) are named only."""
+    metrics = fit_metrics(result, skip)
     rows = []
     for m in metrics:
         quantity = figures.block_quantity(m["block"])
@@ -109,12 +120,17 @@ def fit_section(result, control, figures, control_label=None) -> str:
                      num(m["peak_computed"], 5), num(m["peak_error_percent"], 3), num(m["f"], 4)])
     table = html_table(["block", "unit", "points", "RMS error", "RMS / |measured peak| [%]", "measured peak",
                     "computed peak", "peak error [%]", "objective share f [-]"], rows, text_columns=(0, 1))
-    image = html_image(figures.to_png(figures.fit_figure(result, control, control_label)), "measured and computed curves",
-                   "Measured points with the +/- 2 std band of the data and the curve computed at the estimate "
-                   "(a line through its values at the data points).")
+    fig = figures.fit_figure(result, control, control_label, skip=skip)
+    image = "" if fig is None else html_image(
+        figures.to_png(fig), "measured and computed curves", "Measured points with the +/- 2 std band of the data and "
+        "the curve computed at the estimate (a line through its values at the data points).")
     unit_note = ("RMS error of the computed values over the measured range and peaks in the unit of the block "
                  "(N for forces, mm for widths); peaks are the values of largest magnitude; the objective share is "
                  "sum(((y_exp - y_fit) / std_exp)^2) over the block.")
+    fields = [name for name, _, _ in figures.result_blocks(result) if name in set(skip)]
+    if fields:
+        unit_note += (f" Displacement field block(s) {', '.join(fields)}: not curves; their maps and fit per frame are "
+                      "in their own sections (Displacement field ...).")
     return f"<h2>Fit</h2>\n{image}\n{table}\n<p>{esc(unit_note)}</p>\n{diagnostics_fragment(result, control)}"
 
 
@@ -161,11 +177,21 @@ def notes_section(result, data_notes) -> str:
     return "\n".join(parts)
 
 
+def block_view_section(view) -> str:
+    """The section of a block that is not a curve (:class:`~fracid.report.field_figures.BlockView`: a
+    displacement field's maps per frame): heading, text, table, figures."""
+    table = html_table(view.header, view.rows) if view.rows else ""
+    images = "\n".join(html_image(view.png(stem), stem.replace("_", " "), caption)
+                        for stem, (_, caption) in view.figures.items())
+    return "\n".join(part for part in (f"<h2>{esc(view.heading)}</h2>", f"<p>{esc(view.text)}</p>", table, images)
+                     if part)
+
+
 # ------------------------------------------------------------------------------------ report
 
 
 def write_report(path, result, *, control=None, title: str = "fracid identification", data_notes=(),
-                 extra_sections=(), control_label=None, provenance=None) -> Path:
+                 extra_sections=(), control_label=None, provenance=None, fields=None, views=None) -> Path:
     """Write one self-contained HTML report of an identification.
 
     Parameters
@@ -186,6 +212,16 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
     provenance : dict, optional
         How the result was obtained (:func:`fracid.provenance.collect`); the result's ``provenance``
         when omitted. Shown last, collapsed: "How this was run".
+    fields : dict of str -> dict, optional
+        The coordinates of the displacement-field blocks, by block name: the observation kind's
+        ``coordinates()`` (``frame``, ``component``, ``point``, ``x``, ``y`` [mm], ``control`` [mm]), optionally
+        with ``covariance`` (the block's data covariance [mm^2]) and ``kind`` (a key of
+        :data:`fracid.report.field_figures.BLOCK_VIEWS`, ``"field"`` by default). Each such block gets a section
+        "Displacement field <name>" (maps per frame, a summary, a table per frame) instead of a curve panel; a
+        field block without coordinates (its quantity ``"u"``) is named but not drawn.
+    views : list of BlockView, optional
+        The views already built by :func:`fracid.report.field_figures.block_views` (``fields`` is then not used):
+        ``fracid identify`` builds them once for the report and figures/.
 
     Returns
     -------
@@ -193,7 +229,9 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         The file written.
     """
     from fracid.report import figures  # matplotlib is imported only when a report is written
+    from fracid.report.field_figures import block_views_and_skipped
 
+    views, skip = block_views_and_skipped(result, fields, views, control_label)
     date = generated_now()
     names = ", ".join(str(n) for n in result.names)
     body = [
@@ -202,7 +240,8 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
          f"{np.size(result.y_exp)} measured values.</p>"),
         parameter_section(result, control),
         correlation_section(result, figures),
-        fit_section(result, control, figures, control_label),
+        fit_section(result, control, figures, control_label, skip),
+        *(block_view_section(view) for view in views),
         *stage_sections(result, figures),
         runs_section(result),
         notes_section(result, data_notes),
@@ -213,4 +252,5 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
     return write_document(path, title, body)
 
 
-__all__ = ["correlation_section", "fit_metrics", "fit_section", "notes_section", "parameter_section", "write_report"]
+__all__ = ["block_view_section", "correlation_section", "fit_metrics", "fit_section", "notes_section",
+           "parameter_section", "write_report"]
