@@ -261,4 +261,4 @@ def test_bad_model_side_input_is_named(blocks):
     with pytest.raises(ValueError, match="frames"):
         DerivedFieldObservation(BEAM, block.points, FRAMES[::-1], block.estimator)
     with pytest.raises(ValueError, match="outside"):
-        FieldObservation(BEAM, [[-50.0, 30.0]], FRAMES)  # the wrapped observation names points off the mesh
+        FieldObservation(BEAM, [[200.0, 30.0]], FRAMES)  # the wrapped observation names points off the mesh

@@ -109,6 +109,23 @@ def test_a_run_for_part_of_the_outputs_samples_the_frames_it_passes(case):
     np.testing.assert_allclose(part.S[:needed], whole.S[:needed], rtol=1e-7, atol=1e-10)
 
 
+def test_points_of_the_other_half_are_the_mirror_images(case):
+    """A half beam (crack on the symmetry line x = 0): a camera point at (-x, y) is computed as (x, y), u_x's
+    sign flipped, u_y's kept, with its sensitivities."""
+    beam, model, params, target, _ = case
+    steps, control = _fixed_steps(target)
+    mirror = POINTS * [-1.0, 1.0]
+    kinds = [FieldObservation(beam, np.vstack([POINTS, mirror]), control[[3, 7]])]
+    record = ForwardOperator(kinds, params, NAMES[:2], model=model, steps=steps, sensitivities=True)(
+        np.array([getattr(params, n) for n in NAMES[:2]]))
+    n = len(POINTS)
+    y, S = record.y.reshape(2, 2, 2 * n), record.S.reshape(2, 2, 2 * n, -1)  # frame, component, point
+    assert np.abs(y[:, 0, :n]).max() > 1e-4  # u_x is not zero where we compare
+    np.testing.assert_allclose(y[:, 0, n:], -y[:, 0, :n], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(y[:, 1, n:], y[:, 1, :n], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(S[:, 0, n:], -S[:, 0, :n], rtol=1e-12, atol=1e-15)
+
+
 def test_five_thousand_points_on_the_default_beam_stay_sparse():
     beam = SPECIMENS["notched-beam"]()
     model = DamageModel("gradient")

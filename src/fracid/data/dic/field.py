@@ -42,9 +42,6 @@ class FieldBlock:
         0 (u_x), 1 (u_y) or both.
     keep : ndarray of bool (n_frames * n_components * n_points,)
         True for the entries in ``data.y`` (the ``keep`` of the FieldObservation).
-    mirrored : ndarray of bool (n_points,) or None
-        The points folded across the symmetry line (``points`` holds their folded positions, ``data.y`` their
-        mirror image's values); None without ``symmetry``.
     """
 
     data: ExperimentalData
@@ -53,7 +50,6 @@ class FieldBlock:
     frame_numbers: tuple
     components: tuple
     keep: np.ndarray
-    mirrored: np.ndarray | None = None
 
 
 
@@ -102,18 +98,15 @@ def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -
 
 
 def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple, subset_size,
-                     rigid_std=None, signs=None) -> tuple[Covariance, str]:
+                     rigid_std=None) -> tuple[Covariance, str]:
     """The covariance [mm^2] of all entries (frame, component, point order): diag(sigma^2), or with
     ``subset_size`` [mm] the spatially correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per
     frame and component, scaled by sigma: C = D K D, D = diag(sigma)); with ``rigid_std`` [mm] the rigid motion
-    of every frame marginalised (:mod:`fracid.data.dic.rigid`). ``points`` are where the camera saw them;
-    ``signs`` (+1, or -1 for the values of a frame whose sign a mirror flipped) flip the covariance alike
-    (F C F). ``sigma`` NaN (missing values) are set to 1: those entries are dropped."""
+    of every frame marginalised (:mod:`fracid.data.dic.rigid`). ``sigma`` NaN (missing values) are set to 1:
+    those entries are dropped."""
     from fracid.data.dic.rigid import with_rigid_motion
 
     sigma = np.where(np.isnan(sigma), 1.0, sigma)
-    if signs is not None:
-        sigma = sigma * np.tile(signs, n_frames)
     n_blocks = n_frames * len(components)
     if subset_size is None:
         cov, note = Diagonal(sigma**2), "independent errors (diagonal covariance)"
@@ -133,7 +126,7 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
     if not (np.isfinite(std) and std > 0):
         raise DataError(f"rigid_std = {rigid_std!r} [mm]: give a finite number > 0 (the prior std of the rigid motion)")
     n = len(components) * len(points)
-    frames = [with_rigid_motion(_merged(cov.take(np.arange(k * n, (k + 1) * n))), points, components, std, signs)
+    frames = [with_rigid_motion(_merged(cov.take(np.arange(k * n, (k + 1) * n))), points, components, std)
               for k in range(n_frames)]
     return block_diagonal(frames), (f"{note}; the rigid motion of every frame (t_x, t_y, theta) marginalised: "
                                     f"prior std {std:g} mm, removed from data and model alike")
@@ -166,8 +159,7 @@ def _selected(dic: DicData, frames, region, spacing) -> tuple[DicData, np.ndarra
 
 
 def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: str = "cmod_mm", std=None,
-                subset_size=None, rigid_std=None, region=None, point_spacing=None, symmetry=None,
-                name: str = "field") -> FieldBlock:
+                subset_size=None, rigid_std=None, region=None, point_spacing=None, name: str = "field") -> FieldBlock:
     """The data block of a DIC field and the geometry of its FieldObservation.
 
     Parameters
@@ -194,12 +186,6 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     point_spacing : float or None
         Thin the points (in the region) to at most one per square of this side [mm]
         (:mod:`fracid.data.dic.reduction`: the covariance is the marginal at the kept points); None: all points.
-    symmetry : (int, float) or None
-        (axis, value): the model is the half ``x[axis] >= value`` of a specimen symmetric about that line (e.g.
-        (0, 0.0): the crack line x = 0 of the half notched beam); the points on the other side are folded onto
-        it (position mirrored, the ``axis`` component's sign flipped: the mirror image's values). Their noise
-        correlation and rigid motion stay those of where the camera saw them, so a camera seeing both halves
-        keeps the information a rigid motion of one half would hide. None: the points must lie in the model.
     name : str
         Name of the block.
 
@@ -226,43 +212,14 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     keep = (~missing).reshape(full)[:, :, per_point].reshape(-1)
     points = dic.points[per_point]
     sigma = sigma.reshape(full)[:, :, per_point].reshape(-1)
-    mirrored, signs, fold_note = _folded(points, comps, symmetry)
-    cov, cov_note = field_covariance(points, sigma, len(indices), comps, subset_size, rigid_std, signs)
+    cov, cov_note = field_covariance(points, sigma, len(indices), comps, subset_size, rigid_std)
     kept = np.flatnonzero(keep)
     n_c, n_p = len(comps), len(points)
-    values = values.reshape(full)[:, :, per_point] * (1.0 if signs is None else signs.reshape(1, n_c, n_p))
     notes = (*dic.notes, f"field {name!r}: frames {[dic.frames[i] for i in indices]} at {control} = "
              f"{np.round(controls, 6).tolist()} mm, components {[('u', 'v')[c] for c in comps]}, {n_p} points",
-             f"{kept.size} of {keep.size} values kept ({keep.size - kept.size} missing dropped)", std_note, cov_note,
-             *fold_note)
-    data = ExperimentalData(control=np.repeat(controls, n_c * n_p)[kept], y=values.reshape(-1)[kept],
-                            covariance=cov.take(kept), blocks=((name, 0, kept.size),), notes=notes)
+             f"{kept.size} of {keep.size} values kept ({keep.size - kept.size} missing dropped)", std_note, cov_note)
+    data = ExperimentalData(control=np.repeat(controls, n_c * n_p)[kept],
+                            y=values.reshape(full)[:, :, per_point].reshape(-1)[kept], covariance=cov.take(kept),
+                            blocks=((name, 0, kept.size),), notes=notes)
     frame_numbers = tuple(dic.frames[i] for i in indices)
-    model_points = points if mirrored is None else mirror_points(points, mirrored, symmetry)
-    return FieldBlock(data, model_points, controls, frame_numbers, comps, keep, mirrored)
-
-
-def mirror_points(points, mirrored, symmetry) -> np.ndarray:
-    """``points`` [mm] with those flagged ``mirrored`` reflected across the line x[axis] = value."""
-    axis, value = symmetry
-    out = np.array(points, dtype=float)
-    out[mirrored, axis] = 2.0 * value - out[mirrored, axis]
-    return out
-
-
-def _folded(points, components, symmetry) -> tuple:
-    """(mirrored mask of the points, signs of one frame's entries, note), or (None, None, ()) without symmetry."""
-    if symmetry is None:
-        return None, None, ()
-    try:
-        axis, value = symmetry
-        axis, value = int(axis), real_number(value, "symmetry value")
-    except (TypeError, ValueError):
-        raise DataError(f"symmetry = {symmetry!r}: give (axis, value), e.g. (0, 0.0) for the line x = 0") from None
-    if axis not in (0, 1) or not np.isfinite(value):
-        raise DataError(f"symmetry = {symmetry!r}: the axis is 0 (x) or 1 (y) and the value a finite coordinate [mm]")
-    mirrored = np.asarray(points)[:, axis] < value
-    signs = np.concatenate([np.where(mirrored & (c == axis), -1.0, 1.0) for c in components])
-    note = (f"{int(mirrored.sum())} points folded across the symmetry line {'xy'[axis]} = {value:g} mm onto the "
-            f"modelled half ({'xy'[axis]} displacement's sign flipped)",)
-    return mirrored, signs, note
+    return FieldBlock(data, points, controls, frame_numbers, comps, keep)

@@ -34,18 +34,15 @@ RIGID_STD = 1.0
 MODES = ("tx", "ty", "theta")
 
 
-def rigid_modes(points, components, signs=None) -> np.ndarray:
+def rigid_modes(points, components) -> np.ndarray:
     """The displacement of the unit rigid motions at the entries of one frame [mm per unit].
 
     Parameters
     ----------
     points : array_like, shape (n_points, 2)
-        Positions [mm] in the specimen frame (where the camera saw them: not folded by a mirror).
+        Positions [mm] in the specimen frame.
     components : sequence of int
         0 (u_x), 1 (u_y) or both, in the order of the entries (component-major, point fastest).
-    signs : array_like, shape (len(components) * n_points,), optional
-        +1 or -1 per entry: -1 for the normal component of a point folded across the symmetry line
-        (:func:`fracid.data.dic.field.field_block` ``symmetry``), whose value is the mirror image's.
 
     Returns
     -------
@@ -56,8 +53,7 @@ def rigid_modes(points, components, signs=None) -> np.ndarray:
     x, y = points[:, 0], points[:, 1]
     one, zero = np.ones_like(x), np.zeros_like(x)
     per_component = {0: np.column_stack([one, zero, -y]), 1: np.column_stack([zero, one, x])}
-    modes = np.vstack([per_component[int(c)] for c in components])
-    return modes if signs is None else modes * np.asarray(signs, float)[:, None]
+    return np.vstack([per_component[int(c)] for c in components])
 
 
 def _prior_scales(points, std: float) -> np.ndarray:
@@ -66,34 +62,32 @@ def _prior_scales(points, std: float) -> np.ndarray:
     return np.array([std, std, std / max(radius, 1e-12)])
 
 
-def with_rigid_motion(frame_covariance: Covariance, points, components, std: float = RIGID_STD,
-                      signs=None) -> LowRankPlusDiagonal:
+def with_rigid_motion(frame_covariance: Covariance, points, components, std: float = RIGID_STD) -> LowRankPlusDiagonal:
     """The covariance of one frame's entries with its rigid motion marginalised: C + R diag(s^2) R^T.
 
     Parameters
     ----------
     frame_covariance : Diagonal or LowRankPlusDiagonal
         The noise covariance of the frame's entries [mm^2] (component-major, point fastest).
-    points, components, signs
+    points, components
         As :func:`rigid_modes`.
     std : float
         Prior std of the motions [mm] (:data:`RIGID_STD`): much larger than the motions, small enough to keep
         the Woodbury capacitance well conditioned.
     """
-    modes = rigid_modes(points, components, signs) * _prior_scales(points, std)
+    modes = rigid_modes(points, components) * _prior_scales(points, std)
     modes = modes[:, np.any(modes != 0.0, axis=0)]  # one component alone: no motion of the other
     low_rank = getattr(frame_covariance, "U", np.zeros((frame_covariance.n, 0)))
     variances = frame_covariance.D.var if hasattr(frame_covariance, "D") else frame_covariance.diag()
     return LowRankPlusDiagonal(np.hstack([low_rank, modes]), variances)
 
 
-def fit_rigid_motion(points, components, residual, covariance: Covariance | None = None,
-                     signs=None) -> tuple[np.ndarray, np.ndarray]:
+def fit_rigid_motion(points, components, residual, covariance: Covariance | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The rigid motion of one frame's residual (data minus model), by generalised least squares.
 
     Parameters
     ----------
-    points, components, signs
+    points, components
         As :func:`rigid_modes`.
     residual : array_like, shape (len(components) * n_points,)
         The frame's residual [mm]; NaN entries (missing values) are ignored.
@@ -107,7 +101,7 @@ def fit_rigid_motion(points, components, residual, covariance: Covariance | None
     fitted : ndarray
         The motion's displacement at every entry [mm] (NaN where the residual is).
     """
-    modes = rigid_modes(points, components, signs)
+    modes = rigid_modes(points, components)
     r = np.asarray(residual, float)
     have = np.isfinite(r)
     R, rh = modes[have], r[have]

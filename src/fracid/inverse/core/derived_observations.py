@@ -82,15 +82,12 @@ class DerivedFieldObservation:
     def __post_init__(self):
         points = _positions(self.points)
         frames = check_control_points(self.frames, "frames")
-        line = self.estimator.line
-        other = line.offsets(points) < 0 if line.mirrored else np.zeros(len(points), dtype=bool)
-        sampled = np.where(other[:, None], line.mirror(points), points)
-        field = FieldObservation(self.specimen, sampled, frames, (line.normal,), control=self.control, name=self.name)
+        line = self.estimator.line  # points on the other side of a symmetry line: mirrored by the field
+        field = FieldObservation(self.specimen, points, frames, (line.normal,), control=self.control, name=self.name)
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "frames", frames)
         object.__setattr__(self, "present", _present(self.present, (frames.size, len(points))))
         object.__setattr__(self, "field", field)
-        object.__setattr__(self, "_sign", np.where(other, -1.0, 1.0))
 
     def probe_matrix(self) -> sp.csr_matrix:
         """The wrapped field observation's: u_n at the (mirrored) points, one row per point [mm]."""
@@ -137,8 +134,8 @@ class DerivedFieldObservation:
         not reached."""
         values, derivatives = self.field.sample(run)
         n_frames, n_points = self.present.shape
-        u = values.reshape(n_frames, n_points) * self._sign
-        du = None if derivatives is None else derivatives.reshape(n_frames, n_points, -1) * self._sign[:, None]
+        u = values.reshape(n_frames, n_points)
+        du = None if derivatives is None else derivatives.reshape(n_frames, n_points, -1)
         y, S = [], []
         for k in range(n_frames):
             y_k, J_k = self.estimator.evaluate(self.points, self.present[k], u[k])

@@ -247,7 +247,9 @@ class FieldObservation:
     specimen
         A plane specimen object (with ``describe()``) or a description.
     points : array_like, shape (n_points, 2)
-        Positions [mm] in the modelled part of the specimen (a symmetric half or quarter).
+        Positions [mm] in the specimen frame: in the modelled part, or, for a half modelled about its crack
+        line (``Description.crack.mirrored``), in the other half too (sampled at the mirror image with the
+        normal component's sign flipped: :func:`mirrored_points`).
     frames : array_like
         Increasing control values of the frames [mm].
     components : int or tuple of int
@@ -296,8 +298,9 @@ class FieldObservation:
         d = describe(self.specimen)
         if d.dim != 2:
             raise ValueError(f"a field observation needs a plane specimen; {type(self.specimen).__name__} is {d.dim}D")
-        P = probe_matrix(d.nodes, d.cells, self.points).tocoo()
-        rows = [sp.csr_matrix((P.data, (P.row, 2 * P.col + c)), shape=(P.shape[0], 2 * P.shape[1]))
+        sampled, sign = mirrored_points(d, self.points)
+        P = probe_matrix(d.nodes, d.cells, sampled).tocoo()
+        rows = [sp.csr_matrix((P.data * (sign[c][P.row]), (P.row, 2 * P.col + c)), shape=(P.shape[0], 2 * P.shape[1]))
                 for c in self.components]
         object.__setattr__(self, "_matrix", sp.vstack(rows, format="csr"))
 
@@ -361,6 +364,34 @@ class FieldObservation:
         y = values.ravel()  # frame-major
         S = None if derivatives is None else self._kept_entries(derivatives.reshape(y.size, -1))
         return self._kept_entries(y), S
+
+
+def mirrored_points(description, points) -> tuple[np.ndarray, dict]:
+    """Where the model samples ``points`` (n, 2) [mm], and the sign of each component there.
+
+    A specimen modelled as a symmetric half (its crack on the symmetry line: ``Description.crack.mirrored``)
+    computes a point of the other half as its mirror image, the normal displacement's sign flipped: a camera
+    that sees both halves is compared with the model on both. Other points are sampled where they are.
+
+    Returns
+    -------
+    sampled : ndarray (n, 2)
+        The positions in the model [mm].
+    sign : dict
+        ``{component: ndarray (n,)}`` of +1 / -1 for components 0 (u_x) and 1 (u_y).
+    """
+    from fracid.specimens.crack_line import crack_line
+
+    points = np.asarray(points, float)
+    crack = getattr(description, "crack", None)
+    other = np.zeros(len(points), dtype=bool)
+    sampled = points
+    if crack is not None and crack.nodes is not None and crack.mirrored:
+        line = crack_line(description)
+        other = line.offsets(points) < 0.0
+        sampled = np.where(other[:, None], line.mirror(points), points)
+    flip = {c: np.where(other & (c == getattr(crack, "normal", -1)), -1.0, 1.0) for c in (0, 1)}
+    return sampled, flip
 
 
 def field_observation(block, specimen, *, control: str | None = None, name: str | None = None) -> FieldObservation:
