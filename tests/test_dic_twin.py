@@ -13,6 +13,7 @@ from fracid.data.dic import CameraPlacement
 from fracid.inverse.studies.dic_twin import (inside_mesh, rigid_motion, speckle_grid, synthetic_dic,
                                              write_dic)
 from fracid.specimens.beam import NotchedBeam
+from fracid.specimens.strip import TensionStrip
 
 BEAM = NotchedBeam(h_fine=4.0, h_coarse=10.0)
 PARAMS = DamageParameters(E=36250.0, nu=0.2, kappa_i=6.6e-5, alpha=0.99, beta=600.0, c=9.0, eta=10.0)
@@ -172,3 +173,27 @@ def test_the_readers_read_the_twins_files_back_in_the_specimen_frame(noisy, tmp_
     assert np.array_equal(data.missing.any(axis=(0, 2)), noisy.holes)
     np.testing.assert_allclose(data.load["cmod_mm"], noisy.control, rtol=1e-9)
     np.testing.assert_allclose(data.std[0, ~noisy.holes, 0], 1e-3, rtol=1e-9)
+
+
+def test_a_camera_on_both_halves_sees_the_mirror_image():
+    """both_halves: the grid covers the half beam and its mirror across the crack line x = 0; a point of the other
+    half carries the mirror image's displacement (u_x negated), as the field observation computes it."""
+    from fracid.inverse.core.observations import FieldObservation
+
+    data = synthetic_dic(BEAM, PARAMS, frames=FRAMES[:2], spacing=5.0, std=0.0, subset_size=6.0, both_halves=True)
+    left = data.points[:, 0] < 0
+    assert 0.3 < left.mean() < 0.7 and data.points[:, 0].min() < -80.0
+    field = FieldObservation(BEAM, data.points, FRAMES[:2])
+    run = simulate(BEAM, PARAMS, target=FRAMES[1], checkpoints=FRAMES[:2], probes=field.probe_matrix())
+    model, _ = field.sample(run)
+    measured = data.U.transpose(0, 2, 1).reshape(-1)  # frame, component, point (camera = specimen frame here)
+    np.testing.assert_allclose(measured, model, atol=1e-9 * np.abs(model).max())
+    d = BEAM.describe()
+    mirror = data.points[left] * [-1.0, 1.0]
+    step = int(np.argmin(np.abs(run.control - FRAMES[1])))
+    u = probe_matrix(d.nodes, d.cells, mirror) @ np.asarray(
+        simulate(BEAM, PARAMS, target=FRAMES[1], checkpoints=FRAMES[:2], field_steps="all").fields[step]["u"]
+    ).reshape(-1, 2)
+    np.testing.assert_allclose(data.U[1][left], u * [-1.0, 1.0], atol=1e-9 * np.abs(u).max())
+    with pytest.raises(ValueError, match="both_halves needs"):
+        synthetic_dic(TensionStrip(), PARAMS, frames=[0.01], spacing=5.0, std=0.0, subset_size=6.0, both_halves=True)

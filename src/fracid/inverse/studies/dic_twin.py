@@ -13,8 +13,8 @@ CSV point clouds and the frame table in the DIC export format of fracid (issue 2
   points in the same order in every frame, a hole a ``NaN`` displacement;
 * ``frames.csv``: ``frame, file, <control>_mm, force_N`` (e.g. ``cmod_mm``) of every frame.
 
-The points are in the modelled part of the specimen (a symmetric half or quarter): the twin samples
-the mesh it runs. Units: mm and N; camera units are px or mm (the placement's scale says which).
+The points are in the modelled part of the specimen (a symmetric half or quarter), or on both halves of a
+half modelled about its crack line (``both_halves``: the other half is the mirror image). Units: mm and N; camera units are px or mm (the placement's scale says which).
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ import numpy as np
 
 from fracid.data.dic.placement import CameraPlacement, rotation_matrix
 from fracid.data.dic_noise import dic_covariance
+from fracid.inverse.core.observations import mirrored_points
 from fracid.specimens.description import Description
 
 #: relative tolerance of the point-in-element test (the probe operator has the final word)
@@ -173,7 +174,7 @@ def _check_frames(frames) -> np.ndarray:
 def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: float, subset_size: float,
                   holes: float | None = None, hole_span=None, rigid_body=(0.0, 0.0, 0.0),
                   placement: CameraPlacement = CameraPlacement(1.0), grid_angle: float = np.radians(3.0),
-                  jitter: float = 0.15,
+                  jitter: float = 0.15, both_halves: bool = False,
                   seed: int = 0, **options) -> SyntheticDic:
     """Synthetic DIC data of a forward run at ``params``.
 
@@ -199,6 +200,10 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
         The camera frame on the specimen; the data are returned in camera coordinates.
     grid_angle, jitter
         The grid's rotation [rad] and jitter [fraction of spacing] (:func:`speckle_grid`).
+    both_halves : bool
+        For a specimen modelled as a symmetric half about its crack line (``Description.crack.mirrored``): the
+        camera sees both halves (the other half's displacements are the mirror image's, as
+        :class:`~fracid.inverse.core.observations.FieldObservation` computes them). Default: the modelled part.
     seed : int
         Seeds the jitter and the noise.
     **options
@@ -220,13 +225,17 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     if d.dim != 2:
         raise ValueError(f"DIC needs a plane specimen; {type(specimen).__name__} is {d.dim}D")
     rng = np.random.default_rng(seed)
-    grid = speckle_grid(d.nodes.min(axis=0), d.nodes.max(axis=0), spacing, angle=grid_angle, jitter=jitter, rng=rng)
-    points = grid[inside_mesh(d.nodes, d.corners, grid)]
-    P = probe_matrix(d.nodes, d.cells, points)  # raises for a point outside the mesh
+    low, high = _face(d, both_halves)
+    grid = speckle_grid(low, high, spacing, angle=grid_angle, jitter=jitter, rng=rng)
+    sampled, sign = mirrored_points(d, grid)
+    inside = inside_mesh(d.nodes, d.corners, sampled)
+    points, sampled = grid[inside], sampled[inside]
+    sign = np.column_stack([sign[0][inside], sign[1][inside]])
+    P = probe_matrix(d.nodes, d.cells, sampled)  # raises for a point outside the mesh
     run = simulate(specimen, params, model=model, target=float(frames[-1]), checkpoints=frames, field_steps="all",
                    **options)
     steps = _frame_fields(run, frames)
-    u = np.stack([P @ q.reshape(-1, 2) for _, q in steps])  # (n_frames, n, 2) [mm]
+    u = np.stack([(P @ q.reshape(-1, 2)) * sign for _, q in steps])  # (n_frames, n, 2) [mm]
     u = u + np.stack([rigid_motion(points, *row) for row in rb])
     noise = _noise(points, std, subset_size, len(frames), rng)
     hole = np.zeros(len(points), bool) if holes is None else crack_distance(d, points, hole_span) < holes
@@ -236,6 +245,21 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     return SyntheticDic(X=placement.to_camera(points), U=U, sigma=std / placement.scale, control_name=run.control_name,
                    control=run.control[index], force=run.force[index], placement=placement, points=points,
                    holes=hole, noise=noise, rigid_body=rb)
+
+
+def _face(description: Description, both_halves: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The box [mm] the camera sees: the mesh's, and with ``both_halves`` its mirror across the crack line too."""
+    low, high = description.nodes.min(axis=0), description.nodes.max(axis=0)
+    if not both_halves:
+        return low, high
+    crack = description.crack
+    if crack is None or crack.nodes is None or not crack.mirrored:
+        raise ValueError("both_halves needs a specimen modelled as a symmetric half about its crack line "
+                         "(Description.crack.mirrored); this one is not")
+    from fracid.specimens.crack_line import crack_line
+
+    corners = crack_line(description).mirror(np.array([low, high]))
+    return np.minimum(low, corners.min(axis=0)), np.maximum(high, corners.max(axis=0))
 
 
 def _noise(points, std: float, subset_size: float, n_frames: int, rng) -> np.ndarray:
