@@ -11,7 +11,11 @@ import numpy as np
 from fracid.config.checker import show
 from fracid.config.registry import model_of, model_parameters, specimen_class
 from fracid.config.schema import Config, ConfigError, ExperimentConfig
+from fracid.config.vocabulary import DERIVED_KINDS
 from fracid.inverse.core.settings import SettingError
+
+#: the kinds whose data come from a DIC displacement field: the field and the blocks derived from it
+FIELD_KINDS = ("field", *DERIVED_KINDS)
 
 
 def _require(cfg: Config, section: str):
@@ -45,14 +49,19 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
 
 
 def _field_block(cfg: Config, exp):
-    """The DIC field block of a ``kind = "field"`` experiment (:mod:`fracid.config.field_experiments`)."""
+    """The DIC block of a ``kind = "field"`` experiment (:mod:`fracid.config.field_experiments`: a FieldBlock)
+    or of one derived from a field (:mod:`fracid.config.derived_experiments`: a DerivedBlock, its field read)."""
     from fracid.config.field_experiments import field_block
 
-    return field_block(exp, build_specimen(cfg, exp))
+    if exp.kind == "field":
+        return field_block(exp, build_specimen(cfg, exp))
+    from fracid.config.derived_experiments import derived_block
+
+    return derived_block(exp, _field_block(cfg, exp.source), build_specimen(cfg, exp))
 
 
 def _experiment_data(cfg: Config, exp: ExperimentConfig):
-    if exp.kind == "field":
+    if exp.kind in FIELD_KINDS:
         return _field_block(cfg, exp).data
     from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
 
@@ -187,7 +196,7 @@ def _operator(cfg: Config, experiments, data):
                           f"has {len(experiments)} such [[experiments]] entries; build the data with build_data(cfg)")
     observations = []
     for exp, (name, start, stop) in zip(experiments, data.blocks):
-        if exp.kind == "field":
+        if exp.kind in FIELD_KINDS:
             observations.append(_field_observation(cfg, exp, name, data.control[start:stop]))
             continue
         try:
@@ -201,11 +210,15 @@ def _operator(cfg: Config, experiments, data):
 
 
 def _field_observation(cfg: Config, exp, name: str, control):
-    """The FieldObservation of a field experiment, checked against its block of the data (``control``)."""
+    """The FieldObservation of a field experiment (the DerivedFieldObservation of one derived from a field),
+    checked against its block of the data (``control``)."""
     block = _field_block(cfg, exp)
-    from fracid.inverse.core.observations import field_observation
+    if exp.kind == "field":
+        from fracid.inverse.core.observations import field_observation as observation
+    else:
+        from fracid.inverse.core.derived_observations import derived_observation as observation
 
-    field = field_observation(block, build_specimen(cfg, exp), control=cfg.specimen.control, name=name)
+    field = observation(block, build_specimen(cfg, exp), control=cfg.specimen.control, name=name)
     if field.size != len(control) or not np.array_equal(field.controls, control):
         raise ConfigError(f"{cfg.path}: experiments[{exp.index}]: the data's block {name!r} does not match the field "
                           f"of {exp.file} ({len(control)} values, the field {field.size}); build the data with "

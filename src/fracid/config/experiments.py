@@ -8,6 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from fracid.config.checker import Checker
+from fracid.config.derived_experiments import read_derived_experiment
 from fracid.config.field_experiments import read_field_experiment
 from fracid.config.registry import section_reader, specimen_class, specimen_observables
 from fracid.config.schema import (
@@ -19,6 +20,7 @@ from fracid.config.vocabulary import (
     CONTROL_UNITS,
     DECIMALS,
     DELIMITERS,
+    DERIVED_KINDS,
     EXPERIMENT_KEYS,
     FORCE_UNITS,
     KIND_KEYS,
@@ -67,8 +69,6 @@ def _experiment(ck: Checker, i: int, raw, base: Path, specimen: SpecimenConfig) 
     """The validated ``[[experiments]]`` block ``i``; its keys are checked in a fixed order (the first
     problem is the one reported): units and kind, then the file's format and columns, then the rest."""
     prefix = f"experiments[{i}]"
-    if isinstance(raw, dict) and raw.get("kind") == "field":
-        return read_field_experiment(ck, i, raw, base, specimen)
     ck.table(prefix, raw, EXPERIMENT_KEYS)
     observables = specimen_observables(specimen)
     quantity = ck.choice(f"{prefix}.quantity", raw.get("quantity", "force"), ("force", *observables))
@@ -260,10 +260,24 @@ def _negated(ck: Checker, key: str, value) -> tuple:
 
 
 def read_experiments(ck: Checker, raw, base: Path, specimen: SpecimenConfig, needed: bool) -> tuple:
+    """The validated ``[[experiments]]`` blocks in order: the field blocks read, the blocks derived from them
+    (:mod:`~fracid.config.derived_experiments`) checked last, on the field blocks as read."""
     if raw is None:
         if needed:
             ck.missing("experiments", "one or more [[experiments]] blocks (data files) for identification")
         return ()
     if not isinstance(raw, list) or not raw:
         ck.fail("experiments", raw, "must be one or more [[experiments]] tables")
-    return tuple(_experiment(ck, i, block, base, specimen) for i, block in enumerate(raw))
+    read, fields = {}, {}  # index -> config; a field block's name -> [(config, FieldBlock), ...]
+    for i, block in enumerate(raw):
+        kind = block.get("kind") if isinstance(block, dict) else None
+        if kind == "field":
+            exp, field = read_field_experiment(ck, i, block, base, specimen)
+            read[i] = exp
+            fields.setdefault(exp.name, []).append((exp, field))
+        elif kind not in DERIVED_KINDS:
+            read[i] = _experiment(ck, i, block, base, specimen)
+    for i, block in enumerate(raw):  # the derived blocks, once the field blocks they name are read
+        if i not in read:
+            read[i] = read_derived_experiment(ck, i, block, fields, specimen)
+    return tuple(read[i] for i in range(len(raw)))

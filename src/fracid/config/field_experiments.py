@@ -207,8 +207,9 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
     return "exclude_near" if "no value left" in message and exp.exclude_near is not None else "frames_file"
 
 
-def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: SpecimenConfig):
-    """The validated field block ``i`` of ``[[experiments]]``, its data read (their size is ``n_points``)."""
+def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: SpecimenConfig) -> tuple:
+    """The validated field block ``i`` of ``[[experiments]]`` and its :class:`~fracid.data.dic.FieldBlock`, read
+    while checking (the data's size is ``n_points``; the blocks derived from it reuse the FieldBlock)."""
     from fracid.data import DataError
 
     prefix = f"experiments[{i}]"
@@ -244,4 +245,4 @@ def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: 
         ck.fail(f"{prefix}.{key}", raw.get(key, COLUMN_KEYS.get(key)), str(err))
     except ValueError as err:
         ck.fail(f"{prefix}.exclude_near", raw.get("exclude_near"), str(err))
-    return replace(exp, n_points=block.data.n_y)
+    return replace(exp, n_points=block.data.n_y), block

@@ -84,7 +84,8 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     damage_threshold = 0.5              # optional, local quantity only: 0 <= t < 1, damage counted in
                                         #   the width (default 0: any damage)
     role = "calibration"                # "calibration" (default) | "prediction": predicted at the
-                                        #   estimate by `fracid study`, not calibrated on
+                                        #   estimate by `fracid study`, not calibrated on | "source": read
+                                        #   and checked only (the field a derived block comes from)
     delimiter = ","                     # cell separator: "," (default) | ";" | "\\t" (or "tab") | " " (any
                                         #   run of spaces and tabs)
     decimal = "."                       # decimal mark: "." (default) | "," (0,001); "," needs another delimiter
@@ -112,6 +113,24 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     # exclude_near = 4.0                # mm: points nearer the specimen's crack path dropped
     # point_spacing = 3.0               # mm: thin a dense field to one point per square of this side
     # name = "field", weight = 1.0, role = "calibration"
+
+    [[experiments]]                     # local data derived from a field block (fracid.config.derived_experiments):
+    kind = "opening"                    #   "opening": the crack-opening profile by virtual extensometers across
+                                        #   the crack | "fpz-width": the process-zone width by strain transects
+    field = "field"                     # required: the name of a kind = "field" block of this file; give that
+                                        #   block role = "source" (its measurements not counted twice)
+    heights = [30, 35, 40, 45]          # required, mm: positions along the ligament, increasing
+    gauge = 6.0                         # "opening", required, mm: half-length of the gauges (ends at +-gauge
+                                        #   from the crack line), beyond the band of missing points
+    radius = 5.0                        # required, mm: radius of the plane fits (>= 1.5 DIC point spacings)
+    # pairs = false                     # "opening": ends on both sides of the crack (true: the rigid motion
+                                        #   cancels) or one, the symmetric half, w = 2 u_n(+gauge) (false: the
+                                        #   field's rigid_motion prior makes each frame's mean and tilt
+                                        #   uninformative); default: true if the field has points on both sides
+    # offsets = [5, 8, 11, 14]          # "fpz-width", required, mm: samples of each transect, signed distances
+                                        #   from the crack line (positive on the modelled side), increasing
+    # threshold = 3e-5                  # "fpz-width", required, > 0: the strain above which a sample counts
+    # name = "opening" ("fpz_width"), weight = 1.0, role = "calibration"
 
     [identify]                          # required for identification
     parameters = ["kappa_i", "beta", "c"]   # required: parameters of the [model] type to identify,

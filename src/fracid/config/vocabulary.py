@@ -19,9 +19,13 @@ DECIMALS = (".", ",")
 FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 #: ``force_unit`` of a local quantity (a length) -> multiplier to mm
 LOCAL_UNITS = dict(CONTROL_UNITS)
-KINDS = ("repeats", "envelope", "single", "field")
+#: kinds of local data derived from a field block (fracid.config.derived_experiments): the crack-opening
+#: profile and the process-zone width
+DERIVED_KINDS = ("opening", "fpz-width")
+KINDS = ("repeats", "envelope", "single", "field", *DERIVED_KINDS)
 PURPOSES = ("identify", "simulate")
-ROLES = ("calibration", "prediction")
+#: "source": read and checked, neither calibrated on nor predicted: the field a derived block comes from
+ROLES = ("calibration", "prediction", "source")
 
 # ------------------------------------------------------------------------------------ keys
 
@@ -37,6 +41,8 @@ KIND_KEYS = {
     "envelope": ("mean_column", "lower_column", "upper_column"),
     "single": ("force_columns", "std", "relative_std"),
     "field": (),  # a DIC field: its own keys (fracid.config.field_experiments.FIELD_KEYS)
+    "opening": (),  # derived from a field: its own keys (fracid.config.derived_experiments.DERIVED_KEYS)
+    "fpz-width": (),
 }
 #: the keys of [identify] itself; it also allows every table of a registered inverse method's settings
 #: (fracid.inverse.methods.registry.known_tables), which the method checks

@@ -408,6 +408,7 @@ def derived_block(field: FieldBlock, estimator, *, name: str, rigid_motion=None,
     used = np.flatnonzero(np.any(W != 0.0, axis=0))
     covariance = (W[:, used] @ field.data.covariance.take(used).dense() @ W[:, used].T if used.size
                   else np.zeros((y.size, y.size)))
+    covariance = 0.5 * (covariance + covariance.T)  # symmetric to rounding (a large rigid-motion prior breaks it)
     variance = np.diag(covariance)
     if np.any(variance <= 0):
         i = int(np.argmax(variance <= 0))
