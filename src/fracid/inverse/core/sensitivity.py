@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.data.covariance_matrix import Block, Dense, Diagonal, as_covariance
+from fracid.data.covariance_matrix import Block, Dense, Diagonal, LowRankPlusDiagonal, as_covariance
 from fracid.inverse.core.forward_operator import RunRecord
 
 
@@ -201,10 +201,34 @@ def cumulative_information(S, C_exp) -> np.ndarray:
     C_exp : Covariance
         Covariance of the n observations [units of y squared].
     """
+    S = np.asarray(S, float)
     if _prefix_whitening(C_exp):
         W = C_exp.whiten(S)
         return np.cumsum(W[:, :, None] * W[:, None, :], axis=0)
+    if isinstance(C_exp, Block):  # blocks are independent: each adds its own prefixes to the blocks before
+        parts, total = [], np.zeros((S.shape[1], S.shape[1]))
+        for block, start, stop in zip(C_exp.blocks, C_exp.offsets[:-1], C_exp.offsets[1:]):
+            parts.append(total + cumulative_information(S[start:stop], block))
+            total = parts[-1][-1]
+        return np.concatenate(parts)
+    if isinstance(C_exp, LowRankPlusDiagonal):
+        return _low_rank_prefix_information(S, C_exp)
     return np.array([S[: t + 1].T @ C_exp.take(slice(0, t + 1)).solve(S[: t + 1]) for t in range(S.shape[0])])
+
+
+def _low_rank_prefix_information(S, C_exp) -> np.ndarray:
+    """:func:`cumulative_information` of C = D + U U^T by Woodbury on running sums: with A_t = sum s_i s_i^T / d_i,
+    B_t = sum u_i s_i^T / d_i and K_t = I + sum u_i u_i^T / d_i over the first t entries, the information is
+    A_t - B_t^T K_t^-1 B_t: O(n k^3), exact, no leading block rebuilt."""
+    d, U = C_exp.D.var, C_exp.U
+    A = np.cumsum(S[:, :, None] * (S / d[:, None])[:, None, :], axis=0)
+    B, K = np.zeros((U.shape[1], S.shape[1])), np.eye(U.shape[1])
+    out = np.empty_like(A)
+    for t in range(S.shape[0]):
+        B += np.outer(U[t], S[t]) / d[t]
+        K += np.outer(U[t], U[t]) / d[t]
+        out[t] = A[t] - B.T @ np.linalg.solve(K, B)
+    return out
 
 
 def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sensitivity=None,
