@@ -122,3 +122,19 @@ def test_a_camera_on_both_halves_keeps_the_opening_a_rigid_motion_of_one_half_wo
     assert whole.data.covariance.quadratic(whole.data.y) > 1e3
     model = _hinge(both, 2e-4).T.reshape(-1)  # a model that computes the opening: the rigid motion alone is left
     assert whole.data.covariance.quadratic(whole.data.y - model) < 1e-2
+
+
+def test_the_noise_std_leaves_the_rigid_prior_out():
+    """diag() is the matrix's (the rigid prior's 1 mm in it); noise_diag() the measurement noise's, through take
+    and block stacking; the stability check's relative noise reads the latter."""
+    from fracid.data.covariance_matrix import block_diagonal
+    from fracid.inverse.studies.stability import relative_noise
+
+    C = _noise_covariance(POINTS)
+    total = with_rigid_motion(C, POINTS, (0, 1))
+    assert total.nuisance == 3 and np.all(np.sqrt(total.diag()) > 0.5)
+    np.testing.assert_allclose(total.noise_diag(), C.diag(), rtol=1e-12)
+    part = block_diagonal([Diagonal(np.full(4, 25.0)), total.take(np.arange(10, 50))])
+    np.testing.assert_allclose(part.noise_diag(), np.concatenate([np.full(4, 25.0), C.diag()[10:50]]), rtol=1e-12)
+    y = np.concatenate([np.full(4, 1000.0), np.full(40, 0.02)])  # a curve [N] and displacements [mm]
+    assert relative_noise(y, part) == pytest.approx(np.sqrt(np.mean(np.r_[np.full(4, 25e-6), C.diag()[10:50] / 4e-4])))

@@ -81,6 +81,11 @@ class Covariance:
         w = self.whiten(r)
         return float(w @ w) if w.ndim == 1 else np.sum(w * w, axis=0)
 
+    def noise_diag(self) -> np.ndarray:
+        """The variances of the measurement noise alone: :meth:`diag` less the variance of nuisance modes (the
+        vague prior of a marginalised rigid motion, :class:`LowRankPlusDiagonal` ``nuisance``)."""
+        return self.diag()
+
     def dense(self) -> np.ndarray:
         """The n x n matrix (for reports and tests); ValueError above :data:`DENSE_LIMIT` values."""
         if self.n > DENSE_LIMIT and not isinstance(self, Dense):
@@ -225,9 +230,13 @@ class LowRankPlusDiagonal(Covariance):
         The shared modes [units of y].
     d : array_like, shape (n,)
         Variances of the independent part [units of y squared], > 0.
+    nuisance : int
+        The last ``nuisance`` columns of U are a vague prior on nuisance motions marginalised out (the rigid
+        motion of a DIC frame, :mod:`fracid.data.dic.rigid`), not measurement noise: :meth:`noise_diag` leaves
+        them out.
     """
 
-    def __init__(self, U, d, *, name: str = "covariance"):
+    def __init__(self, U, d, *, name: str = "covariance", nuisance: int = 0):
         self.D = Diagonal(d, name=name)
         U = np.array(U, dtype=float)
         if U.ndim == 1:
@@ -238,6 +247,9 @@ class LowRankPlusDiagonal(Covariance):
             raise ValueError(f"{name}: U holds NaN or infinite values")
         U.setflags(write=False)
         self.U, self.n = U, self.D.n
+        if not 0 <= int(nuisance) <= U.shape[1]:
+            raise ValueError(f"{name}: nuisance = {nuisance!r}; give 0 to {U.shape[1]} (the number of columns of U)")
+        self.nuisance = int(nuisance)
         self._root_d = np.sqrt(self.D.var)
         V = U / self._root_d[:, None]
         self._capacitance = np.linalg.cholesky(np.eye(U.shape[1]) + V.T @ V)
@@ -270,16 +282,19 @@ class LowRankPlusDiagonal(Covariance):
     def diag(self) -> np.ndarray:
         return self.D.var + np.sum(self.U**2, axis=1)
 
+    def noise_diag(self) -> np.ndarray:
+        return self.D.var + np.sum(self.U[:, : self.U.shape[1] - self.nuisance] ** 2, axis=1)
+
     def _dense(self) -> np.ndarray:
         return np.diag(self.D.var) + self.U @ self.U.T
 
     def take(self, index) -> "LowRankPlusDiagonal":
         index = _index(index, self.n)
-        return LowRankPlusDiagonal(self.U[index], self.D.var[index])
+        return LowRankPlusDiagonal(self.U[index], self.D.var[index], nuisance=self.nuisance)
 
     def scaled(self, factors) -> "LowRankPlusDiagonal":
         f = np.asarray(factors, float)
-        return LowRankPlusDiagonal(self.U * f[:, None], self.D.var * f**2)
+        return LowRankPlusDiagonal(self.U * f[:, None], self.D.var * f**2, nuisance=self.nuisance)
 
 
 class Block(Covariance):
@@ -317,6 +332,9 @@ class Block(Covariance):
 
     def diag(self) -> np.ndarray:
         return np.concatenate([block.diag() for block in self.blocks])
+
+    def noise_diag(self) -> np.ndarray:
+        return np.concatenate([block.noise_diag() for block in self.blocks])
 
     def _dense(self) -> np.ndarray:
         return scipy.linalg.block_diag(*[block.dense() for block in self.blocks])

@@ -79,7 +79,8 @@ def with_rigid_motion(frame_covariance: Covariance, points, components, std: flo
     modes = modes[:, np.any(modes != 0.0, axis=0)]  # one component alone: no motion of the other
     low_rank = getattr(frame_covariance, "U", np.zeros((frame_covariance.n, 0)))
     variances = frame_covariance.D.var if hasattr(frame_covariance, "D") else frame_covariance.diag()
-    return LowRankPlusDiagonal(np.hstack([low_rank, modes]), variances)
+    return LowRankPlusDiagonal(np.hstack([low_rank, modes]), variances,
+                               nuisance=modes.shape[1] + getattr(frame_covariance, "nuisance", 0))
 
 
 def fit_rigid_motion(points, components, residual, covariance: Covariance | None = None) -> tuple[np.ndarray, np.ndarray]:

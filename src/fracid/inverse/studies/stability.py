@@ -30,7 +30,7 @@ class Stability:
     errors : list of str
         Failure reason per replicate ("" when it ran).
     noise_level : float
-        RMS of std / |y| over the data: the relative noise added.
+        RMS of std / |y| over the data (:func:`relative_noise`): the relative noise added.
     seed : int
     """
 
@@ -61,6 +61,15 @@ class Stability:
     def amplification(self) -> np.ndarray:
         """Relative scatter of each parameter / relative noise of the data."""
         return self.relative_scatter / self.noise_level
+
+
+def relative_noise(y_exp, C_noise) -> float:
+    """RMS of std / |y| over the values the noise does not swamp (|y| >= 3 std; all if none), the std that of the
+    measurement noise alone (a marginalised rigid motion left out: :meth:`Covariance.noise_diag`) [-]."""
+    variance = C_noise.noise_diag()
+    clear = y_exp**2 >= 9.0 * variance
+    ratio = variance / np.maximum(y_exp**2, 1e-300)
+    return float(np.sqrt(np.mean(ratio[clear] if clear.any() else ratio)))
 
 
 def noisy_replicates(y, C_noise, n: int, seed: int = 0) -> np.ndarray:
@@ -117,6 +126,6 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
             estimates[i], error = result.x, ""
             stds.append(result.std)
         errors.append(error)
-    noise = float(np.sqrt(np.mean(C_noise.diag() / np.maximum(y_exp**2, 1e-300))))
+    noise = relative_noise(y_exp, C_noise)
     posterior = np.mean(stds, axis=0) if stds else None
     return Stability(estimates, errors, noise, seed, posterior)
