@@ -46,7 +46,7 @@ from fracid.specimens.beam import NotchedBeam
 BASE = DamageParameters(E=36250.0, nu=0.2, kappa_i=6.6e-5, alpha=0.99, beta=600.0, c=9.0, eta=10.0)  # demo.toml
 NAMES = ("kappa_i", "beta", "c")
 TRUTH = np.array([4.798e-5, 1086.5, 21.46])  # the demo's estimate (docs/demo/result.json, rounded)
-SPACE = ParameterSpace(list(NAMES), [3e-5, 300.0, 5.0], [8e-5, 3000.0, 60.0], log=["beta"])
+SPACE = ParameterSpace(NAMES, [4e-5, 200.0, 4.0], [1e-4, 3000.0, 30.0], log=(False, True, False))  # the demo's bounds
 CURVE = np.linspace(0.01, 0.2, 12)  # CMOD [mm]
 FRAMES = np.round(np.arange(0.005, 0.2001, 0.005), 6)  # 40 frames [mm]
 RIGID = np.outer(np.linspace(0.0, 1.0, FRAMES.size), [0.004, -0.012, 5e-5])  # tx, ty [mm], theta [rad]
