@@ -50,7 +50,7 @@ import scipy.linalg
 from scipy.spatial.distance import cdist
 
 from fracid.data.dic.field import field_covariance
-from fracid.data.dic.rigid import _prior_scales, rigid_modes
+from fracid.data.dic.rigid import prior_scales, rigid_modes
 from fracid.data.dic_noise import DIAGONAL_FLOOR, dic_kernel
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
@@ -197,7 +197,7 @@ class Study:
         Z = scipy.linalg.solve_triangular(L, cols, lower=True).reshape(n, nf, nc, 3) / setup.std
         if not rigid:
             return Z, None
-        M = (rigid_modes(points, comps) * _prior_scales(points, RIGID_STD)).reshape(nc, n, 3)  # (comps, points, 3)
+        M = (rigid_modes(points, comps) * prior_scales(points, RIGID_STD)).reshape(nc, n, 3)  # (comps, points, 3)
         M = M[:, :, np.any(M != 0.0, axis=(0, 1))]
         Y = scipy.linalg.solve_triangular(L, M.transpose(1, 0, 2).reshape(n, -1), lower=True).reshape(n, nc, -1)
         return Z, Y / setup.std

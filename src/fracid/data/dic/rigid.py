@@ -56,7 +56,7 @@ def rigid_modes(points, components) -> np.ndarray:
     return np.vstack([per_component[int(c)] for c in components])
 
 
-def _prior_scales(points, std: float) -> np.ndarray:
+def prior_scales(points, std: float) -> np.ndarray:
     """Prior std of (t_x, t_y, theta): ``std`` [mm], and the rotation moving the farthest point by ``std``."""
     radius = float(np.max(np.hypot(*np.asarray(points, float).T))) if len(points) else 1.0
     return np.array([std, std, std / max(radius, 1e-12)])
@@ -75,7 +75,7 @@ def with_rigid_motion(frame_covariance: Covariance, points, components, std: flo
         Prior std of the motions [mm] (:data:`RIGID_STD`): much larger than the motions, small enough to keep
         the Woodbury capacitance well conditioned.
     """
-    modes = rigid_modes(points, components) * _prior_scales(points, std)
+    modes = rigid_modes(points, components) * prior_scales(points, std)
     modes = modes[:, np.any(modes != 0.0, axis=0)]  # one component alone: no motion of the other
     low_rank = getattr(frame_covariance, "U", np.zeros((frame_covariance.n, 0)))
     variances = frame_covariance.D.var if hasattr(frame_covariance, "D") else frame_covariance.diag()

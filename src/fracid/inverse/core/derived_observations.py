@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.inverse.core.observations import FieldObservation, _positions, check_control_points
+from fracid.inverse.core.observations import FieldObservation, check_points, check_control_points
 
 
 def _present(present, shape: tuple) -> np.ndarray:
@@ -80,7 +80,7 @@ class DerivedFieldObservation:
     name: str = "derived"
 
     def __post_init__(self):
-        points = _positions(self.points)
+        points = check_points(self.points)
         frames = check_control_points(self.frames, "frames")
         line = self.estimator.line  # points on the other side of a symmetry line: mirrored by the field
         field = FieldObservation(self.specimen, points, frames, (line.normal,), control=self.control, name=self.name)

@@ -213,7 +213,7 @@ def _components(components) -> tuple:
     return tuple(int(c) for c in values)
 
 
-def _positions(points) -> np.ndarray:
+def check_points(points) -> np.ndarray:
     positions = np.asarray(points, dtype=float)
     if positions.ndim != 2 or positions.shape[1] != 2 or len(positions) == 0 or not np.all(np.isfinite(positions)):
         raise ValueError(f"points has shape {positions.shape}; give (n_points, 2) finite coordinates [mm] in the "
@@ -290,7 +290,7 @@ class FieldObservation:
         from fracid.forward import check_specimen
 
         check_specimen(self.specimen)
-        object.__setattr__(self, "points", _positions(self.points))
+        object.__setattr__(self, "points", check_points(self.points))
         object.__setattr__(self, "frames", check_control_points(self.frames, "frames"))
         object.__setattr__(self, "components", _components(self.components))
         shape = (len(self.frames), len(self.components), len(self.points))
