@@ -48,46 +48,72 @@ def equivalent_strain_parameter_derivatives(law, params, strain_state, eps, name
     return stacked(law.equivalent_strain.parameter_derivatives(strain_state, eps, params), names, eps.shape[:-1])
 
 
-def equilibrium_pseudo_load(disc, params, const, ue, omega, omega_rate, names) -> np.ndarray:
+def unit_stress_forces(disc, const, ue):
+    """B^T D eps at every point and the energy density eps . D eps, both per unit E.
+
+    Parameters
+    ----------
+    disc : MixedDiscretization
+    const : ModelConstants
+    ue : ndarray, shape (n_el, n_u)
+        Element displacements [mm].
+
+    Returns
+    -------
+    bt_sigma : ndarray, shape (n_el, n_q, n_u)
+        B^T D B ue at every point [N/mm^2 per unit E, times mm].
+    density : ndarray, shape (n_el, n_q)
+        eps . D eps = ue . B^T D eps at every point [per unit E].
+    """
+    bt_sigma = bt(np.einsum("eqsj,ej->eqs", const.DB, ue), disc.strain_operator)
+    return bt_sigma, np.einsum("eqi,ei->eq", bt_sigma, ue)
+
+
+def _nu_stress_rate(disc, params, ue):
+    """d(D)/d nu eps at every point (n_el, n_q, n_strain), per unit E, and the strain eps."""
+    eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
+    return np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(params.nu), eps), eps
+
+
+def equilibrium_pseudo_load(disc, params, const, ue, omega, omega_rate, names, stress=None) -> np.ndarray:
     """d f_u / d x at fixed displacements, per element: shape (n_el, n_u, p) [N per unit parameter].
 
     f_u = sum_q w (1 - omega) E B^T D(nu) eps; ``omega_rate`` (n_el, n_q, p) is the explicit
     derivative of the damage (the law's, plus d omega / d kappa times the explicit kappa').
+    ``stress``: :func:`unit_stress_forces` of ``ue`` when the caller has it (computed otherwise).
     """
-    B, w = disc.strain_operator, disc.weights
-    eps = np.einsum("eqsi,ei->eqs", B, ue)
-    bt_sigma = bt(np.einsum("eqsj,ej->eqs", const.DB, ue), B)  # B^T D eps per unit E
-    intact = (1.0 - omega) * const.E * w
-    out = np.empty(ue.shape + (len(names),))
-    for k, name in enumerate(names):
-        factor = -omega_rate[..., k] * const.E * w + (intact / params.E if name == "E" else 0.0)
-        force = np.einsum("eqi,eq->ei", bt_sigma, factor)
-        if name == "nu":
-            d_sigma = np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(params.nu), eps)
-            force += np.einsum("eqi,eq->ei", bt(d_sigma, B), intact)
-        out[..., k] = force
+    bt_sigma, _ = stress if stress is not None else unit_stress_forces(disc, const, ue)
+    w_E = const.E * disc.weights
+    intact = (1.0 - omega) * w_E
+    factors = -omega_rate * w_E[..., None]  # (n_el, n_q, p)
+    if "E" in names:
+        factors[..., names.index("E")] += intact / params.E
+    out = np.matmul(bt_sigma.transpose(0, 2, 1), factors)  # sum over the points, all parameters at once
+    if "nu" in names:
+        d_sigma, _ = _nu_stress_rate(disc, params, ue)
+        out[..., names.index("nu")] += np.einsum("eqi,eq->ei", bt(d_sigma, disc.strain_operator), intact)
     return out
 
 
-def elastic_energy_derivative(disc, params, const, ue, due, omega, omega_rate, names) -> np.ndarray:
+def elastic_energy_derivative(disc, params, const, ue, due, omega, omega_rate, names, stress=None) -> np.ndarray:
     """d/dx of the recoverable energy 1/2 int (1 - omega) E eps . D eps dV [N mm per unit parameter],
     given the total derivatives of the element displacements ``due`` (n_el, n_u, p) and of the damage
-    ``omega_rate`` (n_el, n_q, p)."""
-    B, w = disc.strain_operator, disc.weights
-    eps = np.einsum("eqsi,ei->eqs", B, ue)
-    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
-    density = np.sum(eps * sigma_eff, axis=-1)  # eps . D eps per unit E
-    d_eps = np.einsum("eqsi,eip->eqsp", B, due)
-    intact = (1.0 - omega) * const.E * w
-    out = np.empty(len(names))
-    for k, name in enumerate(names):
-        value = np.sum(-0.5 * omega_rate[..., k] * const.E * w * density + intact * np.sum(d_eps[..., k] * sigma_eff, -1))
-        if name == "E":
-            value += 0.5 * np.sum(intact * density) / params.E
-        if name == "nu":
-            dD = disc.strain_state.unit_elastic_matrix_derivative(params.nu)
-            value += 0.5 * np.sum(intact * np.einsum("eqs,st,eqt->eq", eps, dD, eps))
-        out[k] = value
+    ``omega_rate`` (n_el, n_q, p); ``stress`` as for :func:`equilibrium_pseudo_load`.
+
+    The term of the displacements' derivatives, int (1 - omega) E eps' . D eps dV, is taken as the
+    work of the element internal forces sum_q w (1 - omega) E B^T D eps on ``due`` (the same sum,
+    without forming the strains' derivatives at the points).
+    """
+    bt_sigma, density = stress if stress is not None else unit_stress_forces(disc, const, ue)
+    w_E = const.E * disc.weights
+    intact = (1.0 - omega) * w_E
+    internal = np.einsum("eqi,eq->ei", bt_sigma, intact)  # element internal forces
+    out = -0.5 * np.einsum("eqp,eq->p", omega_rate, w_E * density) + np.einsum("eip,ei->p", due, internal)
+    if "E" in names:
+        out[names.index("E")] += 0.5 * np.sum(intact * density) / params.E
+    if "nu" in names:
+        d_sigma, eps = _nu_stress_rate(disc, params, ue)
+        out[names.index("nu")] += 0.5 * np.sum(intact * np.sum(eps * d_sigma, axis=-1))
     return out
 
 

@@ -93,9 +93,28 @@ def model_constants(disc, params, stiffness_factor, damageable=1.0, gradient_spa
     DB = np.einsum("st,eqtj->eqsj", D, disc.strain_operator)
     M = None
     if gradient_space is not None:
-        N, G, w = gradient_space.shape, gradient_space.gradient, disc.weights
-        M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * np.einsum("eq,eqdi,eqdj->eij", w, G, G)
+        N, w = gradient_space.shape, disc.weights
+        M = np.einsum("eq,qi,qj->eij", w, N, N) + params.c * gradient_matrix(gradient_space, w)
     return ModelConstants(E, D, DB, M, mask)
+
+
+def gradient_matrix(space, weights) -> np.ndarray:
+    """int grad N^T grad N of a scalar field at every element: the part of the diffusion equation's
+    matrix that ``c`` multiplies.
+
+    Parameters
+    ----------
+    space : ScalarSpace
+        The field's interpolation (its ``gradient``, shape (n_el, n_q, dim, n_e)).
+    weights : ndarray, shape (n_el, n_q)
+        The integration weights.
+
+    Returns
+    -------
+    ndarray, shape (n_el, n_e, n_e)
+    """
+    G = space.gradient
+    return np.einsum("eq,eqdi,eqdj->eij", weights, G, G)
 
 
 def btdb(weighted_B, DB):

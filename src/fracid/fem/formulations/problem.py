@@ -14,8 +14,8 @@ from fracid.fem.mesh.assembly import assemble_vector, norm2
 from fracid.fem.formulations import damage_sensitivity as ds
 from fracid.fem.mesh.discretization import MixedDiscretization
 from fracid.fem.mesh.dofs import Conditions, FieldSpec, number_dofs
-from fracid.fem.formulations.forms import (elastic_bulk, elastic_energy, gradient_damage, integral_damage, local_damage,
-                                           masked_damage, model_constants, point_outputs)
+from fracid.fem.formulations.forms import (elastic_bulk, elastic_energy, gradient_damage, gradient_matrix, integral_damage,
+                                           local_damage, masked_damage, model_constants, point_outputs)
 from fracid.fem.material.laws import DamageLaw
 from fracid.fem.formulations.nonlocal_average import averaging_length_derivative, internal_length, nonlocal_averaging
 from fracid.fem.formulations.protocol import HistoryVariable, allocate_history
@@ -191,22 +191,29 @@ class DamageProblem(ContinuumProblem):
         law_rate = ds.damage_parameter_derivatives(self.law, self.params, self.const, kappa, names)
         explicit = self._driving_parameter_rate(eps, eq, names)
         omega_rate = law_rate + d_omega[..., None] * np.where(loading[..., None], explicit, kappa_old_rate)
-        force = ds.equilibrium_pseudo_load(self.disc, self.params, self.const, qe[:, :n_u], omega, omega_rate, names)
+        ue = qe[:, :n_u]
+        stress = ds.unit_stress_forces(self.disc, self.const, ue)  # shared by the pseudo-load and the energy
+        force = ds.equilibrium_pseudo_load(self.disc, self.params, self.const, ue, omega, omega_rate, names, stress)
         pseudo_load = self.assemble_columns(self._with_field_rows(force, qe, eps, names))
 
         def complete(dq):
             dqe = self.gather_columns(dq)
             rate = ds.history_derivative(loading, self._driving_response(dqe, eps, d_eq) + explicit, kappa_old_rate)
             total_omega = law_rate + d_omega[..., None] * rate
-            energy = ds.elastic_energy_derivative(self.disc, self.params, self.const, qe[:, :n_u], dqe[:, :n_u], omega,
-                                                  total_omega, names)
+            energy = ds.elastic_energy_derivative(self.disc, self.params, self.const, ue, dqe[:, :n_u], omega,
+                                                  total_omega, names, stress)
             return rate, self.symmetry_factor * energy
 
         return ds.StepDerivative(pseudo_load, complete)
 
+    def _strain(self, qe):
+        """The strain at every point (n_el, n_q, n_strain) of element dof values ``qe``."""
+        return np.einsum("eqsi,ei->eqs", self.disc.strain_operator, qe[:, : self.dofs.n_u])
+
     def _driving(self, qe):
-        """The strain that drives kappa at every point, the strain, eps_eq and d eps_eq / d eps."""
-        eps = np.einsum("eqsi,ei->eqs", self.disc.strain_operator, qe[:, : self.dofs.n_u])
+        """The strain that drives kappa at every point, the strain, eps_eq and d eps_eq / d eps (these two
+        None where the formulation's derivatives do not use them)."""
+        eps = self._strain(qe)
         eq, d_eq = self.law.equivalent_strain(self.disc.strain_state, eps, self.params)
         return eq, eps, eq, d_eq
 
@@ -243,11 +250,11 @@ class GradientDamageProblem(DamageProblem):
         return qe[:, self.dofs.columns["ebar"]]
 
     def _driving(self, qe):
-        _, eps, eq, d_eq = super()._driving(qe)
-        return self._ebar(qe) @ self._gradient_space().shape.T, eps, eq, d_eq
+        # kappa follows the nodal unknown ebar: its derivatives need neither eps_eq nor d eps_eq / d eps
+        return self._ebar(qe) @ self._gradient_space().shape.T, self._strain(qe), None, None
 
     def _driving_parameter_rate(self, eps, eq, names):
-        return np.zeros(eq.shape + (len(names),))  # kappa follows the nodal unknown ebar
+        return np.zeros(eps.shape[:-1] + (len(names),))  # kappa follows the nodal unknown ebar
 
     def _driving_response(self, dqe, eps, d_eq):
         return np.einsum("eip,qi->eqp", self._ebar(dqe), self._gradient_space().shape)
@@ -256,11 +263,17 @@ class GradientDamageProblem(DamageProblem):
         # r_ebar = (M + c K_g) ebar - int N^T eps_eq
         disc, space, ee = self.disc, self._gradient_space(), self._ebar(qe)
         eq_rate = ds.equivalent_strain_parameter_derivatives(self.law, self.params, disc.strain_state, eps, names)
-        rows = -np.einsum("eq,qi,eqp->eip", disc.weights, space.shape, eq_rate)
+        rows = -np.matmul(space.shape.T, disc.weights[..., None] * eq_rate)  # -int N^T d eps_eq / d x
         if "c" in names:
-            G = space.gradient
-            rows[..., names.index("c")] += np.einsum("eq,eqdi,eqdj,ej->ei", disc.weights, G, G, ee)
+            rows[..., names.index("c")] += np.einsum("eij,ej->ei", self._gradient_matrix(), ee)
         return np.concatenate([force, rows], axis=1)
+
+    def _gradient_matrix(self):
+        """int grad N^T grad N per element (n_el, n_e, n_e), d/dc of the diffusion matrix: built at the
+        first derivative asked for, then kept (the plain runs never need it)."""
+        if getattr(self, "_gradient_matrix_cache", None) is None:
+            self._gradient_matrix_cache = gradient_matrix(self._gradient_space(), self.disc.weights)
+        return self._gradient_matrix_cache
 
     def _element_arrays(self, qe, kappa_old):
         u = self.dofs.columns["u"]

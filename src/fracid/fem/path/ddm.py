@@ -11,8 +11,8 @@ with d r / d x taken at fixed q (the formulation's pseudo-load, which carries th
 variables' derivatives from the last step; docs/theory.md, section 6). :class:`PathDerivatives`
 factorizes the converged bordered tangent and hands the factorization on: it is what the next
 increment's Newton iterations start with (modified Newton keeps it while the residual falls fast),
-so the derivatives cost a factorization, a pseudo-load, one solve with p right-hand sides and the
-history update per step. (Iterative refinement with the factorization modified Newton last kept, of
+so the derivatives cost a factorization, a pseudo-load, one solve with p right-hand sides (its residual
+checked, :func:`~fracid.fem.path.linear_backend.refine`) and the history update per step. (Iterative refinement with the factorization modified Newton last kept, of
 an older tangent, was slower on the demo beam: 5.9 s against 4.3 s per run.)
 
 The derivatives are those of the discrete path at the steps' control values: the step sequence is
@@ -27,7 +27,12 @@ import numpy as np
 
 from fracid.fem.mesh.assembly import dot
 from fracid.fem.path.linear_solvers import factorize
+from fracid.fem.path.linear_backend import refine
 from fracid.fem.formulations.protocol import initial_history
+
+
+#: relative residual of the derivatives' solve (equilibrated bordered system) above which it is refined
+DERIVATIVE_RTOL = 1e-10
 
 
 class PathDerivatives:
@@ -87,7 +92,9 @@ class PathDerivatives:
         factor = factorize(solver, matrix)
         stats.factorizations += 1
         stats.time_factorizations += time.perf_counter() - t0
-        solution = factor(rhs)
+        # the derivatives are only as good as this solve (Newton's solves need only a descent direction):
+        # its residual is checked, and refined with the same factorization if a backend left it high
+        solution, _, _ = refine(factor, matrix, rhs, factor(rhs), DERIVATIVE_RTOL, 2)
         dz = equilibration[:, None] * solution
         stats.time_linear += time.perf_counter() - t0
         stats.linear_solves += 1

@@ -15,6 +15,8 @@ from typing import Protocol
 
 import numpy as np
 
+from fracid.fem.mesh.assembly import norm2
+
 
 class SingularMatrixError(RuntimeError):
     """The tangent matrix could not be factorized."""
@@ -33,3 +35,44 @@ def factorize(solver, matrix):
     if keep is not None:
         return keep(matrix)
     return lambda rhs: solver.solve(matrix, rhs)
+
+
+def block_norm(a: np.ndarray) -> float:
+    """Euclidean (Frobenius) norm of a vector or of a block of right-hand sides (n, k), without BLAS
+    (see :func:`~fracid.fem.mesh.assembly.dot`: vector BLAS calls go multithreaded at these sizes and
+    then cost milliseconds each on a busy machine)."""
+    return norm2(np.asarray(a).ravel(order="K"))
+
+
+def refine(solve, matrix, rhs: np.ndarray, x: np.ndarray, rtol: float, steps: int):
+    """Iterative refinement of a solution ``x`` of ``matrix @ x = rhs`` with an approximate solver.
+
+    Parameters
+    ----------
+    solve : callable(r) -> ndarray
+        Solves with (an approximation of) ``matrix``: a factorization, possibly with perturbed pivots.
+    matrix : sparse matrix, shape (n, n)
+    rhs : ndarray, shape (n,) or (n, k)
+    x : ndarray, shape of ``rhs``
+        The solution to refine (updated in place).
+    rtol : float
+        Stop once ||rhs - matrix x|| <= rtol ||rhs|| (Frobenius norm over the columns).
+    steps : int
+        At most this many corrections (0: only the residual is measured).
+
+    Returns
+    -------
+    x : ndarray
+    residual, scale : float
+        ||rhs - matrix x|| of the returned x, and ||rhs||.
+    """
+    scale = block_norm(rhs)
+    r = rhs - matrix @ x
+    residual = block_norm(r)
+    for _ in range(steps):
+        if residual <= rtol * scale:
+            break
+        x += solve(r)
+        r = rhs - matrix @ x
+        residual = block_norm(r)
+    return x, residual, scale
