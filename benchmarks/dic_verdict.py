@@ -13,13 +13,15 @@ take:
   5e-5 rad; the region of interest 2 to 20 mm from the crack line (``field_block(region=...)``); the rigid
   motion of every frame marginalised (``rigid_std`` = 1 mm).
 
-:func:`fracid.inverse.studies.study.run_study` (knn-kalman, population ``--n``, 3 starts, 5 noisy replicates)
+:func:`fracid.inverse.studies.study.run_study` (knn-kalman, population ``--n``, ``--groups`` 4 steps per
+pass of the Kalman filter, ``--starts`` 3, ``--replicates`` 3 noisy replicates)
 runs on the curve alone and on curve + field. Printed: each study's verdict (its ``summary()``), the
 correlations r(beta, c) and r(kappa_i, c) of the identification's covariance, the squared Mahalanobis distance
 of the truth (99 % joint region of chi^2(3): 11.34), forward runs and wall times, the load average. The issue
 asks r(beta, c) >= 0.95 with the curve alone and <= 0.8 with curve + field, as the study's verdict prints.
 
-    python benchmarks/dic_verdict.py [--n 16] [--h-fine 2.0] [--seed 11] [--json out.json]
+    python benchmarks/dic_verdict.py [--n 16] [--groups 4] [--starts 3] [--replicates 3] [--h-fine 2.0] [--seed 11]
+        [--json out.json]
 """
 
 from __future__ import annotations
@@ -74,9 +76,10 @@ def twin(beam, seed: int, folder) -> tuple[ExperimentalData, ExperimentalData, l
     return curve_data, stack(curve_data, block.data), [curve, field]
 
 
-def study(label, kinds, data, n: int) -> dict:
+def study(label, kinds, data, args) -> dict:
     operator = ForwardOperator(kinds, BASE, NAMES)
-    settings = StudySettings().replace(n=n)
+    groups = np.array_split(np.arange(data.n_y), args.groups)  # as [identify.kalman] groups = 4 does
+    settings = StudySettings().replace(n=args.n, groups=groups, starts=args.starts, replicates=args.replicates)
     start = time.perf_counter()
     result = run_study(operator, data, SPACE, settings, progress=False)
     wall = time.perf_counter() - start
@@ -97,13 +100,16 @@ def main(argv=None):
     parser.add_argument("--h-fine", type=float, default=2.0)
     parser.add_argument("--n", type=int, default=16, help="population of the KNN stage")
     parser.add_argument("--seed", type=int, default=11)
+    parser.add_argument("--groups", type=int, default=4, help="steps per pass of the Kalman filter")
+    parser.add_argument("--starts", type=int, default=3, help="multi-start check")
+    parser.add_argument("--replicates", type=int, default=3, help="noisy replicates of the stability check")
     parser.add_argument("--json", default=None)
     args = parser.parse_args(argv)
     load_before = os.getloadavg()
     beam = NotchedBeam(h_fine=args.h_fine, h_coarse=3.0 * args.h_fine)
     with tempfile.TemporaryDirectory() as folder:
         curve_data, both_data, kinds = twin(beam, args.seed, folder)
-    rows = [study("curve alone", kinds[:1], curve_data, args.n), study("curve + field", kinds, both_data, args.n)]
+    rows = [study("curve alone", kinds[:1], curve_data, args), study("curve + field", kinds, both_data, args)]
     out = {"h_fine": args.h_fine, "points": len(kinds[1].points), "frames": FRAMES.size, "rows": rows,
            "loadavg_before": load_before, "loadavg_after": os.getloadavg()}
     print()
