@@ -12,9 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 
 from fracid.data.arguments import real_number
-from fracid.data.covariance_matrix import Covariance, Diagonal, block_diagonal
+from fracid.data.covariance_matrix import Covariance, Diagonal, LowRankPlusDiagonal, block_diagonal
 from fracid.data.dataset import ExperimentalData
 from fracid.data.dic.data import DicData
 from fracid.data.errors import DataError, DataTypeError
@@ -102,14 +103,13 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
     """The covariance [mm^2] of all entries (frame, component, point order): diag(sigma^2), or with
     ``subset_size`` [mm] the spatially correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per
     frame and component, scaled by sigma: C = D K D, D = diag(sigma)); with ``rigid_std`` [mm] the rigid motion
-    of every frame marginalised (:mod:`fracid.data.dic.rigid`). ``sigma`` NaN (missing values) are set to 1:
-    those entries are dropped."""
-    from fracid.data.dic.rigid import with_rigid_motion
-
+    of every frame marginalised (:mod:`fracid.data.dic.rigid`: one low-rank-plus-diagonal block per frame, both
+    components and the prior's columns in it). ``sigma`` NaN (missing values) are set to 1: those entries are
+    dropped."""
     sigma = np.where(np.isnan(sigma), 1.0, sigma)
-    n_blocks = n_frames * len(components)
+    n_c, n = len(components), len(components) * len(points)
     if subset_size is None:
-        cov, note = Diagonal(sigma**2), "independent errors (diagonal covariance)"
+        U, d, note = np.zeros((len(points), 0)), np.ones(len(points)), "independent errors (diagonal covariance)"
     else:
         from fracid.data.dic_noise import dic_covariance
 
@@ -117,30 +117,24 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
         if not (np.isfinite(size) and size > 0):
             raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
         correlation = dic_covariance(points, 1.0, size)
-        cov = block_diagonal([correlation] * n_blocks).scaled(sigma)
+        U, d = correlation.U, correlation.D.var
         note = (f"errors correlated over the subset size {size:g} mm (Gaussian kernel, l = {size / 2:g} mm, "
-                f"{correlation.U.shape[1]} modes per frame and component; independent between them)")
+                f"{U.shape[1]} modes per frame and component; independent between them)")
     if rigid_std is None:
-        return cov, note
+        if subset_size is None:
+            return Diagonal(sigma**2), note
+        return block_diagonal([correlation] * (n_frames * n_c)).scaled(sigma), note
+    from fracid.data.dic.rigid import prior_columns
+
     std = real_number(rigid_std, "rigid_std")
     if not (np.isfinite(std) and std > 0):
         raise DataError(f"rigid_std = {rigid_std!r} [mm]: give a finite number > 0 (the prior std of the rigid motion)")
-    n = len(components) * len(points)
-    frames = [with_rigid_motion(_merged(cov.take(np.arange(k * n, (k + 1) * n))), points, components, std)
-              for k in range(n_frames)]
+    rigid = prior_columns(points, components, std)
+    noise_U, noise_d = scipy.linalg.block_diag(*[U] * n_c), np.tile(d, n_c)  # one frame, unit sigma
+    frames = [LowRankPlusDiagonal(np.hstack([noise_U * s[:, None], rigid]), noise_d * s**2, nuisance=rigid.shape[1])
+              for s in sigma.reshape(n_frames, n)]
     return block_diagonal(frames), (f"{note}; the rigid motion of every frame (t_x, t_y, theta) marginalised: "
                                     f"prior std {std:g} mm, removed from data and model alike")
-
-
-def _merged(cov: Covariance) -> Covariance:
-    """A block diagonal of low-rank-plus-diagonal blocks as one LowRankPlusDiagonal (U block diagonal)."""
-    from fracid.data.covariance_matrix import Block, LowRankPlusDiagonal
-    import scipy.linalg
-
-    if not isinstance(cov, Block):
-        return cov
-    return LowRankPlusDiagonal(scipy.linalg.block_diag(*[b.U for b in cov.blocks]),
-                               np.concatenate([b.D.var for b in cov.blocks]))
 
 
 def _selected(dic: DicData, frames, region, spacing) -> tuple[DicData, np.ndarray]:

@@ -75,12 +75,19 @@ def with_rigid_motion(frame_covariance: Covariance, points, components, std: flo
         Prior std of the motions [mm] (:data:`RIGID_STD`): much larger than the motions, small enough to keep
         the Woodbury capacitance well conditioned.
     """
-    modes = rigid_modes(points, components) * prior_scales(points, std)
-    modes = modes[:, np.any(modes != 0.0, axis=0)]  # one component alone: no motion of the other
+    modes = prior_columns(points, components, std)
     low_rank = getattr(frame_covariance, "U", np.zeros((frame_covariance.n, 0)))
     variances = frame_covariance.D.var if hasattr(frame_covariance, "D") else frame_covariance.diag()
     return LowRankPlusDiagonal(np.hstack([low_rank, modes]), variances,
                                nuisance=modes.shape[1] + getattr(frame_covariance, "nuisance", 0))
+
+
+def prior_columns(points, components, std: float = RIGID_STD) -> np.ndarray:
+    """The low-rank columns R diag(s) of the rigid motion's prior at one frame's entries [mm]: the modes of
+    :func:`rigid_modes` scaled by :func:`prior_scales`, those the components cannot see (t_y with u_x alone)
+    left out."""
+    modes = rigid_modes(points, components) * prior_scales(points, std)
+    return modes[:, np.any(modes != 0.0, axis=0)]
 
 
 def fit_rigid_motion(points, components, residual, covariance: Covariance | None = None) -> tuple[np.ndarray, np.ndarray]:
