@@ -18,6 +18,7 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+from fracid.exits import raise_if_stopped
 from fracid.parallel import SerialExecutor, is_dask, is_executor, make_executor
 from fracid.progress import batch_lines, clock, is_terminal, lines_wanted
 from fracid.store_records import decode_record, encode_record
@@ -163,6 +164,7 @@ def _run_and_keep(executor, calls, records: list, destination: _Destination, sta
         with contextlib.closing(_completed(pool, calls)) as completed:
             for group, (payload, status, seconds) in completed:
                 record = destination.keep(payload, status, seconds, group)
+                raise_if_stopped()
                 for index in group:
                     records[index] = record
                 done += len(group)

@@ -58,6 +58,8 @@ def stop_signals():
             raise _RAISED_BY[signal.Signals(signum).name]()
 
     previous = {}
+    hooks = sys.unraisablehook, sys.excepthook
+    sys.unraisablehook, sys.excepthook = _quiet_about_stops(*hooks)
     try:
         for name in _RAISED_BY:
             if hasattr(signal, name):
@@ -67,9 +69,33 @@ def stop_signals():
     try:
         yield
     finally:
+        sys.unraisablehook, sys.excepthook = hooks
         if not _received:  # after a stop signal the process is ending: a late second one stays ignored
             for name, old in previous.items():
                 signal.signal(getattr(signal, name), old)
+
+
+def _quiet_about_stops(unraisable_hook, except_hook):
+    """``sys.unraisablehook`` and ``sys.excepthook`` that say nothing of a stop signal's exception swallowed
+    by a library (compiled code that cannot pass exceptions on, e.g. scipy's Sobol initialisation, prints the
+    traceback and "Exception ignored in" and goes on): the signal is on record and :func:`raise_if_stopped`
+    raises it again at the next checkpoint."""
+    def unraisable(what):
+        if not (_received and isinstance(what.exc_value, KeyboardInterrupt)):
+            unraisable_hook(what)
+
+    def uncaught(kind, value, traceback):
+        if not (_received and isinstance(value, KeyboardInterrupt)):
+            except_hook(kind, value, traceback)
+    return unraisable, uncaught
+
+
+def raise_if_stopped() -> None:
+    """Raise the first stop signal's exception if one was received: a checkpoint where long work goes on
+    (every finished forward run, every step of a progress bar), for a signal whose exception a library
+    swallowed. After the exception has propagated the work is over and no checkpoint is reached again."""
+    if _received:
+        raise stopped_by()
 
 
 def ignore_stop_signals() -> None:
