@@ -13,7 +13,8 @@ factorizes the converged bordered tangent and hands the factorization on: it is 
 increment's Newton iterations start with (modified Newton keeps it while the residual falls fast),
 so the derivatives cost a factorization, a pseudo-load, one solve with p right-hand sides (its residual
 checked, :func:`~fracid.fem.path.linear_backend.refine`) and the history update per step. (Iterative refinement with the factorization modified Newton last kept, of
-an older tangent, was slower on the demo beam: 5.9 s against 4.3 s per run.)
+an older tangent, was slower on the demo beam: 5.9 s against 4.3 s per run; so was PARDISO's CGS preconditioned
+by the LU it holds, benchmarks/ddm_preconditioned.py: 3 to 7 iterations per step, 2.48 s against 2.05 s.)
 
 The derivatives are those of the discrete path at the steps' control values: the step sequence is
 held, as the central differences of runs that land on the same control values (``checkpoints``) see it.
