@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import collections
 import os
-import time
 
 import numpy as np
 
