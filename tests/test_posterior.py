@@ -144,3 +144,46 @@ def test_bad_settings_are_refused(key, value):
 def test_weighted_quantile_of_equal_weights_is_the_median():
     values = np.array([3.0, 1.0, 2.0])
     assert weighted_quantile(values, np.ones(3) / 3, 0.5)[0] == pytest.approx(2.0)
+
+
+def quadrature_log_evidence(model, y, C, space, n=(401, 501)):
+    """log of the evidence on a grid: the mean over the bounds' box of the normalised Gaussian likelihood."""
+    axes = [np.linspace(lo, hi, k) for lo, hi, k in zip(space.lower, space.upper, n)]
+    a, b = np.meshgrid(*axes, indexing="ij")
+    r = np.array([model(x) for x in np.column_stack([a.ravel(), b.ravel()])]) - y
+    ll = -0.5 * np.einsum("ni,ij,nj->n", r, np.linalg.inv(C), r) - 0.5 * np.linalg.slogdet(2 * np.pi * C)[1]
+    top = ll.max()
+    # trapezoidal mean over the box (the prior's density is 1 / volume)
+    weights = np.outer(*[np.r_[0.5, np.ones(k - 2), 0.5] / (k - 1) for k in n]).ravel()
+    return top + np.log(np.sum(weights * np.exp(ll - top)))
+
+
+@pytest.mark.parametrize("lower, upper", [((-2.0, -3.0), (2.0, 2.0)), ((-4.0, -6.0), (4.0, 4.0))])
+def test_log_evidence_matches_quadrature_within_its_error(lower, upper):
+    """The evidence of the banana model: its importance estimate against quadrature, within 3 of its stated
+    errors (and that error below 0.05); a box twice as wide costs log 4 (the prior's Occam factor)."""
+    space = ParameterSpace(("a", "b"), lower, upper)
+    x0 = np.array([0.05, 0.4])
+    settings = PosteriorSettings(samples_per_round=200, max_rounds=20, target_ess=1500)
+    result = posterior(banana, BANANA_Y, BANANA_C, space, x0, gaussian_seed(banana, x0, BANANA_C), settings=settings)
+    expected = quadrature_log_evidence(banana, BANANA_Y, BANANA_C, space)
+    assert 0.0 < result.log_evidence_error < 0.05
+    assert abs(result.log_evidence - expected) < 3 * result.log_evidence_error, (result.log_evidence, expected)
+    assert result.to_dict()["log_evidence"] == pytest.approx(result.log_evidence)
+
+
+def test_log_evidence_of_a_linear_model_is_the_closed_form():
+    """y = A x + noise, a box far wider than the posterior: Z = |2 pi C|^-1/2 |2 pi (A^T C^-1 A)^-1|^1/2
+    exp(-chi2_min / 2) / volume."""
+    A = np.array([[1.0, 0.5], [0.2, 1.0], [1.0, -1.0], [0.3, 0.3]])
+    C = np.diag([0.1, 0.2, 0.15, 0.1]) ** 2
+    y = A @ np.array([0.3, -0.2]) + np.array([0.05, -0.1, 0.02, 0.0])
+    space = ParameterSpace(("a", "b"), (-3.0, -3.0), (3.0, 3.0))
+    F = A.T @ np.linalg.solve(C, A)
+    x_hat = np.linalg.solve(F, A.T @ np.linalg.solve(C, y))
+    r = y - A @ x_hat
+    expected = (-0.5 * r @ np.linalg.solve(C, r) - 0.5 * np.linalg.slogdet(2 * np.pi * C)[1]
+                + 0.5 * np.linalg.slogdet(2 * np.pi * np.linalg.inv(F))[1] - np.log(36.0))
+    settings = PosteriorSettings(samples_per_round=300, max_rounds=10, target_ess=2000)
+    result = posterior(lambda x, needed=None: A @ x, y, C, space, x_hat, np.linalg.inv(F), settings=settings)
+    assert abs(result.log_evidence - expected) < max(3 * result.log_evidence_error, 0.02), (result.log_evidence, expected)

@@ -178,6 +178,23 @@ def weighted_quantile(values, weights, q) -> np.ndarray:
     return np.interp(np.atleast_1d(q), cdf, v)
 
 
+def amis_log_evidence(densities, loglik, sizes) -> tuple[float, float]:
+    """log of the importance-sampling estimate of the evidence, Z = mean_i L_i p(u_i) / q(u_i), with the prior
+    p uniform on the unit cube (density 1) and q the deterministic mixture of all proposals (``densities``,
+    ``loglik``, ``sizes`` as :func:`amis_weights`), and its Monte-Carlo standard error as a std of log Z:
+    sqrt(var(w) / N) / mean(w) = sqrt(1 / ESS - 1 / N) for the draws' weights (delta method). -inf, inf when
+    no draw has a finite likelihood."""
+    n = np.array(sizes, float)
+    log_q = logsumexp(densities + np.log(n / n.sum())[:, None], axis=0)
+    log_w = np.where(np.isfinite(loglik), loglik - log_q, -np.inf)
+    if not np.any(np.isfinite(log_w)):
+        return -math.inf, math.inf
+    total = len(log_w)
+    w = np.exp(log_w - logsumexp(log_w))
+    ess = 1.0 / float(np.sum(w**2))
+    return float(logsumexp(log_w) - math.log(total)), math.sqrt(max(1.0 / ess - 1.0 / total, 0.0))
+
+
 def amis_weights(densities, loglik, sizes) -> tuple[np.ndarray, float]:
     """Deterministic-mixture weights of all draws against all proposals so far (``densities``: the log density
     of proposal t at draw i, shape (rounds, draws); ``sizes``: the draws of each), normalised, and their ESS."""

@@ -30,6 +30,7 @@ import numpy as np
 from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.sampling.mixture import (
     GaussianMixture,
+    amis_log_evidence,
     amis_weights,
     fit_mixture,
     weighted_covariance,
@@ -140,6 +141,11 @@ class PosteriorResult:
         (below the floor: :attr:`sampling_failed`, no credible intervals).
     history : list of dict
         Per round: draws, failed, ESS after the round, components of the proposal.
+    log_evidence, log_evidence_error : float
+        log p(y_exp) of the model with its prior (uniform, or log-uniform, between the bounds) and the Gaussian
+        likelihood with its normalisation (-1/2 log det(2 pi C_exp)), from the importance weights of all draws
+        (:func:`~fracid.inverse.sampling.mixture.amis_log_evidence`), and its Monte-Carlo standard error. Two
+        models fitted to the same data compare by the difference (the log Bayes factor).
     """
 
     names: list
@@ -159,6 +165,8 @@ class PosteriorResult:
     units: dict = field(default_factory=dict)
     status: str = ""
     history: list = field(default_factory=list)
+    log_evidence: float = float("nan")
+    log_evidence_error: float = float("nan")
 
     @property
     def converged(self) -> bool:
@@ -211,6 +219,8 @@ class PosteriorResult:
     def summary(self) -> str:
         lines = [f"posterior: {len(self.x)} draws in {self.rounds} rounds, ESS {self.ess:.0f}, "
                  f"{self.failed} failed run{'' if self.failed == 1 else 's'}; {self.status}"]
+        if np.isfinite(self.log_evidence):
+            lines.append(f"  log evidence {self.log_evidence:.4g} +- {self.log_evidence_error:.2g} (Monte Carlo)")
         if self.sampling_failed:
             return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
         intervals = self.credible_intervals(0.9)
@@ -228,7 +238,9 @@ class PosteriorResult:
                 "rounds": self.rounds, "failed": self.failed, "status": self.status,
                 "sampling_failed": self.sampling_failed,
                 "estimate": np.asarray(self.estimate).tolist(), "estimate_cov": np.asarray(self.estimate_cov).tolist(),
-                "units": dict(self.units), "history": self.history}
+                "units": dict(self.units), "history": self.history,
+                "log_evidence": _finite_or_none(self.log_evidence),
+                "log_evidence_error": _finite_or_none(self.log_evidence_error)}
 
     def save_csv(self, path) -> Path:
         """The draws: one row each, the parameters, the weight and the log-likelihood."""
@@ -249,6 +261,11 @@ class PosteriorResult:
         data = {name: sample[None, :, j] for j, name in enumerate(self.names)}
         return arviz.from_dict(posterior=data, attrs={"importance_ess": self.ess, "importance_draws": len(self.x),
                                                        "method": "adaptive importance sampling (fracid)"})
+
+
+def _finite_or_none(value: float):
+    """``value``, or None (JSON null) when it is not finite."""
+    return float(value) if np.isfinite(value) else None
 
 
 def _log_likelihood(records, y_exp, C_exp):
@@ -340,9 +357,12 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
                               "identification; failed runs are stored: --retry-failed runs them again")
     status = _status(ess, settings, len(u_all), len(proposals))
     lower, upper = space.lower, space.upper
+    log_z, log_z_error = amis_log_evidence(np.vstack(densities), loglik, sizes)
+    log_z -= 0.5 * (y_exp.size * np.log(2.0 * np.pi) + C_exp.logdet())
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
                            C_exp.std(), ess, len(proposals), failed, np.asarray(x0, float),
-                           np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history)
+                           np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history,
+                           log_evidence=float(log_z), log_evidence_error=log_z_error)
 
 
 def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
