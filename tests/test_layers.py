@@ -9,13 +9,15 @@ import fracid
 
 # floor of each top-level unit of the package: a module may import its own floor and those below
 FLOORS = {
-    "fem": 0, "field_error": 0,
+    "fem": 0, "field_error": 0, "stops": 0,
     "specimens": 1,
     "models": 2, "model_protocol": 2, "forward": 2, "data": 2, "store": 2, "store_records": 2, "tables": 2, "parallel": 2, "batch": 2, "progress": 2, "provenance": 2,
     "inverse": 3,
     "report": 4,
     "config": 5,
+    "datasets": 5, "cli_datasets": 6,  # datasets.load reads a data set through its configuration
     "cli": 6, "cli_common": 6, "cli_studies": 6, "cli_init": 6, "cli_check": 6, "exits": 6, "lock": 6, "outputs": 6,
+    "cli_compare": 6,
     "__main__": 6, "__init__": 6,
 }
 

@@ -18,7 +18,7 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from fracid.exits import raise_if_stopped
+from fracid.stops import raise_if_stopped
 from fracid.parallel import SerialExecutor, is_dask, is_executor, make_executor
 from fracid.progress import batch_lines, clock, is_terminal, lines_wanted
 from fracid.store_records import decode_record, encode_record

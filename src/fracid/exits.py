@@ -26,20 +26,9 @@ import signal
 import sqlite3
 import sys
 
+from fracid.stops import RAISED_BY, HungUp, Terminated, received, raise_if_stopped, stopped_by  # noqa: F401 -- re-exported
+
 OK, INTERNAL, INPUT, FAILED, FILES, MEMORY, INTERRUPTED, TERMINATED, HUNG_UP = 0, 1, 2, 3, 4, 5, 130, 143, 129
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised in the main thread so that the run ends as cleanly as after Ctrl-C."""
-
-
-class HungUp(Terminated):
-    """SIGHUP (the terminal or the SSH session closed), ended as SIGTERM is."""
-
-
-_RAISED_BY = {"SIGINT": KeyboardInterrupt, "SIGTERM": Terminated, "SIGHUP": HungUp}
-#: the stop signals received by this process (the first one raised; the others were ignored)
-_received: list[int] = []
 
 
 @contextlib.contextmanager
@@ -50,18 +39,18 @@ def stop_signals():
     unless a signal came (the process is ending: later ones stay ignored). Outside the main thread (a
     test runner's thread) nothing is installed."""
     def handler(signum, frame):
-        _received.append(signum)
-        if len(_received) == 1:
+        received.append(signum)
+        if len(received) == 1:
             # ignored by the operating system from now on: also while the interpreter shuts down, when
             # Python puts back the default action of the signals it handled
             ignore_stop_signals()
-            raise _RAISED_BY[signal.Signals(signum).name]()
+            raise RAISED_BY[signal.Signals(signum).name]()
 
     previous = {}
     hooks = sys.unraisablehook, sys.excepthook
     sys.unraisablehook, sys.excepthook = _quiet_about_stops(*hooks)
     try:
-        for name in _RAISED_BY:
+        for name in RAISED_BY:
             if hasattr(signal, name):
                 previous[name] = signal.signal(getattr(signal, name), handler)
     except ValueError:  # not the main thread
@@ -70,7 +59,7 @@ def stop_signals():
         yield
     finally:
         sys.unraisablehook, sys.excepthook = hooks
-        if not _received:  # after a stop signal the process is ending: a late second one stays ignored
+        if not received:  # after a stop signal the process is ending: a late second one stays ignored
             for name, old in previous.items():
                 signal.signal(getattr(signal, name), old)
 
@@ -81,35 +70,21 @@ def _quiet_about_stops(unraisable_hook, except_hook):
     traceback and "Exception ignored in" and goes on): the signal is on record and :func:`raise_if_stopped`
     raises it again at the next checkpoint."""
     def unraisable(what):
-        if not (_received and isinstance(what.exc_value, KeyboardInterrupt)):
+        if not (received and isinstance(what.exc_value, KeyboardInterrupt)):
             unraisable_hook(what)
 
     def uncaught(kind, value, traceback):
-        if not (_received and isinstance(value, KeyboardInterrupt)):
+        if not (received and isinstance(value, KeyboardInterrupt)):
             except_hook(kind, value, traceback)
     return unraisable, uncaught
-
-
-def raise_if_stopped() -> None:
-    """Raise the first stop signal's exception if one was received: a checkpoint where long work goes on
-    (every finished forward run, every step of a progress bar), for a signal whose exception a library
-    swallowed. After the exception has propagated the work is over and no checkpoint is reached again."""
-    if _received:
-        raise stopped_by()
 
 
 def ignore_stop_signals() -> None:
     """Ignore SIGINT, SIGTERM and SIGHUP from now on (while a last message is written)."""
     with contextlib.suppress(ValueError):  # not the main thread
-        for name in _RAISED_BY:
+        for name in RAISED_BY:
             if hasattr(signal, name):
                 signal.signal(getattr(signal, name), signal.SIG_IGN)
-
-
-def stopped_by() -> BaseException | None:
-    """The exception of the first stop signal received, or None: a signal that struck inside an import or
-    a library may reach the command as another exception (``ImportError: initialization failed``)."""
-    return _RAISED_BY[signal.Signals(_received[0]).name]() if _received else None
 
 
 def _loaded(module: str, name: str) -> tuple:
