@@ -130,7 +130,7 @@ def test_study_settings_group_the_options_and_replace_by_name():
     assert (settings.starts, settings.replicates, settings.prior) == (0, 5, "bounds")
     assert settings.identification == KnnKalman(settings.knn, settings.kalman)
     assert StudySettings().replace(knn=KnnSettings(n=8), k=2).knn == KnnSettings(n=8, k=2)
-    with pytest.raises(TypeError, match="unknown setting.s. population .*or a study setting: method, noise_seed"):
+    with pytest.raises(TypeError, match="unknown setting.s. population .*or a study setting: error_terms, method, noise_seed"):
         StudySettings().replace(population=16)
     with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
         StudySettings(prior="flat")

@@ -16,6 +16,8 @@
     fracid demo               identification of the bundled real test (Gregoire et al. 2013 beam)
     fracid init               a commented configuration to start from (:mod:`fracid.cli_init`)
     fracid check CONFIG       validate a configuration and print its plan and cost (:mod:`fracid.cli_check`)
+    fracid datasets           the bundled data sets by name; fracid init --dataset NAME writes one's configuration
+                              (:mod:`fracid.cli_datasets`)
     fracid --version
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
@@ -69,6 +71,9 @@ def _parser() -> argparse.ArgumentParser:
 
     cli_init.add_parser(sub)
     cli_check.add_parser(sub, common)
+    from fracid import cli_datasets
+
+    cli_datasets.add_parser(sub)  # `fracid datasets` and `fracid init --dataset NAME`
     return parser
 
 
@@ -128,13 +133,15 @@ def _identify_job(args, config_path):
 
 def _identification(args, job, store, executor):
     """The identification of ``fracid identify`` (its runs through ``store``), timed."""
+    from fracid.config import error_terms
     from fracid.inverse.methods.strategy import identify_data
 
     for line in _stage_plans(job.method, job.operator, job.data.n_y, len(job.space.names)):
         say(args, line)
     start = time.perf_counter()
     result = identify_data(job.operator, job.data, job.space, method=job.method, executor=executor, store=store,
-                           progress=progress_choice(args), retry_failed=args.retry_failed)
+                           progress=progress_choice(args), retry_failed=args.retry_failed,
+                           **error_terms(job.cfg))  # [identify] discretisation_error, model_error
     result.runs["wall_seconds"] = time.perf_counter() - start
     result.provenance = provenance(args, job.cfg, job.operator, job.space, store)
     return result
@@ -291,6 +298,10 @@ def main(argv=None) -> int:
 
 
 def _dispatch(args) -> int:
+    if args.command == "datasets" or getattr(args, "dataset", None) is not None:
+        from fracid import cli_datasets
+
+        return cli_datasets.run(args)
     if args.command in ("init", "check"):
         from fracid import cli_check, cli_init
 

@@ -100,7 +100,27 @@ def plan_lines(cfg, method, plan) -> list:
     post = cfg.posterior
     lines.append(f"fracid posterior adds at most {post.samples_per_round * post.max_rounds} runs "
                  f"([posterior] samples_per_round x max_rounds)")
-    return lines
+    return lines + error_terms_lines(cfg)
+
+
+def error_terms_lines(cfg) -> list:
+    """What ``[identify] discretisation_error`` and ``model_error`` add: the refinement again with them (its
+    population reused from the run store) and a run on a refined mesh; none when both are off."""
+    from fracid.inverse.likelihood.terms import ErrorTerms
+
+    terms = ErrorTerms(cfg.identify.discretisation_error, cfg.identify.model_error)
+    if terms.discretisation is None and terms.model_error is None:
+        return []
+    parts = []
+    if terms.discretisation is not None:
+        disc = terms.discretisation
+        parts.append(f"a run at the estimate on a mesh {disc.refinement:g} times finer"
+                     + (" and one as much coarser" if disc.observed_order else "")
+                     + (", at every loop" if disc.iterations > 1 else ", once"))
+    if terms.model_error is not None:
+        parts.append("the model error's std at every estimate (from the stored run there)")
+    return [f"error terms: the identification again with them, at most {terms.loops} time(s), its population "
+            f"reused from the run store; {'; '.join(parts)}"]
 
 
 def _timed_run(cfg, model, specimen, params, operator) -> float:

@@ -10,7 +10,7 @@ resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
 :func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`simulate_settings`,
-:func:`posterior_settings`)
+:func:`posterior_settings`, :func:`error_terms`)
 are pure functions of the validated :class:`Config`.
 
 Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
@@ -52,6 +52,7 @@ from fracid.config.builders import (
     build_parameters,
     build_space,
     build_specimen,
+    error_terms,
     posterior_settings,
     simulate_settings,
     study_settings,
@@ -98,6 +99,7 @@ __all__ = [
     "study_settings",
     "StudyConfig",
     "posterior_settings",
+    "error_terms",
     "PosteriorConfig",
     # the limits and constants of the docstring
     "BAR_BYTES_PER_ELEMENT",

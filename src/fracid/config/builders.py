@@ -249,12 +249,16 @@ def build_held_out(cfg: Config) -> list:
 def study_settings(cfg: Config) -> dict:
     """The checks of ``[study]`` as keyword arguments of :meth:`fracid.inverse.studies.study.StudySettings.replace`
     (``starts``, ``replicates``, ``noise_seed``, ``tolerance``, ``prior``; ``posterior``: the
-    :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``, None otherwise). The
+    :func:`posterior_settings` of ``[posterior]`` when ``[study] posterior = true``, None otherwise;
+    ``error_terms``: those of ``[identify]``, an :class:`~fracid.inverse.likelihood.terms.ErrorTerms` or None). The
     inverse method is :func:`build_method`'s: ``StudySettings(method=build_method(cfg)).replace(**study_settings(cfg))``."""
+    from fracid.inverse.likelihood.terms import ErrorTerms
+
     study = cfg.study
     return {"starts": study.starts, "replicates": study.replicates, "noise_seed": study.seed,
             "tolerance": study.tolerance, "prior": study.prior,
-            "posterior": posterior_settings(cfg) if study.posterior else None}
+            "posterior": posterior_settings(cfg) if study.posterior else None,
+            "error_terms": ErrorTerms.of(**error_terms(cfg)) if cfg.identify is not None else None}
 
 
 def posterior_settings(cfg: Config):
@@ -292,6 +296,14 @@ def build_method(cfg: Config):
         raise ConfigError(f"{cfg.path}: identify.{err.key} = {show(err.value)}: {err.allowed}") from None
     except (TypeError, ValueError) as err:
         raise ConfigError(f"{cfg.path}: identify.{identify.method}: {err}") from None
+
+
+def error_terms(cfg: Config) -> dict:
+    """The error terms of ``[identify]`` as keyword arguments of
+    :func:`fracid.inverse.methods.strategy.identify_data`: ``discretisation_error`` and ``model_error`` (settings
+    objects, or None when off)."""
+    identify = _require(cfg, "identify")
+    return {"discretisation_error": identify.discretisation_error, "model_error": identify.model_error}
 
 
 def simulate_settings(cfg: Config) -> dict:

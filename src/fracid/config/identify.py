@@ -7,8 +7,8 @@ does not read is checked by a method that reads it and warned about."""
 from __future__ import annotations
 
 from fracid.config.checker import Checker
-from fracid.config.registry import model_of
-from fracid.config.schema import IdentifyConfig, ModelConfig
+from fracid.config.registry import model_of, specimen_class
+from fracid.config.schema import IdentifyConfig, ModelConfig, SpecimenConfig
 from fracid.config.sections import range_text, valid_parameter
 from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD, IDENTIFY_KEYS
 from fracid.inverse.core.settings import SettingError, SettingsContext
@@ -42,7 +42,8 @@ def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelC
     inverse = ck.choice("identify.method", raw.get("method", DEFAULT_INVERSE_METHOD), tuple(registry.METHODS))
     lower, upper, log = _bounds(ck, raw, cls, names)
     tables = {name: value for name, value in raw.items() if name not in IDENTIFY_KEYS}
-    identify = IdentifyConfig(parameters=names, lower=lower, upper=upper, log=log, method=inverse, tables=tables)
+    identify = IdentifyConfig(parameters=names, lower=lower, upper=upper, log=log, method=inverse, tables=tables,
+                              **_error_terms(ck, raw))
     context = SettingsContext(n_y=n_y, parameters=names)
     _checked(ck, raw, inverse, tables, context, inverse)
     read = registry.config_tables(registry.METHODS[inverse])
@@ -51,6 +52,44 @@ def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelC
         _checked(ck, raw, reader, {table: tables[table]}, context, table)
         _warn_unread(ck, table, inverse)
     return identify
+
+
+def _error_terms(ck: Checker, raw) -> dict:
+    """``discretisation_error`` and ``model_error`` of ``[identify]``, each a word or a table
+    (:mod:`fracid.inverse.likelihood.settings`), as the :class:`IdentifyConfig` fields (None: off)."""
+    from fracid.inverse.likelihood import settings
+
+    out = {}
+    for key, read in ((settings.DISCRETISATION_KEY, settings.discretisation_from_config),
+                      (settings.MODEL_ERROR_KEY, settings.model_error_from_config)):
+        try:
+            out[key] = read(raw.get(key))
+        except SettingError as err:
+            ck.fail(f"identify.{err.key}", err.value, err.allowed)
+    return out
+
+
+def check_refinable(ck: Checker, specimen: SpecimenConfig, experiments, identify: IdentifyConfig | None) -> None:
+    """With ``discretisation_error``: every calibration specimen (``[specimen]`` with an experiment's overrides)
+    must have a refined mesh (:func:`fracid.specimens.protocol.refined`) within the size limits (and a coarser one
+    when the order is observed); the error names the key and why not."""
+    settings = None if identify is None else identify.discretisation_error
+    if settings is None:
+        return
+    from fracid.specimens.protocol import refined
+
+    key, cls = "identify.discretisation_error", specimen_class(specimen.type)
+    variants = [{}] + [dict(e.specimen) for e in experiments if e.role == "calibration" and e.specimen]
+    factors = (settings.refinement, 1.0 / settings.refinement) if settings.observed_order else (settings.refinement,)
+    for options in variants:
+        for factor in factors:
+            try:
+                size = refined(cls(**{**dict(specimen.options), **options}), factor).size_estimate()
+            except ValueError as err:
+                ck.fail(key, settings.kind, f"needs a mesh of the specimen {factor:g} times finer, but {err}")
+            if size.too_large:
+                ck.fail(key, settings.kind, f"the mesh {factor:g} times finer would hold {size.summary}, beyond "
+                                            f"the limit of {size.limit:,} {size.unit}s; {size.advice}")
 
 
 def _checked(ck: Checker, raw, name: str, tables: dict, context: SettingsContext, key: str) -> None:

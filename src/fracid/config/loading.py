@@ -12,7 +12,7 @@ from pathlib import Path
 
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, Checker, read_toml
 from fracid.config.experiments import read_experiments
-from fracid.config.identify import read_identify
+from fracid.config.identify import check_refinable, read_identify
 from fracid.config.mesh_section import c_range
 from fracid.config.posterior import read_posterior
 from fracid.config.registry import section_reader, specimen_class
@@ -70,6 +70,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     if experiments and not n_y and purpose == "identify":
         ck.fail("experiments", [e.role for e in experiments], "at least one experiment needs role = 'calibration'")
     identify = read_identify(ck, raw.get("identify"), n_y, purpose == "identify", model)
+    check_refinable(ck, specimen, experiments, identify)
     output = read_output(ck, raw.get("output"), base)
     simulate = read_simulate(ck, raw.get("simulate"))
     study = read_study(ck, raw.get("study"))

@@ -165,6 +165,26 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     [identify.gauss-newton]             # optional, read when method = "knn-gauss-newton"
     max_iterations = 20                 # integer >= 1: linearisations at most, default 20
     tol = 0.01                          # > 0, in standard deviations, default 0.01
+    # The error terms of the likelihood (fracid.inverse.likelihood), each a word or a table with that word as
+    # kind; the identification is run again with them (its stored runs reused):
+    # discretisation_error = "richardson"  # "off" (default) | "richardson": the mesh's error at the estimate from
+    #                                     #   a mesh refined twice (Richardson), added to the data covariance
+    [identify.discretisation_error]     # optional, the same with its settings:
+    kind = "richardson"
+    refinement = 2.0                    # 1 < r <= 4: the refined mesh has h / r (bar: n_elements x r), default 2
+    observed_order = false              # true: also a mesh of h x r, the order observed per block (guarded)
+    order = 1.0                         # 0.5 <= p <= 4: the order where not observed (default 1, conservative)
+    correlation_length = 0.25           # > 0: along the control, a fraction of each block's range
+    iterations = 1                      # 1 <= n <= 10: identifications with the term (more: recomputed at each)
+    # model_error = "variance"          # "off" (default) | "variance" | "bias": the model's own error identified
+    [identify.model_error]              # optional, the same with its settings:
+    kind = "variance"                   # "variance" (independent, std sigma_m) | "bias" (smooth along the control)
+    prior = "half-cauchy"               # "half-cauchy" (default) | "log-uniform"
+    scale = 0.05                        # > 0: the half-Cauchy's scale, a fraction of the group's peak |y|
+    bounds = [1e-4, 1.0]                # 0 < lower < upper: the range of sigma_m, fractions of the peak
+    groups = "block"                    # "block" (one sigma_m per [[experiments]] block) | "quantity"
+    correlation_length = 0.25           # "bias": along the control, a fraction of each block's range
+    iterations = 3                      # 1 <= n <= 10: fixed-point loops at most
 
     [study]                             # optional: the checks of `fracid study`
     starts = 3                          # multi-start Kalman filters from distinct population points
@@ -327,6 +347,11 @@ class IdentifyConfig:
     #: the tables of the methods' settings ``[identify.<table>]`` given, by name, as read (the methods that
     #: read them check them: :func:`fracid.config.identify.method_from_config`)
     tables: dict = field(default_factory=dict)
+    #: the error terms added to the data covariance (None: "off"): a
+    #: :class:`~fracid.inverse.likelihood.settings.DiscretisationError` and a
+    #: :class:`~fracid.inverse.likelihood.settings.ModelError`
+    discretisation_error: object = None
+    model_error: object = None
 
 
 @dataclass(frozen=True)

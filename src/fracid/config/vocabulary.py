@@ -45,8 +45,9 @@ KIND_KEYS = {
     "fpz-width": (),
 }
 #: the keys of [identify] itself; it also allows every table of a registered inverse method's settings
-#: (fracid.inverse.methods.registry.known_tables), which the method checks
-IDENTIFY_KEYS = ("parameters", "method", "bounds")
+#: (fracid.inverse.methods.registry.known_tables), which the method checks; the error terms of the likelihood
+#: (fracid.inverse.likelihood.settings) are a word or a table each
+IDENTIFY_KEYS = ("parameters", "method", "bounds", "discretisation_error", "model_error")
 OUTPUT_KEYS = ("directory", "vtk_steps")
 SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")

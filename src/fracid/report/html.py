@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.report.error_terms import error_terms_section
 from fracid.report.markup import esc, generated_now, html_image, num, provenance_section, html_table, write_document
 from fracid.report.stages import stage_sections, runs_section, status_label
 
@@ -241,6 +242,7 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         parameter_section(result, control),
         correlation_section(result, figures),
         fit_section(result, control, figures, control_label, skip),
+        error_terms_section(result),
         *(block_view_section(view) for view in views),
         *stage_sections(result, figures),
         runs_section(result),

@@ -340,6 +340,7 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
     """A self-contained HTML page: the identification's Gaussian estimate beside the posterior per
     parameter, the sampler's statistics and rounds, the figures ``pngs`` (``corner`` and
     ``posterior_predictive`` PNG bytes) embedded and, collapsed, how the run was made (``provenance``)."""
+    from fracid.report.error_terms import posterior_model_error
     from fracid.report.markup import esc, generated_now, html_image, html_table, num, provenance_section, write_document
 
     table, stats = comparison_table(result), statistics_table(result)
@@ -359,6 +360,7 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
          f"one forward run), prior uniform between the bounds of [identify.bounds] (log-uniform where log-scaled); "
          f"its interval is the equal-tailed 90 % credible interval of the weighted draws. Status: {status}.</p>"),
         stats,
+        posterior_model_error(result),
         "<h2>Figures</h2>",
         html_image(pngs["corner"], "corner plot",
                "Weighted draws of every parameter (diagonal: histogram, dotted: 90 % credible interval) and pair "

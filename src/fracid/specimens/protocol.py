@@ -242,6 +242,34 @@ def bar_resolution(length: float, n_elements: int, internal_length: float | None
     return Resolution("n_elements", n_elements, h, f"the element size length / n_elements = {h:.3g} mm", advice)
 
 
+def refined(specimen, factor: float):
+    """The same specimen with its element size where it localises divided by ``factor`` (< 1: coarser).
+
+    Its own ``refined(factor)`` when it has one (the notched beam, the dog-bone), else the field its
+    :meth:`~Specimen.resolution` names: an element size (``h_fine``) divided by ``factor``, an element count
+    (``n_elements``) multiplied by it and rounded (the actual ratio is the two resolutions' ``h``).
+
+    Raises
+    ------
+    ValueError
+        When no field sets the element size (a mesh file, a fixed mesh), naming the specimen.
+    """
+    own = getattr(specimen, "refined", None)
+    if own is not None:
+        return own(factor)
+    resolution = specimen.resolution()
+    if resolution.field == "n_elements":
+        count = max(3, int(round(specimen.n_elements * factor)))
+        try:
+            return dataclasses.replace(specimen, n_elements=count)
+        except ValueError:  # a count it refuses (the tension strip's is odd): the next one
+            return dataclasses.replace(specimen, n_elements=count + 1)
+    if resolution.field is not None and isinstance(resolution.value, (int, float)):
+        return dataclasses.replace(specimen, **{resolution.field: resolution.value / factor})
+    raise ValueError(f"{type(specimen).__name__}: no field sets its element size ({resolution.text}), so fracid cannot "
+                     "make a refined mesh of it; give meshes of two sizes yourself")
+
+
 def field_names(cls) -> tuple:
     """The dataclass fields of a specimen class (its ``[specimen]`` keys besides type and control)."""
     return tuple(f.name for f in dataclasses.fields(cls)) if dataclasses.is_dataclass(cls) else ()

@@ -122,6 +122,11 @@ class MethodResult(GaussianEstimate):
     provenance : dict
         How the result was obtained (:func:`fracid.provenance.collect`: version, command line,
         configuration, data files and their SHA-256, specimen, mesh, machine, date); empty if not given.
+    error_terms : dict
+        The error terms added to the data covariance (the mesh's discretisation error, the model's own
+        error: :func:`fracid.inverse.likelihood.record.terms_record`): per block the measurement,
+        discretisation and model-error std; empty when none was added (``x`` and ``C`` are then the
+        measurement's alone; with them, ``C`` holds them and ``std_exp`` stays the measurement std).
     """
 
     names: list
@@ -145,6 +150,7 @@ class MethodResult(GaussianEstimate):
     control_names: list = field(default_factory=list)
     quantities: list = field(default_factory=list)
     provenance: dict = field(default_factory=dict)
+    error_terms: dict = field(default_factory=dict)
 
     @property
     def rms_percent(self) -> float:
@@ -248,6 +254,9 @@ class MethodResult(GaussianEstimate):
         if np.size(self.y_fit) == np.size(self.y_exp) and np.any(np.isfinite(np.asarray(self.y_fit, float))):
             lines.append("fit diagnostics:")
             lines += [f"  {line}" for line in diagnostics_lines(self.diagnostics())]
+        if self.error_terms:
+            lines.append("error terms in the data covariance (the std above include them):")
+            lines += [f"  {line}" for line in self.error_terms.get("notes", [])]
         return "\n".join(lines)
 
     def to_dict(self) -> dict:

@@ -16,11 +16,12 @@ from fracid.inverse.methods.knn_kalman import (IdentificationResult, KalmanSetti
 from fracid.inverse.core.method import InverseMethod, MethodResult, check_problem
 from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS, with_settings
 from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.likelihood.terms import ErrorTerms, Problem, identify_with_terms
 
 
 def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMethod | str | None = None,
              executor=None, store=None, blocks=(), notes=(), progress=None, retry_failed=False,
-             **settings) -> MethodResult:
+             discretisation_error=None, model_error=None, **settings) -> MethodResult:
     """Identify the parameters of ``space`` from the data with an inverse method (by default KNN over a
     population for a global overview and the prior, then the Kalman filter to refine).
 
@@ -41,6 +42,13 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
         Progress bars (None: on a terminal).
     retry_failed : bool
         Run again the runs stored as failed.
+    discretisation_error : None, "off", "richardson" or DiscretisationError
+        Add the mesh's discretisation error at the estimate to the data covariance (Richardson extrapolation
+        from a refined mesh, :mod:`fracid.inverse.likelihood.discretisation`) and identify again.
+    model_error : None, "off", "variance", "bias" or ModelError
+        Identify the model's own error (a std per data block, :mod:`fracid.inverse.likelihood.model_error`)
+        with the parameters, to a fixed point. With either term the result's ``error_terms`` reports them
+        (:mod:`fracid.inverse.likelihood.terms`); the re-identifications reuse the stored runs.
     **settings
         Settings of the method by their own names (:func:`~fracid.inverse.methods.registry.with_settings`), e.g.
         ``n=16, k=3`` of its KNN population, ``groups="all", max_iterations=8`` of its Kalman filter.
@@ -65,8 +73,14 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
     start = time.perf_counter()
     y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
     method = with_settings(_method(method), **settings)
-    result = method(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
-                    retry_failed=retry_failed, blocks=blocks, notes=notes)
+    terms = ErrorTerms.of(discretisation_error, model_error)
+    if terms is not None:
+        result = identify_with_terms(method, Problem.of(operator, y_exp, C_exp, space, blocks), terms,
+                                     executor=executor, store=store, progress=progress, retry_failed=retry_failed,
+                                     notes=notes)
+    else:
+        result = method(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+                        retry_failed=retry_failed, blocks=blocks, notes=notes)
     result.runs["wall_seconds"] = time.perf_counter() - start
     return result
 

@@ -119,7 +119,8 @@ class PosteriorResult:
     weights : ndarray, shape (n,)
         Normalised importance weights (sum 1; 0 for failed runs).
     log_likelihood : ndarray, shape (n,)
-        -1/2 chi^2 of each draw (-inf for failed runs).
+        -1/2 chi^2 of each draw (-inf for failed runs); with the model error marginalised, the log of its
+        marginal likelihood less the base covariance's normalisation (:mod:`fracid.inverse.likelihood.marginal`).
     y : ndarray, shape (n, m)
         Computed observations of each draw (NaN for failed runs).
     y_exp, std_exp : ndarray, shape (m,)
@@ -146,6 +147,10 @@ class PosteriorResult:
         likelihood with its normalisation (-1/2 log det(2 pi C_exp)), from the importance weights of all draws
         (:func:`~fracid.inverse.sampling.mixture.amis_log_evidence`), and its Monte-Carlo standard error. Two
         models fitted to the same data compare by the difference (the log Bayes factor).
+    model_error : list of dict
+        With the model's own error marginalised (:class:`~fracid.inverse.likelihood.marginal.MarginalLikelihood`):
+        the posterior of its std per group (``group``, ``blocks``, ``mean``, ``median``, ``interval_90`` [units
+        of y], ``grid``, ``probability``); empty otherwise.
     """
 
     names: list
@@ -167,6 +172,7 @@ class PosteriorResult:
     history: list = field(default_factory=list)
     log_evidence: float = float("nan")
     log_evidence_error: float = float("nan")
+    model_error: list = field(default_factory=list)
 
     @property
     def converged(self) -> bool:
@@ -221,6 +227,9 @@ class PosteriorResult:
                  f"{self.failed} failed run{'' if self.failed == 1 else 's'}; {self.status}"]
         if np.isfinite(self.log_evidence):
             lines.append(f"  log evidence {self.log_evidence:.4g} +- {self.log_evidence_error:.2g} (Monte Carlo)")
+        for g in self.model_error:
+            lines.append(f"  model-error std of {g['group']}: mean {g['mean']:.4g}, 90 % interval "
+                         f"[{g['interval_90'][0]:.4g}, {g['interval_90'][1]:.4g}] (marginalised per draw)")
         if self.sampling_failed:
             return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
         intervals = self.credible_intervals(0.9)
@@ -240,7 +249,7 @@ class PosteriorResult:
                 "estimate": np.asarray(self.estimate).tolist(), "estimate_cov": np.asarray(self.estimate_cov).tolist(),
                 "units": dict(self.units), "history": self.history,
                 "log_evidence": _finite_or_none(self.log_evidence),
-                "log_evidence_error": _finite_or_none(self.log_evidence_error)}
+                "log_evidence_error": _finite_or_none(self.log_evidence_error), "model_error": self.model_error}
 
     def save_csv(self, path) -> Path:
         """The draws: one row each, the parameters, the weight and the log-likelihood."""
@@ -268,13 +277,15 @@ def _finite_or_none(value: float):
     return float(value) if np.isfinite(value) else None
 
 
-def _log_likelihood(records, y_exp, C_exp):
+def _log_likelihood(records, y_exp, C_exp, marginal=None):
     """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs;
-    chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`)."""
+    chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`), or
+    ``marginal(residuals)``: the model error's std integrated out (relative to C_exp's normalisation)."""
     y = np.array([np.asarray(r.y, float) if r.ok else np.full(len(y_exp), np.nan) for r in records])
     good = np.all(np.isfinite(y), axis=1)
-    chi2 = C_exp.quadratic(np.where(good[:, None], y - y_exp, 0.0).T)
-    return np.where(good, -0.5 * chi2, -np.inf), y
+    residuals = np.where(good[:, None], y - y_exp, 0.0)
+    value = -0.5 * C_exp.quadratic(residuals.T) if marginal is None else marginal(residuals)
+    return np.where(good, value, -np.inf), y
 
 
 def _first_proposal(space, x0, C0, settings, rng) -> GaussianMixture:
@@ -290,7 +301,7 @@ def _first_proposal(space, x0, C0, settings, rng) -> GaussianMixture:
 
 
 def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSettings = PosteriorSettings(),
-              executor=None, progress=None, log=None) -> PosteriorResult:
+              executor=None, progress=None, log=None, marginal=None) -> PosteriorResult:
     """Weighted samples of the parameters given the data by adaptive importance sampling on the exact model.
 
     Parameters
@@ -313,6 +324,10 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         ``progress(done_runs, max_runs)`` after every round.
     log : callable, optional
         ``log(text)``: a line per round.
+    marginal : MarginalLikelihood, optional
+        The likelihood with the model error's std integrated out per draw
+        (:class:`~fracid.inverse.likelihood.marginal.MarginalLikelihood` over ``C_exp``); its posterior goes to
+        ``model_error``.
 
     Returns
     -------
@@ -333,7 +348,7 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     for round_ in range(settings.max_rounds):
         u = proposal.sample(rng, settings.samples_per_round)
         records = evaluate_points(evaluate, space.from_unit(u), None, executor)
-        ll, y = _log_likelihood(records, y_exp, C_exp)
+        ll, y = _log_likelihood(records, y_exp, C_exp, marginal)
         # every proposal's log density at every draw: the earlier ones at the new draws, the new one at all
         densities = [np.concatenate([row, q.logpdf(u)]) for row, q in zip(densities, proposals)]
         proposals.append(proposal)
@@ -359,10 +374,12 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     lower, upper = space.lower, space.upper
     log_z, log_z_error = amis_log_evidence(np.vstack(densities), loglik, sizes)
     log_z -= 0.5 * (y_exp.size * np.log(2.0 * np.pi) + C_exp.logdet())
+    ok = np.isfinite(loglik)
+    sigma = [] if marginal is None else marginal.summary(outputs[ok] - y_exp, weights[ok])
     return PosteriorResult(list(space.names), space.from_unit(u_all), weights, loglik, outputs, y_exp,
                            C_exp.std(), ess, len(proposals), failed, np.asarray(x0, float),
                            np.asarray(C0, float), (lower, upper), log=tuple(space.log), status=status, history=history,
-                           log_evidence=float(log_z), log_evidence_error=log_z_error)
+                           log_evidence=float(log_z), log_evidence_error=log_z_error, model_error=sigma)
 
 
 def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
@@ -399,16 +416,26 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
     log : callable, optional
         ``log(text)``: a line before the sampler starts and one per round.
 
-    Returns and raises as :func:`posterior`; the result carries the identification's units.
+    Returns and raises as :func:`posterior`; the result carries the identification's units. With the
+    identification's error terms (``error_terms``), the likelihood is theirs: the data covariance with the mesh's
+    error, and the model error's std integrated out per draw (:func:`~fracid.inverse.likelihood.record.
+    error_likelihood`).
     """
+    from fracid.inverse.likelihood.record import error_likelihood
     from fracid.progress import batch_progress, progress_bar
 
+    C_exp, marginal = data.covariance, None
+    if getattr(identification, "error_terms", None):
+        control = identification.control if identification.control is not None else np.arange(data.y.size)
+        C_exp, marginal = error_likelihood(identification.error_terms, data.covariance, data.y, control,
+                                           identification.quantities)
     total = settings.samples_per_round * settings.max_rounds
     if log is not None:
         log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of {settings.samples_per_round}), "
             f"until the effective sample size reaches {settings.target_ess:g} ([posterior] settings)")
     with progress_bar(total, "posterior", progress) as bar:
-        result = posterior(evaluate, data.y, data.covariance, space, identification.x, identification.C,
-                           settings=settings, executor=executor, progress=batch_progress(bar), log=log)
+        result = posterior(evaluate, data.y, C_exp, space, identification.x, identification.C, settings=settings,
+                           executor=executor, progress=batch_progress(bar), log=log, marginal=marginal)
     result.units = dict(identification.units or {})
+    result.std_exp = data.covariance.std()  # the measurement's, as the identification's std_exp
     return result

@@ -30,6 +30,7 @@ from fracid.inverse.core.method import check_problem, identification_bounds
 from fracid.inverse.methods.registry import StudyMethod, with_settings
 from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.core.runs import StoredOperator
+from fracid.inverse.likelihood.terms import Problem, with_error_terms
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
 from fracid.inverse.studies.stability import stability as stability_check
 from fracid.inverse.studies.study_result import Prediction, StudyResult, describe_data, estimate_objective, predict
@@ -65,6 +66,11 @@ class StudySettings:
         Sample the posterior on the exact model with these settings after the checks, and give the
         verdict from its 90 % credible intervals; None (default): no posterior, the verdict from the
         Gaussian std.
+    error_terms : ErrorTerms or None
+        The mesh's discretisation error and the model's own error added to the data covariance of the
+        refinement (:func:`fracid.inverse.likelihood.terms.with_error_terms`: refined from the same population
+        with them, to a fixed point); the verdict and the posterior read the widened result, the multi-start
+        and stability checks keep the measurement covariance. None (default): none.
     """
 
     method: object = KnnKalman()
@@ -74,6 +80,7 @@ class StudySettings:
     noise_seed: int = 0
     tolerance: float = 0.1
     posterior: PosteriorSettings | None = None
+    error_terms: object = None
 
     def __post_init__(self):
         if self.prior not in ("knn", "bounds"):
@@ -171,6 +178,14 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
     with study.counting(refine_label, evaluate, f"{refine_label} from the {search_label} prior"):
         ident = method.refine(evaluate, y, C, overview, executor=executor, blocks=list(data.blocks),
                               notes=list(data.notes), C0=C0, progress=progress)
+    if settings.error_terms is not None:
+        with study.counting("error terms", evaluate, "error terms: the refinement again with them"):
+            def fit(inverse, covariance):
+                return inverse.refine(evaluate, y, covariance, overview, executor=executor, blocks=list(data.blocks),
+                                      notes=list(data.notes), C0=C0, progress=progress)
+
+            ident = with_error_terms(method, fit, Problem.of(operator, y, C, space, data.blocks), settings.error_terms,
+                                     ident, store=store, executor=executor, retry_failed=retry_failed)
     centre = estimate_objective(ident, y, C)
     maps, extent = objective_maps(overview, centre=centre), valley_extent(overview, centre=centre)
     fit = _local_fit(method, data.blocks)
@@ -191,7 +206,8 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
         study.notes.insert(0, f"{failed} of {total} {search_label} runs failed (they rank last; see population.csv)")
     usable = None if post is None or post.sampling_failed else post  # below the ESS floor: no intervals
     verdict = parameter_verdicts(space.names, ident.x, ident.C, C_bounds, data=describe_data(operator),
-                                 tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=usable)
+                                 tolerance=settings.tolerance, multi_start=ms, stability=st, posterior=usable,
+                                 error_terms=getattr(ident, "error_terms", None))
     return StudyResult(ident, history, maps, extent, ms, st, predictions, verdict, study.timings, study.runs,
                        study.notes, posterior=post)
 

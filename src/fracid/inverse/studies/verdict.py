@@ -34,6 +34,12 @@ posterior, one cut by a bound):
 
 The multi-start and stability rules are the same with either measure. Every
 :class:`ParameterVerdict` (its text, :meth:`Verdict.as_dict`) names the measure it used.
+
+**Error terms.** With the identification's error terms (the mesh's discretisation error, the model's own error:
+:mod:`fracid.inverse.likelihood`), C is the widened covariance; each parameter's remarks give its estimate and
+std without them, and the verdict's notes say where a term dominates the measurement std
+(:func:`~fracid.inverse.likelihood.record.dominant_terms`): the data's scatter is then not what limits the
+identification.
 """
 
 from __future__ import annotations
@@ -130,10 +136,11 @@ class Verdict:
     parameters: tuple
     correlation: np.ndarray = field(repr=False)
     measure: str = GAUSSIAN_MEASURE
+    notes: tuple = ()  # statements on the whole verdict (an error term that dominates the data's std)
 
     def text(self, units: dict | None = None) -> str:
         units = units or {}
-        return "\n".join(v.text(units.get(v.name, "")) for v in self.parameters)
+        return "\n".join([*(v.text(units.get(v.name, "")) for v in self.parameters), *self.notes])
 
     def __getitem__(self, name: str) -> ParameterVerdict:
         for v in self.parameters:
@@ -145,7 +152,7 @@ class Verdict:
         return {"measure": self.measure,
                 "parameters": [dict(v.__dict__, remarks=list(v.remarks), suggestions=list(v.suggestions),
                                     interval=list(v.interval)) for v in self.parameters],
-                "correlation": self.correlation.tolist()}
+                "correlation": self.correlation.tolist(), "notes": list(self.notes)}
 
 
 def _suggestions(data: DataDescription) -> tuple:
@@ -160,7 +167,8 @@ def _suggestions(data: DataDescription) -> tuple:
 
 
 def parameter_verdicts(names, x, C, C_prior, *, data: DataDescription = DataDescription(), tolerance: float = 0.1,
-                       multi_start=None, stability=None, strong: float = 0.9, posterior=None) -> Verdict:
+                       multi_start=None, stability=None, strong: float = 0.9, posterior=None,
+                       error_terms=None) -> Verdict:
     """Verdict per parameter from the posterior covariance and the checks.
 
     Parameters
@@ -183,6 +191,9 @@ def parameter_verdicts(names, x, C, C_prior, *, data: DataDescription = DataDesc
         The sampled posterior (:func:`fracid.inverse.sampling.posterior.posterior`; any object with ``mean``,
         ``cov`` and ``credible_intervals(level)`` in the order of ``names``): the rules then read its
         90 % credible intervals and weighted covariance instead of ``x`` and ``C`` (module docstring).
+    error_terms : dict, optional
+        The identification's ``error_terms`` (``C`` is then the widened covariance): remarks with the estimates
+        without them and notes on a term that dominates (module docstring).
     """
     x, C, C_prior = np.asarray(x, float), np.asarray(C, float), np.asarray(C_prior, float)
     if posterior is None:
@@ -220,12 +231,35 @@ def parameter_verdicts(names, x, C, C_prior, *, data: DataDescription = DataDesc
             remarks.append(f"scatter under noise: {stability.relative_scatter[j]:.1%} "
                            f"({stability.amplification[j]:.1f} x the data noise, whose std is {stability.noise_level:.1%} "
                            "of the measured values in RMS)")
+        remarks += _terms_remark(error_terms, j, std[j])
         suggestions = () if status == "identified" else _suggestions(data)
         interval = () if intervals is None else (float(intervals[j, 0]), float(intervals[j, 1]))
         verdicts.append(ParameterVerdict(name, status, float(value[j]), float(std[j]), float(conditional[j]),
                                          float(removed[j]), partner, r, tuple(remarks), suggestions, measure,
                                          interval))
-    return Verdict(tuple(verdicts), corr, measure)
+    return Verdict(tuple(verdicts), corr, measure, _terms_notes(error_terms))
+
+
+def _terms_remark(error_terms, j: int, std: float) -> list:
+    """The estimate and std of parameter j without the error terms, and how much they widen it."""
+    before = (error_terms or {}).get("measurement_only")
+    if not before or j >= len(before.get("std", [])):
+        return []
+    x0, s0 = before["x"][j], before["std"][j]
+    return [f"without the error terms (measurement std alone): {x0:.4g} +- {s0:.2g}; with them the std is "
+            f"{std / s0:.2g} times wider"] if s0 > 0 else []
+
+
+def _terms_notes(error_terms) -> tuple:
+    """Notes of the verdict on its error terms: what was added, and where a term dominates the data's std."""
+    if not error_terms:
+        return ()
+    from fracid.inverse.likelihood.record import dominant_terms
+
+    added = [name for key, name in (("discretisation", "the mesh's discretisation error"),
+                                    ("model_error", "the model's own error")) if error_terms.get(key)]
+    return (f"Note: the std include {' and '.join(added)} (error terms of the likelihood)",
+            *(f"Note: {text}" for text in dominant_terms(error_terms)))
 
 
 def _posterior_measure(posterior, C_prior):
