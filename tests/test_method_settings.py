@@ -211,7 +211,8 @@ def test_a_method_without_config_tables_reads_the_table_of_its_name(tmp_path, mo
 
 def test_a_table_no_registered_method_reads_is_an_unknown_key(tmp_path):
     with pytest.raises(ConfigError, match=r"identify\.simplex = a table \{steps\}: unknown key; allowed keys here: "
-                                          r"parameters, method, bounds, knn, kalman, gauss-newton$"):
+                                          r"parameters, method, bounds, discretisation_error, model_error, knn, kalman, "
+                                          r"gauss-newton$"):
         load_config(_config(tmp_path, tail="[identify.simplex]\nsteps = 4"))
 
 
