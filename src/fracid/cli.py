@@ -5,6 +5,8 @@
                               HTML report
     fracid posterior CONFIG   identify, then weighted samples of the parameters given the data (adaptive
                               importance sampling on the exact model): CSV, JSON, figures, HTML page
+    fracid compare CONFIG     every model that runs on the specimen identified on the same data and ranked by
+                              log evidence (:mod:`fracid.cli_compare`): compare.json, figures, HTML report
     fracid study CONFIG       the whole strategy through the method's stages: search, sensitivity, uniqueness,
                               refinement, multi-start, stability, prediction of held-out data, size effect;
                               a verdict per parameter
@@ -71,6 +73,9 @@ def _parser() -> argparse.ArgumentParser:
 
     cli_init.add_parser(sub)
     cli_check.add_parser(sub, common)
+    from fracid import cli_compare
+
+    cli_compare.add_parser(sub, common)
     from fracid import cli_datasets
 
     cli_datasets.add_parser(sub)  # `fracid datasets` and `fracid init --dataset NAME`
@@ -312,6 +317,10 @@ def _dispatch(args) -> int:
         return run_identify(args)
     if args.command == "posterior":
         return run_posterior_command(args)
+    if args.command == "compare":
+        from fracid import cli_compare
+
+        return cli_compare.run_compare(args)
     if args.command in ("study", "uniqueness", "stability", "sensitivity", "size-effect"):
         from fracid import cli_studies
 

@@ -198,6 +198,28 @@ def _bounds(cls, name: str, value: float) -> list:
     return [float(f"{lower:.3g}"), float(f"{upper:.3g}")]
 
 
+def default_identification(model_type: str, params) -> tuple:
+    """What ``fracid init`` identifies for a model without the demo's settings: (names, bounds, log names).
+
+    Parameters
+    ----------
+    model_type : str
+        A ``[model] type`` (:data:`fracid.models.MODEL_TYPES`).
+    params : parameter object
+        The model's parameters (an instance of its parameter class): the bounds are a factor 3 around
+        their values, inside the usual and valid ranges (units of the parameters).
+
+    Returns
+    -------
+    tuple
+        The identified names (:data:`IDENTIFIED`, or the two parameters after E and nu), ``{name: [lower,
+        upper]}`` and the names sampled in log scale (beta: its range spans decades).
+    """
+    names = list(IDENTIFIED.get(model_type, params.names()[2:4]))
+    bounds = {name: _bounds(type(params), name, getattr(params, name)) for name in names}
+    return names, bounds, [name for name in names if name == "beta"]
+
+
 def _identify_lines(model_type: str, demo: dict | None, params) -> list:
     """``[identify]``: the demo's, or the pair's usual parameters with bounds from their ranges; the tables of
     the default inverse method's settings are written by the method (its ``config_template``), with the demo's
@@ -206,9 +228,7 @@ def _identify_lines(model_type: str, demo: dict | None, params) -> list:
         names, bounds = demo["parameters"], {k: v for k, v in demo["bounds"].items() if k != "log"}
         log = demo["bounds"].get("log", [])
     else:
-        names = list(IDENTIFIED.get(model_type, params.names()[2:4]))
-        bounds = {name: _bounds(type(params), name, getattr(params, name)) for name in names}
-        log = [name for name in names if name == "beta"]
+        names, bounds, log = default_identification(model_type, params)
     return ["[identify]                          # for `fracid identify` (needs [[experiments]])",
             _line("parameters", names, "identified; the others keep their [model.parameters] value"),
             "[identify.bounds]                   # [lower, upper], inside the valid range of each"] + [

@@ -34,6 +34,7 @@ OUTPUTS = {
     "stability": _STUDY,
     "sensitivity": ("runs.sqlite", "sensitivity.csv", "sensitivity.png"),
     "size-effect": ("size_effect.csv", "size_effect.json", "size_effect.png"),
+    "compare": ("runs.sqlite", "compare.json", "report.html", "figures"),
 }
 
 

@@ -22,7 +22,7 @@ from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import IdentificationResult, identify_data
 from fracid.models import ConvergenceError
 
-__all__ = ["Candidate", "ModelFit", "fit_model", "relative_rms", "run_to_end"]
+__all__ = ["Candidate", "ModelFit", "candidate_operator", "fit_model", "relative_rms", "run_to_end"]
 
 
 @dataclass(frozen=True)
@@ -182,6 +182,25 @@ def run_to_end(model, specimen, params, control_points, *, control="cmod", steps
     return run, energy
 
 
+def candidate_operator(data: ExperimentalData, candidate: Candidate, specimen=None, *, control="cmod",
+                       steps=None) -> ForwardOperator:
+    """The forward operator of a candidate on force data: one force observation per data block, at its
+    control values [mm], on ``candidate.specimen`` (or ``specimen`` when it has none), with the step rule
+    ``steps`` (the specimen's default if None).
+
+    Raises
+    ------
+    ValueError
+        When neither the candidate nor the call gives a specimen.
+    """
+    specimen = candidate.specimen if candidate.specimen is not None else specimen
+    if specimen is None:
+        raise ValueError(f"candidate {candidate.label!r} has no specimen and none was given")
+    observations = [Observation(specimen, data.control[a:b], quantity="force", control=control, name=name)
+                    for name, a, b in data.blocks]
+    return ForwardOperator(observations, candidate.base, candidate.names, model=candidate.model, steps=steps)
+
+
 def fit_model(data: ExperimentalData, candidate: Candidate, specimen=None, *, control="cmod", steps=None,
               **settings) -> ModelFit:
     """Identify one candidate model on force data, then run it at the estimate.
@@ -208,12 +227,8 @@ def fit_model(data: ExperimentalData, candidate: Candidate, specimen=None, *, co
     ModelFit
     """
     start = time.perf_counter()
-    specimen = candidate.specimen if candidate.specimen is not None else specimen
-    if specimen is None:
-        raise ValueError(f"candidate {candidate.label!r} has no specimen and none was given")
-    observations = [Observation(specimen, data.control[a:b], quantity="force", control=control, name=name)
-                    for name, a, b in data.blocks]
-    operator = ForwardOperator(observations, candidate.base, candidate.names, model=candidate.model, steps=steps)
+    operator = candidate_operator(data, candidate, specimen, control=control, steps=steps)
+    specimen = operator.observations[0].specimen
     result = identify_data(operator, data, candidate.space, **{**settings, **candidate.settings})
     params = operator.parameters(result.x)
     run, energy = run_to_end(candidate.model, specimen, params, data.control, control=control, steps=steps)

@@ -1,0 +1,249 @@
+"""The result of a comparison of models by evidence (:func:`fracid.inverse.studies.model_comparison.compare`):
+a :class:`ModelScore` per model and the :class:`ComparisonResult` that ranks them.
+
+Units: RMS in % of the measured peak; chi^2, the MAP objective, AIC, BIC and the log evidences are
+dimensionless (natural logarithms); parameters in their units.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from fracid.inverse.studies.evidence import TIE_SIGMAS, rank_by_evidence
+
+__all__ = ["ComparisonResult", "ModelScore", "map_objective"]
+
+
+def map_objective(result, chi2: float) -> float:
+    """The inverse method's Bayesian objective at its estimate: chi^2 + (x - x0)^T C0^-1 (x - x0), with x0, C0
+    the prior of its KNN stage (``result.knn``); chi^2 alone for a result without one [-]."""
+    knn = getattr(result, "knn", None) or {}
+    if knn.get("x0") is None or knn.get("C0") is None:
+        return float(chi2)
+    d = np.asarray(result.x, float) - np.asarray(knn["x0"], float)
+    try:
+        return float(chi2 + d @ np.linalg.solve(np.asarray(knn["C0"], float), d))
+    except np.linalg.LinAlgError:
+        return float("nan")
+
+
+def _plain(value):
+    """``value`` for JSON: floats that are not finite become None, arrays lists."""
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value.item() if isinstance(value, np.generic) else value
+
+
+@dataclass
+class ModelScore:
+    """One model identified on the data, with its posterior and the numbers it is ranked by.
+
+    Attributes
+    ----------
+    label, model : str
+        The contender's label and the forward model's ``key``.
+    names : list of str
+        Its identified parameters (p = len(names)).
+    identification : MethodResult
+        Estimate ``x``, covariance ``C``, the fit ``y_fit``, the status.
+    posterior : PosteriorResult or None
+        The sampled posterior (None when every draw failed: ``posterior_status`` says why).
+    verdict : Verdict
+        Per parameter (:func:`~fracid.inverse.studies.verdict.parameter_verdicts`).
+    n : int
+        Data values.
+    chi2, map_objective, log_likelihood, aic, bic : float
+        At the estimate (:mod:`fracid.inverse.studies.evidence`) [-].
+    log_evidence, log_evidence_error : float
+        From the posterior's importance weights, and its Monte-Carlo standard error [-].
+    log_evidence_laplace : float
+        The Laplace approximation at the estimate [-] (NaN when it could not be formed).
+    posterior_status : str
+    bounds : (list, list)
+        The prior's bounds (units of the parameters); ``log`` its log flags.
+    seconds : float
+        Wall time of the model's identification and sampling [s].
+    rank : int
+        1 for the largest log evidence; ``tied`` whether it ties with the first (:data:`TIE_SIGMAS`), ``delta``
+        its log evidence less the first's (the log Bayes factor against the best) [-].
+    """
+
+    label: str
+    model: str
+    names: list
+    identification: object
+    posterior: object
+    verdict: object
+    n: int
+    chi2: float
+    map_objective: float
+    log_likelihood: float
+    aic: float
+    bic: float
+    log_evidence: float
+    log_evidence_error: float
+    log_evidence_laplace: float
+    posterior_status: str
+    bounds: tuple = ()
+    log: list = field(default_factory=list)
+    seconds: float = 0.0
+    rank: int = 0
+    tied: bool = False
+    delta: float = float("nan")
+
+    @property
+    def p(self) -> int:
+        return len(self.names)
+
+    @property
+    def rms_percent(self) -> float:
+        """RMS misfit at the estimate [% of the measured peak]."""
+        return self.identification.rms_percent
+
+    def parameters_text(self) -> str:
+        """``name = value +- std unit`` of every identified parameter (the identification's Gaussian)."""
+        units = self.identification.units or {}
+        return "; ".join(f"{n} = {v:.4g} +- {s:.2g}" + (f" {units[n]}" if units.get(n, "-") != "-" else "")
+                         for n, v, s in zip(self.names, self.identification.x, self.identification.std))
+
+    def evidence_text(self) -> str:
+        """``log Z +- error``, or why there is none."""
+        if not math.isfinite(self.log_evidence):
+            return "n/a"
+        return f"{self.log_evidence:.2f} +- {self.log_evidence_error:.2f}"
+
+    def sampling_text(self) -> str:
+        """The posterior's effective sample size and whether it reached the target (``ESS 212``, ``ESS 40 (below
+        the target)``, ``ESS 12 (below the floor)``), or ``not sampled``."""
+        post = self.posterior
+        if post is None:
+            return "not sampled"
+        state = "" if post.converged else " (below the floor)" if post.sampling_failed else " (below the target)"
+        return f"ESS {post.ess:.0f}{state}"
+
+    def line(self) -> str:
+        """One line: estimate, RMS, chi^2, AIC, BIC, log evidences."""
+        return (f"{self.parameters_text()}; RMS {self.rms_percent:.3g} %, chi2 {self.chi2:.4g}, AIC {self.aic:.4g}, "
+                f"BIC {self.bic:.4g}, log Z {self.evidence_text()} (Laplace {self.log_evidence_laplace:.4g}); "
+                f"{self.seconds:.0f} s")
+
+    def to_dict(self) -> dict:
+        """Plain values for JSON (None for numbers that are not finite)."""
+        ident, post = self.identification, self.posterior
+        return _plain({
+            "rank": self.rank, "label": self.label, "model": self.model, "p": self.p, "n": self.n,
+            "parameters": {n: {"value": float(v), "std": float(s), "unit": (ident.units or {}).get(n, "")}
+                           for n, v, s in zip(self.names, ident.x, ident.std)},
+            "covariance": np.asarray(ident.C, float), "bounds": list(self.bounds), "log": list(self.log),
+            "identification_status": ident.status, "rms_percent": self.rms_percent, "chi2": self.chi2,
+            "map_objective": self.map_objective, "log_likelihood": self.log_likelihood, "aic": self.aic,
+            "bic": self.bic, "log_evidence": self.log_evidence, "log_evidence_error": self.log_evidence_error,
+            "log_evidence_laplace": self.log_evidence_laplace, "delta_log_evidence": self.delta,
+            "tied_with_best": self.tied, "posterior_status": self.posterior_status,
+            "posterior": post.to_dict() if post is not None else None, "verdict": self.verdict.as_dict(),
+            "y_fit": np.asarray(ident.y_fit, float), "forward_runs": ident.forward_runs, "seconds": self.seconds})
+
+
+#: the ranking table's columns (:meth:`ComparisonResult.table`)
+TABLE_HEADER = ["rank", "model", "p", "RMS [% of peak]", "chi2", "MAP objective", "AIC", "BIC",
+                "log Z (+- MC error)", "log Z Laplace", "delta log Z", "posterior"]
+
+
+@dataclass
+class ComparisonResult:
+    """Models ranked by log evidence on one data set.
+
+    Attributes
+    ----------
+    data : ExperimentalData
+        The data every model was identified on.
+    scores : list of ModelScore
+        Best (largest log evidence) first; those without one last.
+    failures : dict
+        label -> why the model could not be compared.
+    settings : dict
+        The sampler's settings, the verdict's tolerance, the inverse method.
+    """
+
+    data: object
+    scores: list
+    failures: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+    @classmethod
+    def ranked(cls, data, scores, failures, settings) -> "ComparisonResult":
+        """The result with ``scores`` ranked (:func:`~fracid.inverse.studies.evidence.rank_by_evidence`)."""
+        order, tied = rank_by_evidence([s.log_evidence for s in scores], [s.log_evidence_error for s in scores])
+        best = scores[order[0]].log_evidence if order else float("nan")
+        for rank, i in enumerate(order, start=1):
+            scores[i].rank, scores[i].tied, scores[i].delta = rank, tied[i], scores[i].log_evidence - best
+        return cls(data, [scores[i] for i in order], dict(failures), dict(settings))
+
+    @property
+    def best(self):
+        """The score of the largest log evidence (None when no model has one)."""
+        return self.scores[0] if self.scores and math.isfinite(self.scores[0].log_evidence) else None
+
+    def score(self, label: str) -> ModelScore:
+        for s in self.scores:
+            if s.label == label:
+                return s
+        raise KeyError(f"no model labelled {label!r}; labels: {[s.label for s in self.scores]}")
+
+    def table(self) -> tuple[list, list]:
+        """The ranking table's header and rows, formatted (:data:`TABLE_HEADER`)."""
+        rows = [[str(s.rank) + (" (tie)" if s.tied else ""), s.label, str(s.p), f"{s.rms_percent:.2f}", f"{s.chi2:.4g}",
+                 f"{s.map_objective:.4g}", f"{s.aic:.4g}", f"{s.bic:.4g}", s.evidence_text(),
+                 f"{s.log_evidence_laplace:.2f}", f"{s.delta:.2f}", s.sampling_text()]
+                for s in self.scores]
+        return list(TABLE_HEADER), rows
+
+    def notes(self) -> list[str]:
+        """What to read in the ranking: the best model and its margin, ties, failures."""
+        best = self.best
+        lines = []
+        if best is not None and len(self.scores) > 1:
+            second = self.scores[1]
+            ties = [s.label for s in self.scores if s.tied and s is not best]
+            lines.append(f"best by evidence: {best.label}" + (
+                f", tied within {TIE_SIGMAS:g} combined Monte-Carlo errors with {', '.join(ties)}" if ties else
+                f", log Bayes factor {-second.delta:.3g} against {second.label}"))
+        lines += [f"{s.label}: its posterior's effective sample size {s.posterior.ess:.0f} is below the sampler's floor: "
+                  "its log evidence and Monte-Carlo error are rough (more draws: --samples, --rounds)"
+                  for s in self.scores if s.posterior is not None and s.posterior.sampling_failed]
+        lines += [f"{label}: not compared ({why})" for label, why in self.failures.items()]
+        return lines
+
+    def summary(self) -> str:
+        """The ranking as a text table, with the notes."""
+        header, rows = self.table()
+        widths = [max(len(str(c)) for c in column) for column in zip(header, *rows)]
+        text = ["  ".join(str(c).rjust(w) for c, w in zip(line, widths)) for line in (header, *rows)]
+        return "\n".join(text + self.notes())
+
+    def to_dict(self) -> dict:
+        """compare.json: the ranking (labels, best first), every model's numbers, the failures, the settings
+        and the data (control [mm], values, std)."""
+        data = self.data
+        return _plain({"ranking": [s.label for s in self.scores], "best": self.best.label if self.best else None,
+                       "tie_sigmas": TIE_SIGMAS, "models": [s.to_dict() for s in self.scores],
+                       "failures": dict(self.failures), "settings": self.settings, "notes": self.notes(),
+                       "data": {"control": np.asarray(data.control, float), "y": np.asarray(data.y, float),
+                                "std": np.asarray(data.std, float), "blocks": [list(b) for b in data.blocks]}})
+
+    def save(self, path) -> Path:
+        """Write :meth:`to_dict` as JSON."""
+        path = Path(path)
+        path.write_text(json.dumps(self.to_dict(), indent=1) + "\n", encoding="utf-8")
+        return path
