@@ -5,7 +5,7 @@ Runs ``fracid compare src/fracid/data/gregoire2013_beam4/demo.toml --out OUT --s
 with S draws per round and R rounds at most), times it, and writes OUT/README.md: the settings, the wall time, the
 ranking table, the evidence with its error bars, the estimates, the failures and what to read in them. The run
 store (OUT/runs.sqlite, not committed) makes a rerun reuse every run: ``--readme-only`` rewrites the README from
-OUT/compare.json and OUT/run.json without computing.
+OUT/compare.json and OUT/run.json (the computing run's wall times) without computing.
 
     python benchmarks/compare_demo.py [--out docs/compare] [--workers 2] [--samples 40] [--rounds 3] [--readme-only]
 """
@@ -36,12 +36,27 @@ def run(args) -> dict:
     """Run the command; its exit status, wall time and settings (OUT/run.json)."""
     start = time.perf_counter()
     status = main(_command(args))
+    saved = json.loads((args.out / "compare.json").read_text(encoding="utf-8"))
     record = {"status": status, "wall_seconds": time.perf_counter() - start,
+              "model_seconds": {m["label"]: m["seconds"] for m in saved["models"]}, "failed_runs": failed_runs(args.out),
               "command": "fracid " + " ".join(_command(args)).replace(str(ROOT) + "/", ""),
               "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
               "machine": f"{platform.machine()}, {args.workers or 'one worker per core'} workers"}
     (args.out / "run.json").write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
     return record
+
+
+def failed_runs(out: Path) -> list:
+    """The failed forward runs of OUT/runs.sqlite: their parameters and the reason (its first sentence)."""
+    from fracid.store import RunStore
+
+    if not (out / "runs.sqlite").is_file():
+        return []
+    with RunStore(out / "runs.sqlite", readonly=True) as store:
+        keys = [key for key, status in store.statuses(store.keys()).items() if status != "ok"]
+        records = [store.get(key) for key in keys]
+    return [{"x": [float(v) for v in r["x"]], "error": str(r.get("error", "")).split(": no convergence")[0]}
+            for r in records if r is not None]
 
 
 def _rows(saved) -> tuple[list, list]:
@@ -62,7 +77,8 @@ def _number(value) -> str:
     return "n/a" if value is None else f"{value:.2f}"
 
 
-def _estimates(saved) -> list:
+def _estimates(saved, seconds: dict) -> list:
+    """Per model: the estimate, the bounds, the verdict, the statuses and the wall time of the computing run."""
     lines = []
     for m in saved["models"]:
         values = "; ".join(f"{n} = {p['value']:.4g} +- {p['std']:.2g} {p['unit'] if p['unit'] != '-' else ''}".rstrip()
@@ -70,9 +86,12 @@ def _estimates(saved) -> list:
         bounds = ", ".join(f"{n} [{lo:.3g}, {hi:.3g}]" + (" log" if lg else "")
                            for n, lo, hi, lg in zip(m["parameters"], *m["bounds"], m["log"]))
         verdict = ", ".join(f"{v['name']} {v['status']}" for v in m["verdict"]["parameters"])
+        failed = [f"{c['failed']} of {c['runs']} {stage}" for stage, c in m["stage_runs"].items() if c["failed"]]
+        failed += [f"{m['posterior']['failed']} posterior draws"] if (m["posterior"] or {}).get("failed") else []
         lines.append(f"- **{m['label']}** ({m['model']}): {values}; bounds {bounds}; verdict: {verdict}; "
                      f"identification {m['identification_status'].split(';')[0]}; posterior {m['posterior_status']}; "
-                     f"{m['forward_runs']} identification runs, {m['seconds'] / 60:.0f} min")
+                     f"{m['forward_runs']} identification runs ({', '.join(failed) or 'none'} failed), "
+                     f"{seconds.get(m['label'], m['seconds']) / 60:.0f} min")
     return lines
 
 
@@ -83,6 +102,8 @@ def readme(out: Path) -> str:
     post = saved["settings"]["posterior"]
     header, rows = _rows(saved)
     failures = [f"- **{label}**: not compared: {why}" for label, why in saved["failures"].items()]
+    failed = [f"- x = {', '.join(f'{v:.4g}' for v in run['x'])}: {run['error']}"
+              for run in run_record.get("failed_runs") or failed_runs(out)]
     return "\n".join([
         "# Models compared by evidence on the Grégoire beam (`fracid compare`)", "",
         "Every model that runs on the notched beam identified on the demo's data (Grégoire et al. 2013, beam 4: 24 "
@@ -97,12 +118,15 @@ def readme(out: Path) -> str:
         "", "## Ranking", "", markdown_table(header, rows), "", *[f"- {n}" for n in saved["notes"]], "",
         "![log evidence with Monte-Carlo error bars](figures/compare_evidence.png)", "",
         "![the data and every model's fit](figures/compare_fits.png)", "",
-        "## Estimates and verdicts", "", *_estimates(saved), *([""] + failures if failures else []), "",
+        "## Estimates and verdicts", "", *_estimates(saved, run_record.get("model_seconds", {})),
+        *(["", "Failed forward runs (their models by the counts above; the identification and the posterior go on "
+           "without them):", "", *failed] if failed else []), *([""] + failures if failures else []), "",
         "## Definitions", "", DEFINITIONS, "",
         "The error bars of the figure are +- 2 Monte-Carlo standard errors. The Monte-Carlo error of log Z is the "
         "delta-method error of the importance-sampling mean, sqrt(1/ESS - 1/N): with an effective sample size "
         "below the sampler's floor it is itself rough. Files: `compare.json` (every number, the posteriors' "
-        "statistics, the fits), `report.html`, `figures/`.", ""])
+        "statistics, the fits), `report.html`, `figures/`. What the ranking says: the main README, \"Comparing models\".",
+        ""])
 
 
 def main_script(argv=None) -> int:

@@ -235,3 +235,21 @@ def test_a_model_that_does_not_run_on_the_specimen_is_refused(bar_config, capsys
     assert cli.main(["compare", str(bar_config), "--models", "cohesive-crack", "--out", str(bar_config.parent / "x")]) == 2
     err = capsys.readouterr().err
     assert "cohesive-crack" in err and "does not run on the bar" in err and "Traceback" not in err
+
+
+def test_a_failing_model_is_recorded_and_the_others_go_on(bar_config):
+    """A contender that cannot be identified (its space names another parameter than its operator) is recorded
+    with its reason; the other is compared."""
+    from fracid.config import build_data, build_operator, build_space, load_config
+    from fracid.inverse.studies.model_comparison import Contender
+
+    cfg = load_config(bar_config, purpose="identify")
+    data = build_data(cfg)
+    operator, space = build_operator(cfg, data), build_space(cfg)
+    wrong = ParameterSpace(("kappa_i", "c"), space.lower, space.upper)
+    result = compare(data, [Contender("bar", operator, space), Contender("broken", operator, wrong)],
+                     posterior=PosteriorSettings(samples_per_round=8, max_rounds=1, target_ess=4.0), n=4, k=2,
+                     max_iterations=1, max_starts=1)
+    assert [s.label for s in result.scores] == ["bar"] and result.best.label == "bar"
+    assert "broken" in result.failures and "ValueError" in result.failures["broken"]
+    assert any("broken: not compared" in line for line in result.notes())

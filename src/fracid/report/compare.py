@@ -61,28 +61,39 @@ def fits_figure(result):
     return fig
 
 
+#: the evidence figure adds a panel of the models within this many log units of the best when others lie
+#: further off (their spread would hide the error bars of the close ones)
+ZOOM = 10.0
+
+
 def evidence_figure(result):
     """The log evidence of every model with +- :data:`TIE_SIGMAS` Monte-Carlo standard errors (bars) and the
-    Laplace approximation (open marker), best at the top; None when no model has one."""
+    Laplace approximation (open marker), best at the top, and beside it the models within :data:`ZOOM` of the
+    best when some lie further; None when no model has a log evidence."""
     scores = [s for s in result.scores if np.isfinite(s.log_evidence)]
     if not scores:
         return None
-    fig = new_figure(6.4, 0.6 * len(scores) + 1.6)
-    ax = fig.subplots()
+    near = [s for s in scores if scores[0].log_evidence - s.log_evidence <= ZOOM]
+    panels = [scores] if len(near) in (1, len(scores)) else [scores, near]
+    fig = new_figure(6.4 * len(panels), 0.6 * len(scores) + 1.6)
+    for ax, shown in zip(np.atleast_1d(fig.subplots(1, len(panels))), panels):
+        _evidence_panel(ax, shown)
+    return fig
+
+
+def _evidence_panel(ax, scores) -> None:
     rows = np.arange(len(scores))[::-1]
-    z = np.array([s.log_evidence for s in scores])
-    ax.errorbar(z, rows, xerr=TIE_SIGMAS * np.array([s.log_evidence_error for s in scores]), fmt="o", color="k",
-                capsize=4, label=f"log Z +/- {TIE_SIGMAS:g} MC std")
+    ax.errorbar([s.log_evidence for s in scores], rows, xerr=TIE_SIGMAS * np.array([s.log_evidence_error for s in scores]),
+                fmt="o", color="k", capsize=4, label=f"log Z +/- {TIE_SIGMAS:g} MC std")
     ax.plot([s.log_evidence_laplace for s in scores], rows, "s", mfc="none", color="#d62728", label="Laplace")
     for row, s in zip(rows, scores):
-        ax.annotate(f"{s.evidence_text()}", (s.log_evidence, row), textcoords="offset points", xytext=(0, 7),
-                    ha="center", fontsize="x-small")
+        ax.annotate(s.evidence_text(), (s.log_evidence, row), textcoords="offset points", xytext=(0, 7), ha="center",
+                    fontsize="x-small")
     ax.set_yticks(rows, [s.label for s in scores])
     ax.set_ylim(-0.7, len(scores) - 0.3)
     ax.set_xlabel("log evidence [-]")
     ax.grid(True, axis="x", alpha=0.3)
     ax.legend(fontsize="small")
-    return fig
 
 
 def _model_section(score) -> str:

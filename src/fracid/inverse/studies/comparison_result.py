@@ -152,7 +152,8 @@ class ModelScore:
             "log_evidence_laplace": self.log_evidence_laplace, "delta_log_evidence": self.delta,
             "tied_with_best": self.tied, "posterior_status": self.posterior_status,
             "posterior": post.to_dict() if post is not None else None, "verdict": self.verdict.as_dict(),
-            "y_fit": np.asarray(ident.y_fit, float), "forward_runs": ident.forward_runs, "seconds": self.seconds})
+            "y_fit": np.asarray(ident.y_fit, float), "forward_runs": ident.forward_runs,
+            "stage_runs": ident.stage_runs(), "seconds": self.seconds})
 
 
 #: the ranking table's columns (:meth:`ComparisonResult.table`)
