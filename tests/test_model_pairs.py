@@ -14,6 +14,7 @@ PAIRS = {
     "integral-damage": {BarWithWeakZone, NotchedBeam, DogBone, WedgeSplitting},
     "cohesive-crack": {NotchedBeam, DogBone, WedgeSplitting},
     "crack-band": {NotchedBeam, DogBone, TensionStrip, WedgeSplitting},
+    "pf-czm": {BarWithWeakZone, NotchedBeam, DogBone, TensionStrip, WedgeSplitting},
 }
 
 

@@ -23,7 +23,8 @@ from fracid.inverse.core.settings import COMMENT_COLUMN, toml_line
 
 #: the parameters a first identification looks for, per ``[model] type`` (others: the two after E and nu)
 IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("kappa_i", "beta", "c"),
-              "local-damage": ("kappa_i", "beta"), "cohesive-crack": ("ft", "Gf"), "crack-band": ("ft", "Gf")}
+              "local-damage": ("kappa_i", "beta"), "cohesive-crack": ("ft", "Gf"), "crack-band": ("ft", "Gf"),
+              "pf-czm": ("ft", "Gf")}
 #: (specimen, model) whose configuration is the bundled demo's, with its data file
 DEMO_PAIR = ("notched-beam", "gradient-damage")
 _ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")

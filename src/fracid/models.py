@@ -52,12 +52,14 @@ from fracid.fem.mesh.probes import probe_matrix
 from fracid.fem.material.tsl import differentiable as gives_derivatives
 from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOptions, follow_path
 from fracid.fem.formulations.problem import FORMULATIONS
+from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
+from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
 from fracid.model_protocol import ForwardModel, ModelDefaults, declared, runs_on
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
 __all__ = ["IMPLAUSIBLE_FACTOR", "probe_matrix", "MODEL_TYPES", "USUAL_RANGES", "CohesiveCrackModel", "ConvergenceError",
-           "CrackBandModel", "DamageModel", "ForwardModel", "ModelDefaults", "PathResult", "StepOptions", "declared",
+           "CrackBandModel", "DamageModel", "PhaseFieldModel", "ForwardModel", "ModelDefaults", "PathResult", "StepOptions", "declared",
            "implausible", "known_units", "model_from_type", "model_laws", "parameter_units", "runs_on", "usual_range_text"]
 
 
@@ -263,6 +265,41 @@ class CrackBandModel(_CrackModel):
         return {}
 
 
+@dataclass(frozen=True)
+class PhaseFieldModel(PathFollowingModel):
+    """The phase-field regularised cohesive zone model (PF-CZM; Wu 2017, docs/theory.md, section 7): the
+    displacements and a crack phase field of length scale ``l`` solved together, whose global response follows
+    the cohesive law of its softening shape (Cornelissen's by default; linear, exponential) for any l fine enough
+    for the mesh (h <= l / 5 where the crack runs). Runs wherever a damage model runs, and reads a specimen's
+    strength imperfection.
+    """
+
+    law: PhaseFieldSoftening = PhaseFieldSoftening()
+
+    @property
+    def parameters(self) -> type:
+        return self.law.parameters
+
+    @property
+    def key(self) -> str:
+        """``pf-czm-<shape>``: runs of different softening shapes never share a key."""
+        return f"pf-czm-{self.law.name}"
+
+    @property
+    def differentiable(self) -> tuple:
+        return PhaseFieldProblem.differentiable
+
+    def build(self, specimen, params):
+        d = _description(specimen)
+        disc = discretize(d)
+        return PhaseFieldProblem(disc, params, conditions(d), stiffness_factor=at_points(d.stiffness_factor, disc),
+                                 damageable=at_points(d.damageable, disc),
+                                 strength_factor=at_points(d.strength_factor, disc))
+
+    def observers(self, description, params, damage_threshold: float = 0.0) -> dict:
+        return {}
+
+
 def known_units() -> dict:
     """Unit of every parameter name of the registered models (:data:`MODEL_TYPES`), those of the
     damage model first where two models share a name."""
@@ -281,11 +318,12 @@ def parameter_units(model_or_params) -> dict:
 
 #: The usual values of the parameters of the registered models for quasi-brittle materials (concrete, mortar,
 #: rock), wide on purpose: name -> (lower, upper) in the unit of the parameter class (MPa, mm^2, N/mm, -).
-#: Concrete: kappa_i ~ 1e-4 (ft / E), c of a few mm^2, beta of a few hundred, ft of 2 to 5 MPa, Gf ~ 0.1 N/mm.
+#: Concrete: kappa_i ~ 1e-4 (ft / E), c of a few mm^2, beta of a few hundred, ft of 2 to 5 MPa, Gf ~ 0.1 N/mm; the
+#: PF-CZM's length scale l of a few mm and its shape constants (p, a2, a3) near Wu's (2, -0.5..1.4, 0..0.7).
 USUAL_RANGES = {
     "E": (5.0e3, 1.0e5), "nu": (0.0, 0.45), "kappa_i": (2.0e-5, 1.0e-3), "alpha": (0.0, 1.0), "beta": (10.0, 1.0e4),
     "c": (0.01, 1000.0), "eta": (1.0, 30.0), "ft": (0.5, 20.0), "Gf": (0.005, 1.0), "c1": (0.0, 10.0),
-    "c2": (1.0, 20.0),
+    "c2": (1.0, 20.0), "l": (0.1, 50.0), "p": (1.5, 5.0), "a2": (-0.5, 5.0), "a3": (0.0, 5.0),
 }
 
 #: A value further outside its usual range than this factor (above upper * factor, below lower / factor) is
@@ -334,6 +372,7 @@ MODEL_TYPES = {
     "integral-damage": lambda: DamageModel("integral"),
     "cohesive-crack": lambda: CohesiveCrackModel(),
     "crack-band": lambda: CrackBandModel(),
+    "pf-czm": lambda: PhaseFieldModel(),
 }
 
 
@@ -355,6 +394,8 @@ def model_from_type(name: str, law: str | None = None):
 
 def model_laws(model) -> dict:
     """The laws a configuration may give ``model`` by name (``[model] law``): the traction-separation laws
-    (:data:`~fracid.fem.material.laws.TRACTION_SEPARATION_LAWS`) for the crack models; none for the others
-    (their law is given in Python: ``DamageModel(law=...)``)."""
+    (:data:`~fracid.fem.material.laws.TRACTION_SEPARATION_LAWS`) for the crack models, the softening shapes (:data:`~fracid.fem.material.phase_field.PHASE_FIELD_SHAPES`) for the PF-CZM; none for
+    the others (their law is given in Python: ``DamageModel(law=...)``)."""
+    if isinstance(model, PhaseFieldModel):
+        return dict(PHASE_FIELD_SHAPES)
     return dict(TRACTION_SEPARATION_LAWS) if isinstance(model, _CrackModel) else {}

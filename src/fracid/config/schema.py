@@ -14,11 +14,14 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     type = "gradient-damage"            # any name of fracid.models.MODEL_TYPES, read when the file is
                                         #   validated: "gradient-damage" | "local-damage" (mesh-
                                         #   dependent) | "cohesive-crack" (Hordijk crack on the beam's
-                                        #   ligament; parameters E nu ft Gf c1 c2) | models added later
+                                        #   ligament; parameters E nu ft Gf c1 c2) | "crack-band" |
+                                        #   "pf-czm" (phase-field cohesive zone model; E nu ft Gf l p a2 a3)
     law = "hordijk"                     # optional, cohesive-crack and crack-band: the traction-separation
                                         #   law by name (fracid.fem.material.laws.TRACTION_SEPARATION_LAWS):
                                         #   "hordijk" (default) | "linear" | "bilinear"; the parameters are
-                                        #   then the law's (linear: E nu ft Gf; bilinear: + psi chi)
+                                        #   then the law's (linear: E nu ft Gf; bilinear: + psi chi);
+                                        #   pf-czm: the softening shape "cornelissen" (default) |
+                                        #   "linear" | "exponential" (parameters E nu ft Gf l p a2 a3)
     [model.parameters]                  # any subset of the model's parameters (its parameter class's
                                         # names(); checked by its own validation); the rest take the
                                         # class's defaults. Gradient and local damage (DamageParameters):

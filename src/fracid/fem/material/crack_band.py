@@ -37,6 +37,30 @@ import numpy as np
 from fracid.fem.material.damage import update_history
 
 
+def major_principal(s):
+    """Major principal value lambda_1 of stress-like tensors in Voigt components and d lambda_1 / ds.
+
+    Parameters
+    ----------
+    s : ndarray, shape (..., 1) or (..., 3)
+        A uniaxial value, or plane (sxx, syy, sxy).
+
+    Returns
+    -------
+    lam : ndarray, shape (...)
+    dlam : ndarray, shape s.shape
+    """
+    s = np.asarray(s, dtype=float)
+    if s.shape[-1] == 1:
+        return s[..., 0], np.ones_like(s)
+    m = 0.5 * (s[..., 0] + s[..., 1])
+    a = 0.5 * (s[..., 0] - s[..., 1])
+    t = s[..., 2]
+    r = np.maximum(np.hypot(a, t), 1e-12 * np.abs(m) + 1e-30)
+    dlam = np.stack([0.5 + 0.5 * a / r, 0.5 - 0.5 * a / r, t / r], axis=-1)
+    return m + r, dlam
+
+
 def principal_tension(s):
     """Major principal value of plane stress-like tensors, its tensile part on its projector, and
     their derivatives.
