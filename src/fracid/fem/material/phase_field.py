@@ -39,7 +39,7 @@ LENGTH = (Field("l", 2.5, ParameterRange(0.0, False, None, False, "mm"),
 
 
 def _shape_fields(p, a2, a3):
-    return (Field("p", p, ParameterRange(1.0, False, None, False, "-"), "Exponent of (1 - d) in the degradation"),
+    return (Field("p", p, ParameterRange(2.0, True, None, False, "-"), "Exponent of (1 - d) in the degradation"),
             Field("a2", a2, ParameterRange(-0.5, True, None, False, "-"),
                   "Softening shape: 2nd coefficient of Q(d) = a1 d (1 + a2 d + a2 a3 d^2)"),
             Field("a3", a3, ParameterRange(None, False, None, False, "-"), "Softening shape: 3rd coefficient of Q(d)"))
