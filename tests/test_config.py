@@ -697,6 +697,15 @@ def test_warnings(tmp_path):
     # the local model has no internal length: nothing to resolve
     cfg = load_config(write(tmp_path, BAR_SIMULATE.replace("n_elements = 120", "n_elements = 20")), purpose="simulate")
     assert cfg.warnings == ()
+    # the PF-CZM's mesh resolves l / 5 (l = 2.5 mm by default: elements of 100 / 200 mm pass, of 100 / 100 not)
+    pf_czm = (BAR_SIMULATE.replace('"local-damage"', '"pf-czm"').replace("kappa_i = 1e-4\nc = 2.0\n", "ft = 2.4\n")
+              .replace("damage_threshold = 0.1\n", ""))
+    assert load_config(write(tmp_path, pf_czm.replace("n_elements = 120", "n_elements = 200")), purpose="simulate").warnings == ()
+    (warning,) = load_config(write(tmp_path, pf_czm.replace("n_elements = 120", "n_elements = 100")),
+                             purpose="simulate").warnings
+    assert warning.startswith("specimen.n_elements = 100: the element size length / n_elements = 1 mm is larger than "
+                              "l / 5 (a fifth of the length scale) = 0.5 mm (with l = 2.5 mm (default)): the phase "
+                              "field's band is not resolved"), warning
 
 
 def test_mesh_size_is_counted_without_building_the_mesh():

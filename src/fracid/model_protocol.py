@@ -5,7 +5,30 @@ the defaults of a model that declares only ``key``, ``parameters`` and ``simulat
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import Callable, ClassVar, NamedTuple, Protocol, runtime_checkable
+
+
+class MeshLength(NamedTuple):
+    """The length a model's mesh must resolve where the crack runs, set by one of its parameters (a
+    configuration is warned when its element size there is larger).
+
+    Attributes
+    ----------
+    parameter, unit : str
+        The parameter it follows and the parameter's unit.
+    length : callable
+        Parameter value -> the largest element size [mm].
+    text : str
+        The length in words, e.g. ``"the internal length l = sqrt(2 c)"``.
+    band : str
+        What a coarser mesh does not resolve, e.g. ``"the damage band"``.
+    """
+
+    parameter: str
+    unit: str
+    length: Callable[[float], float]
+    text: str
+    band: str
 
 
 @runtime_checkable
@@ -39,6 +62,8 @@ class ModelDefaults:
     differentiates_observers: ClassVar[bool] = False
     observer_names: ClassVar[tuple] = ()
     regularization: ClassVar[str | None] = None
+    #: the length its mesh must resolve (:class:`MeshLength`), None: no such length
+    mesh_length: ClassVar[MeshLength | None] = None
 
     def why_not(self, specimen) -> str | None:
         return None

@@ -54,7 +54,7 @@ from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOpt
 from fracid.fem.formulations.problem import FORMULATIONS
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
-from fracid.model_protocol import ForwardModel, ModelDefaults, declared, runs_on
+from fracid.model_protocol import ForwardModel, MeshLength, ModelDefaults, declared, runs_on
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 
@@ -128,6 +128,14 @@ class DamageModel(PathFollowingModel):
     def key(self) -> str:
         suffix = "" if self.law.name == "exponential" else f"-{self.law.name}"
         return f"{self.regularization}-damage{suffix}"
+
+    @property
+    def mesh_length(self) -> MeshLength | None:
+        """The internal length l = sqrt(2 c) of the regularised formulations (none for local damage)."""
+        if self.regularization == "local":
+            return None
+        return MeshLength("c", "mm^2", lambda c: math.sqrt(2.0 * c), "the internal length l = sqrt(2 c)",
+                          "the damage band")
 
     def why_not(self, specimen):
         d = _description(specimen)
@@ -288,6 +296,10 @@ class PhaseFieldModel(PathFollowingModel):
     @property
     def differentiable(self) -> tuple:
         return PhaseFieldProblem.differentiable
+
+    #: h <= l / 5 where the crack runs (Wu 2017): the band's profile is then resolved
+    mesh_length: ClassVar[MeshLength] = MeshLength("l", "mm", lambda l: l / 5.0, "l / 5 (a fifth of the length scale)",
+                                                   "the phase field's band")
 
     def build(self, specimen, params):
         d = _description(specimen)

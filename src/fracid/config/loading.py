@@ -5,7 +5,6 @@ internal length)."""
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import sys
 from pathlib import Path
@@ -13,9 +12,10 @@ from pathlib import Path
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, Checker, read_toml
 from fracid.config.experiments import read_experiments
 from fracid.config.identify import check_refinable, read_identify
-from fracid.config.mesh_section import c_range
+from fracid.config.mesh_section import parameter_range
 from fracid.config.posterior import read_posterior
-from fracid.config.registry import section_reader, specimen_class
+from fracid.config.registry import model_of, section_reader, specimen_class
+from fracid.model_protocol import declared
 from fracid.config.schema import (
     Config,
     ConfigError,
@@ -99,18 +99,20 @@ def _config_path(path) -> tuple[Path, bytes | None]:
 
 
 def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:
-    """Warn when the element size in the process zone exceeds the internal length l = sqrt(2 c) of a
-    gradient or integral damage model (the smallest c: the given one, or the lower bound when c is
-    identified): the damage band, a few l wide, is then not resolved and the results depend on the mesh.
+    """Warn when the element size in the process zone exceeds the length the model's mesh must resolve (its
+    :class:`~fracid.model_protocol.MeshLength`: the internal length l = sqrt(2 c) of a gradient or integral damage
+    model, l / 5 of the PF-CZM) at the smallest value of its parameter (the given one, or the lower bound when it is
+    identified): the band is then not resolved and the results depend on the mesh.
 
     The element size, the key that sets it and the advice are the specimen's
     (:meth:`~fracid.specimens.protocol.Specimen.resolution`): ``h_fine`` of the notched beam, ``length /
     n_elements`` of the bar, the smallest element side of a mesh file.
     """
-    if model.regularization not in ("gradient", "integral"):
+    resolved = declared(model_of(model.type, model.law)).mesh_length
+    if resolved is None:
         return
-    (c, where), _ = c_range(model, identify)
-    length = math.sqrt(2.0 * c)
+    (value, where), _ = parameter_range(model, identify, resolved.parameter, resolved.unit)
+    length = resolved.length(value)
     variants = [("specimen", dict(specimen.options), dict(specimen.options))]
     variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))
                  for e in experiments if e.specimen]
@@ -124,5 +126,5 @@ def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, ex
         if resolution.field is not None:
             key, default = field_key(prefix, resolution.field, options, given)
             size = f"{key} = {value_text(resolution.value)}{default if resolution.field in fields else ''}: {resolution.text}"
-        ck.warn(f"{size} is larger than the internal length l = sqrt(2 c) = {length:.3g} mm (with {where}): "
-                f"the damage band is not resolved and the results depend on the mesh; {resolution.advice}")
+        ck.warn(f"{size} is larger than {resolved.text} = {length:.3g} mm (with {where}): "
+                f"{resolved.band} is not resolved and the results depend on the mesh; {resolution.advice}")

@@ -244,12 +244,18 @@ def check_mesh_units(ck: Checker, model, specimen: SpecimenConfig, identify) -> 
 
 def c_range(model, identify) -> tuple:
     """((smallest c, where), (largest c, where)) [mm^2] of the model's c and the bounds of an identified c."""
-    c = model_parameters(model).c
-    values = [(c, f"c = {c:g} mm^2" + ("" if "c" in dict(model.parameters) else " (default)"))]
-    if identify is not None and "c" in identify.parameters:
-        i = identify.parameters.index("c")
-        values += [(identify.lower[i], f"the lower bound c = {identify.lower[i]:g} mm^2 of identify.bounds.c"),
-                   (identify.upper[i], f"the upper bound c = {identify.upper[i]:g} mm^2 of identify.bounds.c")]
+    return parameter_range(model, identify, "c", "mm^2")
+
+
+def parameter_range(model, identify, name: str, unit: str) -> tuple:
+    """((smallest value, where), (largest value, where)) of the model's parameter ``name`` [``unit``] and the bounds
+    of ``name`` when it is identified."""
+    value = getattr(model_parameters(model), name)
+    values = [(value, f"{name} = {value:g} {unit}" + ("" if name in dict(model.parameters) else " (default)"))]
+    if identify is not None and name in identify.parameters:
+        i = identify.parameters.index(name)
+        values += [(identify.lower[i], f"the lower bound {name} = {identify.lower[i]:g} {unit} of identify.bounds.{name}"),
+                   (identify.upper[i], f"the upper bound {name} = {identify.upper[i]:g} {unit} of identify.bounds.{name}")]
     return min(values), max(values)
 
 
