@@ -6,11 +6,12 @@ import pytest
 
 import fracid
 from fracid.models import DamageModel
-from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh, write_gmsh
+from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh
 
 meshio = pytest.importorskip("meshio")
 
 from hostile_mesh import H, L, grid, strip_config, two_halves, write_msh  # noqa: E402 -- shared with the hostile cases
+from _gmsh_beam import beam_msh  # noqa: E402 -- shared with the PF-CZM tests
 
 T, E = 5.0, 30000.0
 
@@ -210,15 +211,6 @@ def test_bad_specimen_fields():
     with pytest.raises(ValueError, match="component 'z'; use 'x' or 'y'"):
         from fracid.specimens.mesh import _component
         _component("z", "supports")
-
-
-def beam_msh(beam, path, triangles=False):
-    """The half beam's mesh written by write_gmsh (its node sets as groups) and described as a MeshSpecimen."""
-    write_gmsh(beam.describe(), path, triangles=triangles)
-    return MeshSpecimen(str(path), thickness=beam.thickness, supports=(("support", "y"),),
-                        loads=(("loading_plate", "y", True, -0.5),), symmetry=(("ligament", "x"),),
-                        controls=(("cmod", (("mouth", "x", 2.0),)), ("deflection", (("loading_plate", "y", -1.0),))),
-                        symmetry_factor=2.0, crack=("ligament", "x", beam.h_fine))
 
 
 PEER = fracid.DamageParameters(E=37000.0, nu=0.2, kappa_i=1.1e-4, alpha=0.99, beta=500.0, c=4.0, eta=10.0)

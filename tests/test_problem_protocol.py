@@ -20,7 +20,7 @@ def test_every_problem_implements_the_protocol(kind):
     problem = model.build(BEAM, params)
     assert isinstance(problem, Problem)
     assert set(problem.functionals) == {"cmod", "deflection"} and problem.load_vector.shape == (problem.n_free,)
-    assert set(problem.blocks) <= {"u", "ebar"} and problem.element_dofs.max() < problem.n_free
+    assert set(problem.blocks) <= {"u", "ebar", "d"} and problem.element_dofs.max() < problem.n_free
     # its declared history is the layout of the history the path starts from
     assert np.shape(allocate_history(problem.history_spec, problem.disc)) == np.shape(initial_history(problem))
 
