@@ -71,7 +71,6 @@ class PhaseFieldProblem(ContinuumProblem):
         self.a1 = pf.a1(params.E, self.ft, params.Gf, params.l)
         self.k1 = params.Gf / (pf.C_ALPHA * params.l)  # Gf / (c_alpha l) [MPa]
         self.k2 = 2.0 * params.Gf * params.l / pf.C_ALPHA  # 2 l^2 Gf / (c_alpha l) [N]
-        self.mass_weights = disc.weights  # int N N^T of the d equation's local terms
         self.laplacian = gradient_matrix(self.space, disc.weights)  # int grad N^T grad N, (n_el, n_e, n_e)
         self.n_u = self.dofs.n_u
 
@@ -81,8 +80,9 @@ class PhaseFieldProblem(ContinuumProblem):
         return {"h": HistoryVariable()}
 
     def onset_ratio(self, history) -> float:
-        """Largest effective major principal stress reached relative to the strength (< 1: no crack yet)."""
-        return float(np.max(history * self.params.E / self.ft))
+        """Largest effective major principal stress reached relative to where the rounded threshold starts to
+        drive d, (1 - ONSET_ROUNDING) ft (< 1: no crack yet)."""
+        return float(np.max(history * self.params.E / self.ft)) / (1.0 - pf.ONSET_ROUNDING)
 
     def _state(self, qe, h_old):
         """What the residual, the tangent and the derivatives share at element dof values ``qe``."""
@@ -107,7 +107,7 @@ class PhaseFieldProblem(ContinuumProblem):
         bt_s = bt(st["s"], B)  # B^T D eps per unit E, (n_el, n_q, n_u)
         w_E = w * const.E
         f_u = np.einsum("eqi,eq->ei", bt_s, w_E * st["g"])
-        alpha1 = 2.0 - 2.0 * st["d"]
+        _, alpha1, alpha2 = pf.geometric(st["d"])
         local = self.k1 * alpha1 + st["g1"] * st["Y"]
         f_d = (w * local) @ N + self.k2 * np.einsum("eij,ej->ei", self.laplacian, st["de"])
         reference = (w * np.abs(st["g1"]) * st["Y"]) @ N
@@ -119,7 +119,7 @@ class PhaseFieldProblem(ContinuumProblem):
             # at loading points dY / du = dY / dh d lambda_1 / d s . D B
             dY = bt(st["dlam"], const.DB) * (st["dY_dh"] * st["loading"])[..., None]
             out[:, nu:, :nu] = np.matmul(N.T, dY * (w * st["g1"])[..., None])
-            local_slope = w * (-2.0 * self.k1 + st["g2"] * st["Y"])
+            local_slope = w * (self.k1 * alpha2 + st["g2"] * st["Y"])
             out[:, nu:, nu:] = np.einsum("qi,eq,qj->eij", N, local_slope, N) + self.k2 * self.laplacian
             return out
 
@@ -160,7 +160,7 @@ class PhaseFieldProblem(ContinuumProblem):
         force = ds.equilibrium_pseudo_load(disc, params, const, st["ue"], omega, -np.where(mask, g_rate, 0.0), names,
                                            stress)
         local_rate = g1_rate * st["Y"][..., None] + st["g1"][..., None] * Y_rate
-        alpha1 = 2.0 - 2.0 * st["d"]
+        _, alpha1, _ = pf.geometric(st["d"])
         laplace_d = np.einsum("eij,ej->ei", self.laplacian, st["de"])
         for name, k1_rate, k2_rate in (("Gf", self.k1 / params.Gf, self.k2 / params.Gf),
                                        ("l", -self.k1 / params.l, self.k2 / params.l)):
