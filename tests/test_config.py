@@ -706,6 +706,7 @@ def test_warnings(tmp_path):
     assert warning.startswith("specimen.n_elements = 100: the element size length / n_elements = 1 mm is larger than "
                               "l / 5 (a fifth of the length scale) = 0.5 mm (with l = 2.5 mm (default)): the phase "
                               "field's band is not resolved"), warning
+    assert warning.endswith("make the elements where the crack runs 0.5 mm or smaller")
 
 
 def test_mesh_size_is_counted_without_building_the_mesh():

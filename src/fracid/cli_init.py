@@ -29,7 +29,7 @@ IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("
 DEMO_PAIR = ("notched-beam", "gradient-damage")
 _ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
 #: specimen fields changed from their defaults for a pair, and why (the written comment says so)
-_PF_MESH = "h <= l / 5 = 0.5 mm where the crack runs resolves the phase field's band (l = 2.5 mm)"
+_PF_MESH = "a finer mesh where the crack runs, h <= l / 5 = 0.5 mm, resolves the phase field's band (l = 2.5 mm)"
 PAIR_SPECIMEN = {("wedge-splitting", "crack-band"): ({"h_fine": 4.0}, "at h_fine = 5 the crack band stops converging "
                                                       "after the peak (cmod 0.046 mm); 4 runs through"),
                  **{(kind, "pf-czm"): ({"h_fine": 0.5}, _PF_MESH) for kind in ("notched-beam", "dogbone", "wedge-splitting")},

@@ -22,6 +22,9 @@ class MeshLength(NamedTuple):
         The length in words, e.g. ``"the internal length l = sqrt(2 c)"``.
     band : str
         What a coarser mesh does not resolve, e.g. ``"the damage band"``.
+    advice : str or None
+        What to do, with ``{size}`` the largest element size [mm]; None: the specimen's advice
+        (:meth:`~fracid.specimens.protocol.Specimen.resolution`, written for h <= l / 2 of an internal length).
     """
 
     parameter: str
@@ -29,6 +32,7 @@ class MeshLength(NamedTuple):
     length: Callable[[float], float]
     text: str
     band: str
+    advice: str | None = None
 
 
 @runtime_checkable

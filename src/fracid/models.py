@@ -299,7 +299,8 @@ class PhaseFieldModel(PathFollowingModel):
 
     #: h <= l / 5 where the crack runs (Wu 2017): the band's profile is then resolved
     mesh_length: ClassVar[MeshLength] = MeshLength("l", "mm", lambda l: l / 5.0, "l / 5 (a fifth of the length scale)",
-                                                   "the phase field's band")
+                                                   "the phase field's band",
+                                                   "make the elements where the crack runs {size:.3g} mm or smaller")
 
     def build(self, specimen, params):
         d = _description(specimen)

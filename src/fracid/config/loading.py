@@ -126,5 +126,6 @@ def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, ex
         if resolution.field is not None:
             key, default = field_key(prefix, resolution.field, options, given)
             size = f"{key} = {value_text(resolution.value)}{default if resolution.field in fields else ''}: {resolution.text}"
+        advice = resolution.advice if resolved.advice is None else resolved.advice.format(size=length)
         ck.warn(f"{size} is larger than {resolved.text} = {length:.3g} mm (with {where}): "
-                f"{resolved.band} is not resolved and the results depend on the mesh; {resolution.advice}")
+                f"{resolved.band} is not resolved and the results depend on the mesh; {advice}")
