@@ -53,12 +53,18 @@ def major_principal(s):
     s = np.asarray(s, dtype=float)
     if s.shape[-1] == 1:
         return s[..., 0], np.ones_like(s)
+    m, a, t, r = _plane_invariants(s)
+    dlam = np.stack([0.5 + 0.5 * a / r, 0.5 - 0.5 * a / r, t / r], axis=-1)
+    return m + r, dlam
+
+
+def _plane_invariants(s):
+    """m = (sxx + syy) / 2, a = (sxx - syy) / 2, sxy and r = sqrt(a^2 + sxy^2) (kept above 1e-12 |m| + 1e-30,
+    see :func:`principal_tension`): lambda_1,2 = m +- r."""
     m = 0.5 * (s[..., 0] + s[..., 1])
     a = 0.5 * (s[..., 0] - s[..., 1])
     t = s[..., 2]
-    r = np.maximum(np.hypot(a, t), 1e-12 * np.abs(m) + 1e-30)
-    dlam = np.stack([0.5 + 0.5 * a / r, 0.5 - 0.5 * a / r, t / r], axis=-1)
-    return m + r, dlam
+    return m, a, t, np.maximum(np.hypot(a, t), 1e-12 * np.abs(m) + 1e-30)
 
 
 def principal_tension(s):
@@ -90,10 +96,7 @@ def principal_tension(s):
     above 1e-12 |m| + 1e-30 there (the damage term then acts along an arbitrary but fixed axis).
     """
     s = np.asarray(s, dtype=float)
-    m = 0.5 * (s[..., 0] + s[..., 1])
-    a = 0.5 * (s[..., 0] - s[..., 1])
-    t = s[..., 2]
-    r = np.maximum(np.hypot(a, t), 1e-12 * np.abs(m) + 1e-30)
+    m, a, t, r = _plane_invariants(s)
     lam = m + r
     ones = np.array([1.0, 1.0, 0.0])
     u = np.stack([a, -a, t], axis=-1)

@@ -45,10 +45,15 @@ def _shape_fields(p, a2, a3):
             Field("a3", a3, ParameterRange(None, False, None, False, "-"), "Softening shape: 3rd coefficient of Q(d)"))
 
 
+def shape_polynomial(d, a2, a3):
+    """P(d) = 1 + a2 d + a2 a3 d^2 of the softening shape: Q(d) = a1 d P(d)."""
+    return 1.0 + a2 * d + a2 * a3 * d * d
+
+
 def _check_shape(params):
     """Q(d) / d = a1 (1 + a2 d + a2 a3 d^2) must stay positive on (0, 1] (a degradation in (0, 1))."""
     d = np.linspace(0.0, 1.0, 201)
-    if np.min(1.0 + params.a2 * d + params.a2 * params.a3 * d**2) <= 0.0:
+    if np.min(shape_polynomial(d, params.a2, params.a3)) <= 0.0:
         raise ValueError(f"a2 = {params.a2:g}, a3 = {params.a3:g}: 1 + a2 d + a2 a3 d^2 must stay positive for "
                          "0 <= d <= 1 (else the degradation leaves (0, 1]); the shapes of Wu & Nguyen (2018): "
                          + ", ".join(f"{name} {shape}" for name, shape in SHAPES.items()))
@@ -88,7 +93,7 @@ def _parts(d, a_1, p, a2, a3):
     P = r**p
     P1 = -p * r ** (p - 1.0)
     P2 = p * (p - 1.0) * np.maximum(r, 1e-12) ** (p - 2.0)
-    Q = a_1 * d * (1.0 + a2 * d + a2 * a3 * d**2)
+    Q = a_1 * d * shape_polynomial(d, a2, a3)
     Q1 = a_1 * (1.0 + 2.0 * a2 * d + 3.0 * a2 * a3 * d**2)
     Q2 = a_1 * (2.0 * a2 + 6.0 * a2 * a3 * d)
     return r, (P, P1, P2), (Q, Q1, Q2)

@@ -63,7 +63,7 @@ from scipy.optimize import brentq
 
 from fracid.fem.material.cohesive import hordijk_stress
 from fracid.fem.material.phase_field import C_ALPHA, SHAPES, a1 as a1_coefficient, geometric
-from fracid.fem.material.phase_field import degradation as _degradation
+from fracid.fem.material.phase_field import degradation as _degradation, shape_polynomial
 
 #: Cornelissen / Hordijk's constants of the nominal law: c1, c2 and wc ft / Gf
 HORDIJK_C1 = 3.0
@@ -111,11 +111,6 @@ def degradation(d, E, ft, Gf, l, p, a2, a3):
     return _degradation(d, a1_coefficient(E, ft, Gf, l), p, a2, a3)[0]
 
 
-def _poly(d, a2, a3):
-    """P(d) = 1 + a2 d + a2 a3 d^2, Q(d) = a1 d P(d)."""
-    return 1.0 + a2 * d + a2 * a3 * d * d
-
-
 def _validate(E, ft, Gf, l, p, a2, a3):
     for name, value in (("E", E), ("ft", ft), ("Gf", Gf), ("l", l)):
         if not (np.isscalar(value) and np.isreal(value) and math.isfinite(value) and value > 0.0):
@@ -126,7 +121,7 @@ def _validate(E, ft, Gf, l, p, a2, a3):
     if p < 2.0:
         raise ValueError(f"p = {p!r}: must be >= 2 (for p < 2 the opening closes again as d* -> 1)")
     d = np.linspace(0.0, 1.0, 401)
-    if np.min(_poly(d, a2, a3)) <= 0.0:
+    if np.min(shape_polynomial(d, a2, a3)) <= 0.0:
         raise ValueError(f"a2 = {a2!r}, a3 = {a3!r}: 1 + a2 d + a2 a3 d^2 must stay positive on [0, 1]")
     # the stress must fall monotonically with d*: R = alpha / omega strictly decreasing on [0, 1)
     d = d[:-1]
@@ -138,13 +133,13 @@ def _rho(d, p, a2, a3, u=None):
     """rho(d) = a1 R(d) = a1 alpha / omega = (2 - d) u^p / P(d) [-], u = 1 - d (pass it when it is known more
     accurately than 1 - d); sigma^2 / ft^2 = rho(d*) / 2."""
     u = np.maximum(1.0 - d, 0.0) if u is None else u
-    return (2.0 - d) * u**p / _poly(d, a2, a3)
+    return (2.0 - d) * u**p / shape_polynomial(d, a2, a3)
 
 
 def _dlogR(d, p, a2, a3, u=None):
     """d log R / d d = -1 / (2 - d) - p / u - P'(d) / P(d), u = 1 - d > 0."""
     u = 1.0 - d if u is None else u
-    return -1.0 / (2.0 - d) - p / u - (a2 + 2.0 * a2 * a3 * d) / _poly(d, a2, a3)
+    return -1.0 / (2.0 - d) - p / u - (a2 + 2.0 * a2 * a3 * d) / shape_polynomial(d, a2, a3)
 
 
 def _opening_integral(d_star, delta, p, a2, a3):
@@ -267,7 +262,7 @@ def ultimate_opening(ft, Gf, p, a2, a3):
     _validate(1.0, ft, Gf, 1.0, p, a2, a3)
     if p > 2.0:
         return math.inf
-    return 2.0 * math.sqrt(2.0 * _poly(1.0, a2, a3)) * Gf / ft
+    return 2.0 * math.sqrt(2.0 * shape_polynomial(1.0, a2, a3)) * Gf / ft
 
 
 def crack_opening(centre_values, E, ft, Gf, l, p, a2, a3):
