@@ -72,13 +72,21 @@ def modified_von_mises_plane_stress(strain, nu, eta):
     d_eps_eq : ndarray, shape (..., 3)
         Total derivative with respect to (exx, eyy, gxy), through ezz as well.
     """
+    # in closed form (no 6-component state): with k = nu / (1 - nu) and s = exx + eyy, ezz = -k s,
+    # I1 = (1 - k) s and J2 = (exx^2 + eyy^2 - exx eyy + k (k + 1) s^2) / 3 + gxy^2 / 4
     e = np.asarray(strain, dtype=float)
-    ezz = -nu / (1.0 - nu) * (e[..., 0] + e[..., 1])
-    zeros = np.zeros_like(ezz)
-    full = np.stack([e[..., 0], e[..., 1], ezz, e[..., 2], zeros, zeros], axis=-1)
-    eps_eq, d = modified_von_mises_3d(full, nu, eta)
-    d_ezz = d[..., 2:3] * (-nu / (1.0 - nu))
-    return eps_eq, np.concatenate([d[..., :2] + d_ezz, d[..., 3:4]], axis=-1)
+    exx, eyy, gxy = e[..., 0], e[..., 1], e[..., 2]
+    k = nu / (1.0 - nu)
+    s = exx + eyy
+    kk = 2.0 * k * (k + 1.0) * s
+    J2 = (exx * exx + eyy * eyy - exx * eyy + 0.5 * kk * s) / 3.0 + 0.25 * gxy * gxy
+    eps_eq, d_I1, d_J2 = _from_invariants((1.0 - k) * s, J2, nu, eta)
+    d = np.empty(e.shape)
+    volumetric = (1.0 - k) * d_I1
+    d[..., 0] = volumetric + d_J2 * (2.0 * exx - eyy + kk) / 3.0
+    d[..., 1] = volumetric + d_J2 * (2.0 * eyy - exx + kk) / 3.0
+    d[..., 2] = d_J2 * 0.5 * gxy
+    return eps_eq, d
 
 
 def modified_von_mises_uniaxial(strain, nu, eta):

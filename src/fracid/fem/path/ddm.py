@@ -9,12 +9,17 @@ parameters x gives the bordered system of the step's consistent tangent
 
 with d r / d x taken at fixed q (the formulation's pseudo-load, which carries the history
 variables' derivatives from the last step; docs/theory.md, section 6). :class:`PathDerivatives`
-factorizes the converged bordered tangent and hands the factorization on: it is what the next
-increment's Newton iterations start with (modified Newton keeps it while the residual falls fast),
-so the derivatives cost a factorization, a pseudo-load, one solve with p right-hand sides (its residual
-checked, :func:`~fracid.fem.path.linear_backend.refine`) and the history update per step. (Iterative refinement with the factorization modified Newton last kept, of
-an older tangent, was slower on the demo beam: 5.9 s against 4.3 s per run; so was PARDISO's CGS preconditioned
-by the LU it holds, benchmarks/ddm_preconditioned.py: 3 to 7 iterations per step, 2.48 s against 2.05 s.)
+factorizes the converged bordered tangent: the derivatives cost a factorization, a pseudo-load, one
+solve with p right-hand sides (its residual checked, :func:`~fracid.fem.path.linear_backend.refine`) and
+the history update per step. :class:`ConcurrentDerivatives` (the default, ``BESIDE_PATH``) runs these
+steps in a thread of their own while the path solves the next step: on the demo beam a run with three
+parameters' derivatives costs 1.5 plain runs with PARDISO (2.0 in the path's thread) and the path is the
+plain run's to the last digit (benchmarks/sensitivities.py). In the path's thread the factorization is
+handed on: it starts the next increment's Newton iterations. (Iterative refinement with the
+factorization modified Newton last kept, of an older tangent, was slower on the demo beam: 5.9 s against
+4.3 s per run; so was PARDISO's CGS preconditioned by the LU it holds, benchmarks/ddm_preconditioned.py: 3
+to 7 iterations per step, 2.48 s against 2.05 s; and GMRES preconditioned by it, 4 to 10 iterations per
+right-hand side, 1.27 s against 0.73 s of factorizations and solves over the 88 steps.)
 
 The derivatives are those of the discrete path at the steps' control values: the step sequence is
 held, as the central differences of runs that land on the same control values (``checkpoints``) see it.
@@ -22,15 +27,22 @@ held, as the central differences of runs that land on the same control values (`
 
 from __future__ import annotations
 
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from fracid.fem.mesh.assembly import dot
-from fracid.fem.path.linear_solvers import factorize
+from fracid.fem.path.linear_solvers import factorize, linear_solver
+from fracid.fem.path.solver import SolverStatistics
 from fracid.fem.path.linear_backend import refine
 from fracid.fem.formulations.protocol import initial_history
 
+
+#: whether a path's derivatives run beside it, in a thread of their own (:class:`ConcurrentDerivatives`);
+#: False: in the path's thread, each step's factorization then starting the next increment
+BESIDE_PATH = True
 
 #: relative residual of the derivatives' solve (equilibrated bordered system) above which it is refined
 DERIVATIVE_RTOL = 1e-10
@@ -130,6 +142,64 @@ class PathDerivatives:
         if self.probes is not None:
             out["probed"] = self.probed
         return out
+
+
+class ConcurrentDerivatives:
+    """The steps of :class:`PathDerivatives` in a thread of their own, one step behind the path.
+
+    The path never needs its derivatives (they need the path): the derivatives of step n (the
+    factorization of its converged tangent, the solve and the history update) run while the path's
+    Newton iterations solve step n + 1. The linear solvers release the GIL in their factorizations
+    and solves, so on a second core a run with derivatives takes little more than a plain run; and
+    the path is the plain run's to the last digit (its modified Newton no longer starts from the
+    derivatives' factorization). On one core it costs what the steps one after the other cost.
+
+    The element tangents are copied here, in the path's thread, before it goes on: the next iteration
+    overwrites the problem's buffer. The derivatives' thread is one per process, with its
+    own linear solver (:func:`~fracid.fem.path.linear_solvers.linear_solver` keeps one per thread and
+    backend), shared by the runs of the process one step at a time.
+
+    Parameters
+    ----------
+    derivatives : PathDerivatives
+    solver : str or None
+        The backend's name (a solver instance cannot be shared between threads: use
+        :meth:`PathDerivatives.step` directly).
+    """
+
+    def __init__(self, derivatives: PathDerivatives, solver):
+        self.derivatives, self.solver = derivatives, solver
+        self.stats = SolverStatistics()
+        self._pending = None
+
+    def submit(self, system, z, history_old, arrays, tau) -> None:
+        """Differentiate the converged step ``z`` (see :meth:`PathDerivatives.step`) once the step before
+        is done; a failure of the step before (:class:`~fracid.fem.path.linear_backend.SingularMatrixError`)
+        is raised here."""
+        self.wait()
+        own = arrays._replace(tangent=np.array(arrays.tangent))
+        self._pending = _derivatives_thread().submit(self._step, system, z, history_old, own, tau)
+
+    def _step(self, system, z, history_old, arrays, tau):
+        solver = linear_solver(self.solver)  # the derivatives' thread's own
+        self.derivatives.step(system, z, history_old, arrays, solver, self.stats, tau=tau)
+
+    def wait(self) -> None:
+        """Wait for the step in flight; its exception propagates."""
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            pending.result()
+
+
+_THREAD_LOCK = threading.Lock()
+_THREAD: list = []
+
+
+def _derivatives_thread() -> ThreadPoolExecutor:
+    with _THREAD_LOCK:
+        if not _THREAD:
+            _THREAD.append(ThreadPoolExecutor(1, thread_name_prefix="fracid-derivatives"))
+        return _THREAD[0]
 
 
 def _rates_like(history, p: int):

@@ -9,7 +9,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from fracid.fem.path.ddm import PathDerivatives
+from fracid.fem.path import ddm
+from fracid.fem.path.ddm import ConcurrentDerivatives, PathDerivatives
 from fracid.fem.path.recorder import ProbeSampler, Recorder, probed_at
 from fracid.fem.path import linear_solvers
 from fracid.fem.path.linear_solvers import SingularMatrixError
@@ -326,6 +327,11 @@ class _Run:
         self.recorder = Recorder(problem, dict(observers or {}), field_steps, probes)
         self.derivatives = (PathDerivatives(problem, sensitivities, observers, probes)
                             if sensitivities is not None else None)
+        # the derivatives beside the path, unless the caller's own solver instance would be shared
+        self.concurrent = (ConcurrentDerivatives(self.derivatives, linear_solver)
+                           if self.derivatives is not None and ddm.BESIDE_PATH
+                           and (linear_solver is None or isinstance(linear_solver, str)) else None)
+        self.derivative_tau = None  # the control of the step whose derivatives are in flight
 
     def trace(self, sizes: _StepSizes, max_steps, stop_force_fraction, callback) -> PathResult:
         """Converged steps up to the target or a stop criterion (see :func:`follow_path`)."""
@@ -348,12 +354,13 @@ class _Run:
                 state = factor = None  # the failed iterations overwrote the problem's tangent buffer
                 stats.failed_increments += 1
                 if sizes.cut(increment):
+                    self.wait_derivatives()  # a failure of the derivatives came first
                     raise _failure(self.control, tau, increment, stats, recorder, err,
                                    self.result("failed: " + str(err))) from None
                 continue
             tau += increment
             if self.derivatives is not None:
-                factor = self.differentiate(tau, z_new, history, arrays)
+                factor = self.differentiate(tau, z_new, history, arrays) or factor
             z, history = z_new, arrays.history
             stats.steps += 1
             force = recorder.record(stats.steps, tau, z[:-1], z[-1], arrays)
@@ -363,20 +370,45 @@ class _Run:
                 status = f"force below {stop_force_fraction:g} of the peak"
                 break
             sizes.advance(tau, increment, iterations, self.problem.onset_ratio(history))
+        self.wait_derivatives()
         return self.result(status)
 
     def differentiate(self, tau, z, history, arrays):
-        """The derivatives' step at the converged ``z``; its factorization of the tangent (or None)."""
+        """The derivatives' step at the converged ``z`` (control ``tau``): in this thread, returning the
+        factorization of the converged tangent for the next increment, or beside the path (None)."""
+        if self.concurrent is None:
+            try:
+                return self.derivatives.step(self.system, z, history, arrays, self.solver, self.stats, tau=tau)
+            except SingularMatrixError as err:
+                raise self._singular(tau, err) from None
+        self.wait_derivatives()
+        self.concurrent.submit(self.system, z, history, arrays, tau)
+        self.derivative_tau = tau
+        return None
+
+    def wait_derivatives(self):
+        """Wait for the derivatives of the last step recorded (beside the path); if they failed, raise the
+        :class:`ConvergenceError` of the steps before it."""
+        if self.concurrent is None:
+            return
         try:
-            return self.derivatives.step(self.system, z, history, arrays, self.solver, self.stats, tau=tau)
+            self.concurrent.wait()
         except SingularMatrixError as err:
-            message = (f"the tangent of the converged step at {self.control} = {tau:.6g} mm is singular, so the "
-                       f"derivatives are not defined there (a bifurcation of the path): {err}")
-            raise ConvergenceError(message, self.result("failed: singular tangent for the derivatives"),
-                                   control=self.control, functionals=tuple(self.problem.functionals)) from None
+            self.recorder.drop_last()
+            self.stats.steps -= 1
+            raise self._singular(self.derivative_tau, err) from None
+
+    def _singular(self, tau, err) -> ConvergenceError:
+        message = (f"the tangent of the converged step at {self.control} = {tau:.6g} mm is singular, so the "
+                   f"derivatives are not defined there (a bifurcation of the path): {err}")
+        return ConvergenceError(message, self.result("failed: singular tangent for the derivatives"),
+                                control=self.control, functionals=tuple(self.problem.functionals))
 
     def result(self, status: str) -> PathResult:
         """The :class:`PathResult` of the steps recorded so far, ending with ``status``."""
+        if self.concurrent is not None:
+            self.stats.add(self.concurrent.stats)
+            self.concurrent.stats = SolverStatistics()
         self.stats.time_total = time.perf_counter() - self.t_start
         control, force, observables, fields = self.recorder.curves()
         out = PathResult(self.control, control, force, observables, fields, self.stats, status,

@@ -65,6 +65,19 @@ class Recorder:
         self.peak = max(self.peak, abs(force))
         return force
 
+    def drop_last(self) -> None:
+        """Forget the last step recorded (its derivatives failed): its values, fields and probes; the
+        fields of the step before are then not added at the end."""
+        step = len(self.records["tau"]) - 1
+        if step < 1:
+            return
+        for values in self.records.values():
+            values.pop()
+        self.fields.pop(step, None)
+        self.probed.pop(step, None)
+        self.last = None
+        self.peak = float(np.max(np.abs(self.records["force"])))
+
     def curves(self) -> tuple:
         """(control, force, observables, fields) of the steps recorded, as :class:`PathResult` holds them.
 

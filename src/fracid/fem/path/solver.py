@@ -104,6 +104,11 @@ class SolverStatistics:
     def as_dict(self) -> dict:
         return dict(self.__dict__)
 
+    def add(self, other: "SolverStatistics") -> None:
+        """Add the linear-algebra counters and times of ``other`` (the derivatives' own)."""
+        for name in ("time_linear", "time_factorizations", "linear_solves", "factorizations"):
+            setattr(self, name, getattr(self, name) + getattr(other, name))
+
 
 @dataclass
 class ControlledSystem:
