@@ -12,6 +12,10 @@ factorization measured for that case): how far the run is from the sparse-solver
 
     python benchmarks/forward_2d.py [--specimen beam,dogbone,peer1,peer05,dogbone1600|all]
                                     [--solvers superlu,pardiso,superlu-own] [--newton modified,full]
+                                    [--figure docs/speed/forward_2d.png]
+
+``--figure``: each run's wall time split into factorizations, solves and the rest (residuals, tangents,
+history and records), with the ratio to the factorizations written over the bar.
 
 ``superlu`` is SciPy's SuperLU in a METIS ordering when pymetis (the ``metis`` extra) is installed;
 ``superlu-own`` is SuperLU in its own ordering (a plain ``pip install fracid``).
@@ -77,7 +81,7 @@ def run(name, solver_name, newton="modified"):
           f"wall {wall:7.1f} s  "
           f"wall/linear {wall / s.time_linear:5.2f}  peak RSS {peak_rss_mib():7.0f} MiB  "
           f"peak force {result.peak_force:9.1f} N  ({result.status})", flush=True)
-    return wall, s.factorizations, per_factorization
+    return wall, s.factorizations, per_factorization, s.time_factorizations, s.time_linear - s.time_factorizations
 
 
 def main(argv=None):
@@ -85,17 +89,47 @@ def main(argv=None):
     parser.add_argument("--specimen", default="beam,dogbone", help=f"comma-separated, from {list(CASES)}, or all")
     parser.add_argument("--solvers", default="superlu,pardiso")
     parser.add_argument("--newton", default="modified", help=f"comma-separated, from {list(NEWTON)}")
+    parser.add_argument("--figure", default=None, help="write the time split of every run here (png)")
     args = parser.parse_args(argv)
     names = list(CASES) if args.specimen == "all" else args.specimen.split(",")
+    bars = []
     for name in names:
         runs = {(newton, solver): run(name, solver, newton) for newton in args.newton.split(",")
                 for solver in args.solvers.split(",")}
         runs = {key: r for key, r in runs.items() if r is not None}
         if runs:
             floor = min(r[2] for r in runs.values())
-            for (newton, solver), (wall, factorizations, _) in runs.items():
+            for (newton, solver), (wall, factorizations, _, t_factor, t_solve) in runs.items():
+                ratio = wall / (factorizations * floor)
                 print(f"{name:8s} {newton:8s} {solver:8s} wall / (factorizations x fastest factorization "
-                      f"{floor:.3f} s) = {wall / (factorizations * floor):5.2f}")
+                      f"{floor:.3f} s) = {ratio:5.2f}")
+                bars.append((f"{name}\n{newton}\n{solver}", t_factor, t_solve, wall - t_factor - t_solve, ratio))
+    if args.figure and bars:
+        draw(bars, args.figure)
+
+
+def draw(bars, path):
+    """Stacked bars: factorizations, solves and the rest of each run's wall time [s], with wall / factorizations."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    labels, factor, solve, rest, ratio = zip(*bars)
+    x = np.arange(len(bars))
+    fig, ax = plt.subplots(figsize=(max(5.0, 1.3 * len(bars) + 2.0), 3.8))
+    ax.bar(x, factor, label="factorizations")
+    ax.bar(x, solve, bottom=factor, label="solves")
+    ax.bar(x, rest, bottom=np.add(factor, solve), label="residuals, tangents, records")
+    for k, r in enumerate(ratio):
+        ax.annotate(f"{r:.2f}x", (x[k], factor[k] + solve[k] + rest[k]), ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(x, labels, fontsize=7)
+    ax.set_ylabel("wall time of one run [s]")
+    ax.set_title("Forward runs: time split, and wall / factorizations' time", fontsize=10)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
 
 
 if __name__ == "__main__":

@@ -154,6 +154,23 @@ def strain_of(B, ue):
     return np.matmul(B.reshape(n_el, n_q * n_s, n_u), ue[:, :, None]).reshape(n_el, n_q, n_s)
 
 
+def bt_sum(B, values):
+    """sum over the points and strain components of B^T v: the element vectors of point values.
+
+    Parameters
+    ----------
+    B : ndarray, shape (n_el, n_q, n_strain, n_u)
+    values : ndarray, shape (n_el, n_q, n_strain)
+        Point values, the integration weights included.
+
+    Returns
+    -------
+    ndarray, shape (n_el, n_u)
+    """
+    n_el, n_q, n_s, n_u = B.shape
+    return np.matmul(values.reshape(n_el, 1, n_q * n_s), B.reshape(n_el, n_q * n_s, n_u))[:, 0, :]
+
+
 def bt(vector, B):
     """B^T v at every integration point.
 
@@ -190,12 +207,12 @@ def masked_damage(law, params, const, kappa):
 
 
 def _secant_equilibrium(B, const, w, ue, omega):
-    """Shared by the models: B^T D eps at the points, the internal forces and the weights of the secant
-    stiffness (``btdb(B * w_sec, DB)``)."""
-    sigma_eff = strain_of(const.DB, ue)  # D eps, stress per unit E
+    """Shared by the models: D eps at the points (stress per unit E), the internal forces and the weights
+    of the secant stiffness (``btdb(B * w_sec, DB)``). ``bt(sigma_eff, B)``, the points' share of the
+    forces, is left to the tangents that need it: a residual does not."""
+    sigma_eff = strain_of(const.DB, ue)
     w_sec = w * (1.0 - omega) * const.E
-    bt_sigma = bt(sigma_eff, B)  # (n_el, n_q, n_u)
-    return bt_sigma, np.matmul(w_sec[:, None, :], bt_sigma)[:, 0], w_sec
+    return sigma_eff, bt_sum(B, sigma_eff * w_sec[..., None]), w_sec
 
 
 def _secant(B, const, w_sec):
@@ -226,14 +243,14 @@ def gradient_damage(disc, space, law, params, const: ModelConstants, ue, ee, kap
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, ebar)
     omega, d_omega = masked_damage(law, params, const, kappa)
-    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    sigma_eff, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
     f_eq = (w * eq) @ N
     f_e = np.matmul(const.ebar_matrix, ee[:, :, None])[:, :, 0] - f_eq
 
     def tangent():
         out_tangent[:, :nu, :nu] = _secant(B, const, w_sec)
         w_ue = -(w * const.E * d_omega * loading)
-        out_tangent[:, :nu, nu:] = np.matmul((bt_sigma * w_ue[..., None]).transpose(0, 2, 1), N)
+        out_tangent[:, :nu, nu:] = np.matmul((bt(sigma_eff, B) * w_ue[..., None]).transpose(0, 2, 1), N)
         out_tangent[:, nu:, :nu] = -np.matmul(N.T, bt(d_eq * w[..., None], B))
         return out_tangent
 
@@ -248,10 +265,10 @@ def local_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out_ta
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
     kappa, loading = update_history(kappa_old, eq)
     omega, d_omega = masked_damage(law, params, const, kappa)
-    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    sigma_eff, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
 
     def tangent():
-        softening = np.matmul((bt_sigma * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1),
+        softening = np.matmul((bt(sigma_eff, B) * (w * const.E * d_omega * loading)[..., None]).transpose(0, 2, 1),
                               bt(d_eq, B))
         out_tangent[:] = _secant(B, const, w_sec) - softening
         return out_tangent
@@ -287,9 +304,9 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
     ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
     kappa, loading = update_history(kappa_old, ebar)
     omega, d_omega = masked_damage(law, params, const, kappa)
-    bt_sigma, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
+    sigma_eff, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
     secant = _secant(B, const, w_sec)
-    g = bt_sigma * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
+    g = bt(sigma_eff, B) * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
     h = bt(d_eq, B)  # d eps_eq / d u at each point
     out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
     coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
