@@ -45,6 +45,10 @@ from fracid.progress import progress_lines
 __all__ = ["demo_config_path", "main", "provenance", "version"]
 
 
+#: the commands that keep a run store (and take --store)
+STORE_COMMANDS = ("identify", "posterior", "study", "uniqueness", "stability")
+
+
 def _parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--out", type=Path, help="output directory (default: the config's output.directory)")
@@ -53,6 +57,10 @@ def _parser() -> argparse.ArgumentParser:
     common.add_argument("--quiet", action="store_true", help="no progress bars or summaries")
     common.add_argument("--retry-failed", action="store_true", help="run again the forward runs stored as failed")
     common.add_argument("--debug", action="store_true", help="show the traceback of a failure")
+    stored = argparse.ArgumentParser(add_help=False, parents=[common])  # the commands that keep a run store
+    stored.add_argument("--store", type=Path, metavar="FILE",
+                        help="the run store to read and write instead of OUT/runs.sqlite: commands that share one "
+                             "reuse each other's forward runs (same model, specimen, steps and measured controls)")
     parser = argparse.ArgumentParser(prog="fracid", description="Parameter identification for localized-failure models.")
     parser.add_argument("--version", action="version", version=f"fracid {version()}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -64,18 +72,18 @@ def _parser() -> argparse.ArgumentParser:
                        ("stability", "the study's stability stage only: identification on noisy replicates"),
                        ("sensitivity", "sensitivities and information along the load history"),
                        ("size-effect", "nominal strength versus size and Bazant's size effect law")):
-        p = sub.add_parser(name, parents=[common], help=text)
+        p = sub.add_parser(name, parents=[stored if name in STORE_COMMANDS else common], help=text)
         p.add_argument("config", type=Path, help="TOML configuration file")
         if name == "size-effect":
             p.add_argument("--sizes", type=float, nargs="+", help="sizes D [mm] (default: those of the experiments)")
-    sub.add_parser("demo", parents=[common], help="identify the bundled real beam test (Gregoire et al. 2013)")
+    sub.add_parser("demo", parents=[stored], help="identify the bundled real beam test (Gregoire et al. 2013)")
     from fracid import cli_check, cli_init
 
     cli_init.add_parser(sub)
     cli_check.add_parser(sub, common)
     from fracid import cli_compare
 
-    cli_compare.add_parser(sub, common)
+    cli_compare.add_parser(sub, stored)
     from fracid import cli_datasets
 
     cli_datasets.add_parser(sub)  # `fracid datasets` and `fracid init --dataset NAME`

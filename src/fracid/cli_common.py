@@ -79,17 +79,35 @@ def _inputs(cfg):
 
 @contextlib.contextmanager
 def working_in(args, out, store=False):
-    """The output directory's lock, and (``store``) its run store; the store's path goes to messages."""
-    from fracid.lock import directory_lock
+    """The output directory's lock, and (``store``) its run store: ``OUT/runs.sqlite``, or the file of
+    ``--store`` (shared between commands, under a lock of its own); the store's path goes to messages."""
+    from fracid.lock import directory_lock, store_lock
     from fracid.store import RunStore
 
+    shared = getattr(args, "store", None)
     with directory_lock(out):
         if not store:
             yield None
             return
-        args.store_path = out / "runs.sqlite"
-        with RunStore(args.store_path) as runs:
-            yield runs
+        args.store_path = out / "runs.sqlite" if shared is None else shared_store(shared)
+        with contextlib.ExitStack() as stack:
+            if shared is not None:
+                stack.enter_context(store_lock(args.store_path))
+            yield stack.enter_context(RunStore(args.store_path))
+
+
+def shared_store(path) -> Path:
+    """The run store file of ``--store PATH``; :class:`~fracid.exits.UsageError` for a directory or a missing
+    directory."""
+    from fracid.exits import UsageError
+
+    path = Path(path).expanduser()
+    if path.is_dir():
+        raise UsageError(f"--store {path} is a directory; give the run store's file, e.g. --store {path / 'runs.sqlite'}")
+    if not path.parent.is_dir():
+        raise UsageError(f"--store {path}: the directory {path.parent} does not exist; create it, or give a store in an "
+                         "existing directory")
+    return path
 
 
 def progress_choice(args):

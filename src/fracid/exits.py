@@ -162,7 +162,7 @@ def _store_text(err, where) -> str:
     """The message of a run-store failure, by SQLite's result code: only a damaged file is to be moved away."""
     if isinstance(err, _loaded("fracid.store", "NotARunStore")):
         return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
-                "output directory (--out DIR).")
+                "output directory (--out DIR) or run store (--store FILE).")
     code = getattr(err, "sqlite_errorcode", None)
     code = code if code is not None else getattr(err.__cause__, "sqlite_errorcode", None)
     advice = _STORE_ADVICE.get(code & 0xFF if isinstance(code, int) else None, _DAMAGED)

@@ -1,8 +1,9 @@
-"""An exclusive lock on an output directory, so that two fracid processes never compute into one.
+"""Exclusive locks on an output directory and on a shared run store, so that two fracid processes never
+compute into one (a run store has one writer, :mod:`fracid.store`).
 
-The lock is an operating-system lock on the file ``.fracid.lock`` in the directory (``fcntl.flock``
-on POSIX, ``msvcrt.locking`` on Windows): it is released when the process ends in any way, SIGKILL
-included, so a stale lock file never blocks a rerun.
+A lock is an operating-system lock on a file (``.fracid.lock`` in the directory; ``<store>.fracid.lock``
+beside a store given with ``--store``; ``fcntl.flock`` on POSIX, ``msvcrt.locking`` on Windows): it is
+released when the process ends in any way, SIGKILL included, so a stale lock file never blocks a rerun.
 """
 
 from __future__ import annotations
@@ -16,18 +17,29 @@ from fracid.exits import OutputInUse
 LOCK_NAME = ".fracid.lock"
 
 
-@contextlib.contextmanager
 def directory_lock(directory):
     """Hold the lock of ``directory`` for the duration; :class:`~fracid.exits.OutputInUse` if another
     process holds it (the message names that process's pid)."""
-    path = Path(directory) / LOCK_NAME
+    return _file_lock(Path(directory) / LOCK_NAME, f"the output directory {directory}",
+                      "give another directory with --out DIR")
+
+
+def store_lock(store):
+    """Hold the lock of the run store file ``store`` (shared between commands with ``--store``) for the
+    duration; :class:`~fracid.exits.OutputInUse` if another process holds it."""
+    store = Path(store)
+    return _file_lock(store.with_name(store.name + LOCK_NAME), f"the run store {store}",
+                      "give another store with --store FILE")
+
+
+@contextlib.contextmanager
+def _file_lock(path, what: str, instead: str):
     handle = open(path, "a+")
     try:
         if not _try_lock(handle):
             handle.seek(0)
             holder = handle.read().strip() or "unknown"
-            raise OutputInUse(f"another fracid process (pid {holder}) is using the output directory {directory}. "
-                              "Wait until it ends, or give another directory with --out DIR.")
+            raise OutputInUse(f"another fracid process (pid {holder}) is using {what}. Wait until it ends, or {instead}.")
         handle.seek(0)
         handle.truncate()
         handle.write(str(os.getpid()))
