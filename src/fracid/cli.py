@@ -163,6 +163,7 @@ def _identification(args, job, store, executor):
 def _write_identification(args, job, out, result) -> None:
     """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
     from fracid.report.field_figures import block_views
+    from fracid.report.figures import rendered_once
     from fracid.report.html import write_report
     from fracid.tables import write_csv_table
 
@@ -174,9 +175,10 @@ def _write_identification(args, job, out, result) -> None:
     write_csv_table(out / "fit.csv", ("control_mm", "measured", "std", "computed", "block"),
                     zip(data.control.tolist(), data.y.tolist(), data.std.tolist(), result.y_fit.tolist(), block_of))
     views = block_views(result, _field_coordinates(job))
-    write_report(out / "report.html", result, control=data.control,
-                 title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes, views=views)
-    _write_figures(out / "figures", result, data.control, views=views)
+    with rendered_once():  # the report's figures are figures/'s
+        write_report(out / "report.html", result, control=data.control,
+                     title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes, views=views)
+        _write_figures(out / "figures", result, data.control, views=views)
     say(args, result.summary())
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
                         for stage, c in result.stage_runs().items())
@@ -276,7 +278,7 @@ def _write_figures(directory: Path, result, control, fields=None, views=None) ->
              "correlation": figures.correlation_figure(result)}
     for name, fig in drawn.items():
         if fig is not None:
-            (directory / f"{name}.png").write_bytes(figures.to_png(fig))
+            (directory / f"{name}.png").write_bytes(figures.to_png(fig, stem=name))
     for view in views:
         for stem in view.figures:
             (directory / f"{stem}.png").write_bytes(view.png(stem))

@@ -12,6 +12,8 @@ Units: control [mm], force [N], parameters in the units of
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import io
 import math
 
@@ -34,12 +36,33 @@ ESTIMATE = "#d62728"
 # ------------------------------------------------------------------------------------ helpers
 
 
-def to_png(fig: Figure, dpi: int = DPI) -> bytes:
-    """The figure as PNG bytes (rendered by the Agg canvas)."""
+_RENDERED = contextvars.ContextVar("fracid_rendered_figures", default=None)
+
+
+@contextlib.contextmanager
+def rendered_once():
+    """Within the block, :func:`to_png` renders a figure given a ``stem`` once and returns that PNG for the stem
+    afterwards: ``fracid identify`` draws the same figures into report.html and figures/ (rendering is most of a
+    figure's cost)."""
+    token = _RENDERED.set({})
+    try:
+        yield
+    finally:
+        _RENDERED.reset(token)
+
+
+def to_png(fig: Figure, dpi: int = DPI, stem: str | None = None) -> bytes:
+    """The figure as PNG bytes (rendered by the Agg canvas); ``stem`` names it (its file name in figures/) for
+    :func:`rendered_once`."""
+    rendered = _RENDERED.get() if stem is not None else None
+    if rendered is not None and (stem, dpi) in rendered:
+        return rendered[stem, dpi]
     if not isinstance(fig.canvas, FigureCanvasAgg):
         FigureCanvasAgg(fig)
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi)
+    if rendered is not None:
+        rendered[stem, dpi] = buffer.getvalue()
     return buffer.getvalue()
 
 

@@ -103,7 +103,7 @@ def correlation_section(result, figures) -> str:
     corr = np.asarray(result.correlation, float)
     rows = [[n] + [f"{v:+.3f}" if np.isfinite(v) else "n/a" for v in corr[i]] for i, n in enumerate(names)]
     table = html_table([""] + names, rows, text_columns=(0,))
-    image = html_image(figures.to_png(figures.correlation_figure(result)), "correlation matrix",
+    image = html_image(figures.to_png(figures.correlation_figure(result), stem="correlation"), "correlation matrix",
                    "Correlation matrix of the estimate (C_ij / (std_i std_j)); |value| near 1: the data "
                    "hardly separate the two parameters.")
     return f"<h2>Correlation</h2>\n{table}\n{image}"
@@ -123,7 +123,7 @@ def fit_section(result, control, figures, control_label=None, skip=()) -> str:
                     "computed peak", "peak error [%]", "objective share f [-]"], rows, text_columns=(0, 1))
     fig = figures.fit_figure(result, control, control_label, skip=skip)
     image = "" if fig is None else html_image(
-        figures.to_png(fig), "measured and computed curves", "Measured points with the +/- 2 std band of the data and "
+        figures.to_png(fig, stem="fit"), "measured and computed curves", "Measured points with the +/- 2 std band of the data and "
         "the curve computed at the estimate (a line through its values at the data points).")
     unit_note = ("RMS error of the computed values over the measured range and peaks in the unit of the block "
                  "(N for forces, mm for widths); peaks are the values of largest magnitude; the objective share is "

@@ -38,7 +38,7 @@ def history_section(result, name, figures) -> str:
     fig = history_figure(result, label)
     if fig is None:
         return f"<h2>{esc(label)}</h2>\n<p>No history of this stage in this result.</p>"
-    shown = html_image(figures.to_png(fig), f"{label} history",
+    shown = html_image(figures.to_png(fig, stem=name), f"{label} history",
                   f"Estimate after every step of the {label} with +/- 2 std from the step's covariance; "
                   "dotted lines separate global iterations, the dashed line is the final value.")
     return f"<h2>{esc(label)}</h2>\n{shown}"
@@ -53,13 +53,14 @@ def population_section(result, name, figures) -> str:
         return "<h2>KNN population</h2>\n<p>No KNN population in this result.</p>"
     points, f, failed, order, k = arrays
     parts = ["<h2>KNN population</h2>"]
-    parts.append(html_image(figures.to_png(stage_figures.population_objective_figure(result)), "KNN objective",
+    parts.append(html_image(figures.to_png(stage_figures.population_objective_figure(result), stem=f"{name}_objective"),
+                            "KNN objective",
                         "Objective of every population point against each parameter (log scale); circles: the "
                         f"{k} nearest; crosses at the top: failed runs; vertical line: the final estimate."))
     fig = stage_figures.population_map_figure(result)
     if fig is not None:
         i, j = stage_figures.strongest_pair(result)
-        parts.append(html_image(figures.to_png(fig), "KNN map",
+        parts.append(html_image(figures.to_png(fig, stem=f"{name}_map"), "KNN map",
                             f"Population over {result.names[i]} and {result.names[j]} (the most correlated pair), "
                             "coloured by log10 f, with the estimate and its 2-std ellipse."))
     errors = list((result.knn or {}).get("errors") or [""] * len(points))
