@@ -45,7 +45,7 @@ from fracid.progress import progress_lines
 __all__ = ["demo_config_path", "main", "provenance", "version"]
 
 
-#: the commands that keep a run store (and take --store)
+#: the commands of the loop below that keep a run store (and take --store; demo and compare too)
 STORE_COMMANDS = ("identify", "posterior", "study", "uniqueness", "stability")
 
 

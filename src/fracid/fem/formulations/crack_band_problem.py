@@ -11,7 +11,7 @@ from fracid.fem.material.crack_band import (band_damage, band_damage_parameter_d
                                    crack_direction_stress, crack_direction_stress_nu_derivative, element_mean,
                                    snap_back_limit)
 from fracid.fem.material.damage import update_history
-from fracid.fem.formulations.forms import ElementArrays, btdb, point_outputs
+from fracid.fem.formulations.forms import ElementArrays, btdb, point_outputs, strain_of
 from fracid.fem.formulations.problem import ContinuumProblem
 from fracid.fem.material.tsl import ScaledLaw, differentiable
 
@@ -89,7 +89,7 @@ class CrackBandProblem(ContinuumProblem):
         return float(np.max(kappa * self.const.E / self.ft))
 
     def _stress(self, ue, kappa_old):
-        s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)  # D eps per unit E
+        s = strain_of(self.const.DB, ue)  # D eps per unit E
         return crack_band_stress(s, kappa_old, self.disc.weights, self.band_width, self.const.E, self.params.nu,
                                  self.local_law, self.crackable)
 
@@ -110,8 +110,8 @@ class CrackBandProblem(ContinuumProblem):
         """Energy recovered on unloading to zero stress, 1/2 int eps . sigma dV (secant unloading) [N mm]."""
         omega = point_outputs(arrays)["omega"]
         ue = self.gather(q)
-        eps = np.einsum("eqsi,ei->eqs", self.disc.strain_operator, ue)
-        s = np.einsum("eqsj,ej->eqs", self.const.DB, ue)
+        eps = strain_of(self.disc.strain_operator, ue)
+        s = strain_of(self.const.DB, ue)
         sigma = self.const.E[..., None] * (s - omega[..., None] * crack_direction_stress(s, self.params.nu)[1])
         return self.symmetry_factor * 0.5 * float(np.sum(self.disc.weights * np.sum(eps * sigma, axis=-1)))
 
@@ -146,8 +146,8 @@ class CrackBandProblem(ContinuumProblem):
             return np.broadcast_to(np.einsum("eq,eqp->ep", share, values)[:, None, :], values.shape)
 
         ue = self.gather(q)
-        eps = np.einsum("eqsi,ei->eqs", B, ue)
-        s = np.einsum("eqsj,ej->eqs", const.DB, ue)
+        eps = strain_of(B, ue)
+        s = strain_of(const.DB, ue)
         lam, F, dF, dlam = crack_direction_stress(s, nu)
         F_nu = crack_direction_stress_nu_derivative(s)
         kappa, loading = update_history(kappa_old, element_mean(lam, weights))

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.fem.formulations.forms import bt
+from fracid.fem.formulations.forms import bt, strain_of
 
 
 def check_names(names, known) -> tuple:
@@ -65,13 +65,13 @@ def unit_stress_forces(disc, const, ue):
     density : ndarray, shape (n_el, n_q)
         eps . D eps = ue . B^T D eps at every point [per unit E].
     """
-    bt_sigma = bt(np.einsum("eqsj,ej->eqs", const.DB, ue), disc.strain_operator)
+    bt_sigma = bt(strain_of(const.DB, ue), disc.strain_operator)
     return bt_sigma, np.einsum("eqi,ei->eq", bt_sigma, ue)
 
 
 def _nu_stress_rate(disc, params, ue):
     """d(D)/d nu eps at every point (n_el, n_q, n_strain), per unit E, and the strain eps."""
-    eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
+    eps = strain_of(disc.strain_operator, ue)
     return np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(params.nu), eps), eps
 
 

@@ -315,8 +315,8 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
 
 def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:
     """Recoverable energy 1/2 int (1 - omega) E eps . D eps dV [N mm]."""
-    eps = np.einsum("eqsi,ei->eqs", disc.strain_operator, ue)
-    sigma_eff = np.einsum("eqsj,ej->eqs", const.DB, ue)
+    eps = strain_of(disc.strain_operator, ue)
+    sigma_eff = strain_of(const.DB, ue)
     return 0.5 * float(np.sum(disc.weights * (1.0 - omega) * const.E * np.sum(eps * sigma_eff, axis=-1)))
 
 

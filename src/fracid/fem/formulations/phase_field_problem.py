@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from fracid.fem.formulations import damage_sensitivity as ds
-from fracid.fem.formulations.forms import ElementArrays, bt, btdb, gradient_matrix
+from fracid.fem.formulations.forms import ElementArrays, bt, btdb, gradient_matrix, strain_of
 from fracid.fem.formulations.problem import ContinuumProblem
 from fracid.fem.formulations.protocol import HistoryVariable
 from fracid.fem.material import phase_field as pf
@@ -88,7 +88,7 @@ class PhaseFieldProblem(ContinuumProblem):
         """What the residual, the tangent and the derivatives share at element dof values ``qe``."""
         const, N = self.const, self.space.shape
         ue, de = qe[:, : self.n_u], qe[:, self.n_u:]
-        s = np.einsum("eqsj,ej->eqs", const.DB, ue)  # D eps, stress per unit E
+        s = strain_of(const.DB, ue)  # D eps, stress per unit E
         lam, dlam = major_principal(s)
         mask = const.damageable > 0.0
         loading = mask & ((lam > h_old) | (not self.irreversible))
@@ -145,7 +145,7 @@ class PhaseFieldProblem(ContinuumProblem):
         column = {name: k for k, name in enumerate(names)}
         n_p = len(names)
 
-        eps = np.einsum("eqsi,ei->eqs", B, st["ue"])
+        eps = strain_of(B, st["ue"])
         s_nu = np.einsum("st,eqt->eqs", disc.strain_state.unit_elastic_matrix_derivative(params.nu), eps)
         explicit = np.zeros(w.shape + (n_p,))  # d lambda_1 / d x at fixed strain
         if "nu" in column:

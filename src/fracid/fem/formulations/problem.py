@@ -15,7 +15,7 @@ from fracid.fem.formulations import damage_sensitivity as ds
 from fracid.fem.mesh.discretization import MixedDiscretization
 from fracid.fem.mesh.dofs import Conditions, FieldSpec, number_dofs
 from fracid.fem.formulations.forms import (elastic_bulk, elastic_energy, gradient_damage, gradient_matrix, integral_damage,
-                                           local_damage, masked_damage, model_constants, point_outputs)
+                                           local_damage, masked_damage, model_constants, point_outputs, strain_of)
 from fracid.fem.material.laws import DamageLaw
 from fracid.fem.formulations.nonlocal_average import averaging_length_derivative, internal_length, nonlocal_averaging
 from fracid.fem.formulations.protocol import HistoryVariable, allocate_history
@@ -208,7 +208,7 @@ class DamageProblem(ContinuumProblem):
 
     def _strain(self, qe):
         """The strain at every point (n_el, n_q, n_strain) of element dof values ``qe``."""
-        return np.einsum("eqsi,ei->eqs", self.disc.strain_operator, qe[:, : self.dofs.n_u])
+        return strain_of(self.disc.strain_operator, qe[:, : self.dofs.n_u])
 
     def _driving(self, qe):
         """The strain that drives kappa at every point, the strain, eps_eq and d eps_eq / d eps (these two

@@ -56,6 +56,16 @@ def modified_von_mises_3d(strain, nu, eta):
     return eps_eq, d
 
 
+def _plane_stress_invariants(e, nu):
+    """(k, s, I1, J2) of in-plane strains ``e`` (..., 3) with ezz = -k s, k = nu / (1 - nu), s = exx + eyy: in
+    closed form (no 6-component state), I1 = (1 - k) s and J2 = (exx^2 + eyy^2 - exx eyy + k (k + 1) s^2) / 3
+    + gxy^2 / 4."""
+    exx, eyy, gxy = e[..., 0], e[..., 1], e[..., 2]
+    k = nu / (1.0 - nu)
+    s = exx + eyy
+    return k, s, (1.0 - k) * s, (exx * exx + eyy * eyy - exx * eyy + k * (k + 1.0) * s * s) / 3.0 + 0.25 * gxy * gxy
+
+
 def modified_von_mises_plane_stress(strain, nu, eta):
     """Equivalent strain in plane stress, with ezz = -nu/(1-nu) (exx + eyy) entering I1 and J2.
 
@@ -72,15 +82,11 @@ def modified_von_mises_plane_stress(strain, nu, eta):
     d_eps_eq : ndarray, shape (..., 3)
         Total derivative with respect to (exx, eyy, gxy), through ezz as well.
     """
-    # in closed form (no 6-component state): with k = nu / (1 - nu) and s = exx + eyy, ezz = -k s,
-    # I1 = (1 - k) s and J2 = (exx^2 + eyy^2 - exx eyy + k (k + 1) s^2) / 3 + gxy^2 / 4
     e = np.asarray(strain, dtype=float)
     exx, eyy, gxy = e[..., 0], e[..., 1], e[..., 2]
-    k = nu / (1.0 - nu)
-    s = exx + eyy
+    k, s, I1, J2 = _plane_stress_invariants(e, nu)
     kk = 2.0 * k * (k + 1.0) * s
-    J2 = (exx * exx + eyy * eyy - exx * eyy + 0.5 * kk * s) / 3.0 + 0.25 * gxy * gxy
-    eps_eq, d_I1, d_J2 = _from_invariants((1.0 - k) * s, J2, nu, eta)
+    eps_eq, d_I1, d_J2 = _from_invariants(I1, J2, nu, eta)
     d = np.empty(e.shape)
     volumetric = (1.0 - k) * d_I1
     d[..., 0] = volumetric + d_J2 * (2.0 * exx - eyy + kk) / 3.0
@@ -139,15 +145,11 @@ def modified_von_mises_plane_stress_parameter_derivatives(strain, nu, eta) -> di
         d eps_eq / d nu (through the invariants' coefficients and ezz = -nu/(1-nu)(exx + eyy)) and
         d eps_eq / d eta [-].
     """
-    e = np.asarray(strain, dtype=float)
-    exx, eyy, gxy = e[..., 0], e[..., 1], e[..., 2]
-    ezz = -nu / (1.0 - nu) * (exx + eyy)
-    I1 = exx + eyy + ezz
-    J2 = (exx**2 + eyy**2 + ezz**2 - exx * eyy - eyy * ezz - ezz * exx) / 3.0 + gxy**2 / 4.0
+    k, s, I1, J2 = _plane_stress_invariants(np.asarray(strain, dtype=float), nu)
     _, d_I1, d_J2 = _from_invariants(I1, J2, nu, eta)
     d_nu, d_eta = _invariant_parameter_derivatives(I1, J2, nu, eta)
-    d_ezz = -(exx + eyy) / (1.0 - nu) ** 2
-    d_nu = d_nu + (d_I1 + d_J2 * (2.0 * ezz - exx - eyy) / 3.0) * d_ezz
+    d_ezz = -s / (1.0 - nu) ** 2
+    d_nu = d_nu + (d_I1 - d_J2 * (2.0 * k + 1.0) * s / 3.0) * d_ezz
     return {"nu": d_nu, "eta": d_eta}
 
 

@@ -173,10 +173,8 @@ class ConcurrentDerivatives:
         self._pending = None
 
     def submit(self, system, z, history_old, arrays, tau) -> None:
-        """Differentiate the converged step ``z`` (see :meth:`PathDerivatives.step`) once the step before
-        is done; a failure of the step before (:class:`~fracid.fem.path.linear_backend.SingularMatrixError`)
-        is raised here."""
-        self.wait()
+        """Differentiate the converged step ``z`` (see :meth:`PathDerivatives.step`) in the derivatives' thread;
+        the caller has waited for the step before (:meth:`wait`), whose failure it handles."""
         own = arrays._replace(tangent=np.array(arrays.tangent))
         self._pending = _derivatives_thread().submit(self._step, system, z, history_old, own, tau)
 
