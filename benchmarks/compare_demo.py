@@ -19,7 +19,7 @@ import platform
 import time
 from pathlib import Path
 
-from fracid.cli import demo_config_path, main
+from fracid.cli.dispatch import demo_config_path, main
 from fracid.report.compare import DEFINITIONS
 from fracid.report.cross_model import markdown_table
 
@@ -48,7 +48,7 @@ def run(args) -> dict:
 
 def failed_runs(out: Path) -> list:
     """The failed forward runs of OUT/runs.sqlite: their parameters and the reason (its first sentence)."""
-    from fracid.store import RunStore
+    from fracid.store.runs import RunStore
 
     if not (out / "runs.sqlite").is_file():
         return []

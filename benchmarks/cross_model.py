@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli import demo_config_path
+from fracid.cli.dispatch import demo_config_path
 from fracid.config import build_data, build_method, build_parameters, build_space, build_specimen, load_config
 from fracid.inverse.studies.cross_model import compare_models, cross_calibration
 from fracid.inverse.studies.model_fit import Candidate
@@ -34,7 +34,7 @@ from fracid.inverse.methods.knn import ParameterSpace
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.material.parameters import DamageParameters
 from fracid.models import CohesiveCrackModel, CrackBandModel, DamageModel
-from fracid.parallel import make_executor
+from fracid.runtime.executors import make_executor
 from fracid.report.cross_model import (CurvePanel, comparison_rows, cross_rows, curves_figure, markdown_table,
                                        write_cross_model_report)
 from fracid.report.figures import to_png

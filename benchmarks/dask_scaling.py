@@ -35,13 +35,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from fracid.batch import BatchStats, run_batch  # noqa: E402
+from fracid.runtime.batch import BatchStats, run_batch  # noqa: E402
 from fracid.config import build_data, build_operator, build_space  # noqa: E402
 from fracid.inverse.core.runs import run_key, run_population  # noqa: E402
 from fracid.inverse.methods.knn import design  # noqa: E402
-from fracid.parallel import make_executor  # noqa: E402
-from fracid.store import RunStore, key_for  # noqa: E402
-from fracid.store_records import decode_record, encode_record  # noqa: E402
+from fracid.runtime.executors import make_executor  # noqa: E402
+from fracid.store.runs import RunStore, key_for  # noqa: E402
+from fracid.store.records import decode_record, encode_record  # noqa: E402
 from demo_setup import demo_config  # noqa: E402
 
 

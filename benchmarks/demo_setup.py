@@ -2,7 +2,7 @@
 
 import dataclasses
 
-from fracid.cli_common import demo_config_path
+from fracid.cli.common import demo_config_path
 from fracid.config import load_config
 
 

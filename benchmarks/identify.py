@@ -20,7 +20,7 @@ import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.methods.knn import ParameterSpace, design, evaluate_population
 from fracid.inverse.methods.strategy import identify
-from fracid.parallel import make_executor
+from fracid.runtime.executors import make_executor
 from fracid.specimens.beam import NotchedBeam
 
 SPECIMEN = NotchedBeam(h_fine=2.0, h_coarse=6.0)

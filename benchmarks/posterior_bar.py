@@ -31,7 +31,7 @@ from fracid.inverse.methods.knn import ParameterSpace
 from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.methods.strategy import identify
-from fracid.parallel import executor_session
+from fracid.runtime.executors import executor_session
 
 TRUTH = np.array([2.0, 250.0])
 POINTS = np.linspace(0.0025, 0.03, 12)

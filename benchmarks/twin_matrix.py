@@ -21,7 +21,7 @@ import numpy as np
 import fracid
 from fracid.inverse.methods.knn import ParameterSpace
 from fracid.inverse.studies.twin import dogbone_cases, twin_matrix
-from fracid.parallel import make_executor
+from fracid.runtime.executors import make_executor
 from fracid.report.figures import _new_figure, to_png
 from fracid.report.study import stability_figure, valley_figure
 

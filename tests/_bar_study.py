@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 import fracid
-from fracid.store import RunStore
+from fracid.store.runs import RunStore
 
 TEMPLATE = """
 [model.parameters]

@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
-from fracid.batch import run_batch
-from fracid.parallel import make_executor
-from fracid.store import RunStore, key_for
+from fracid.runtime.batch import run_batch
+from fracid.runtime.executors import make_executor
+from fracid.store.runs import RunStore, key_for
 
 NONDETERMINISTIC = ("pid", "time")
 
@@ -71,7 +71,7 @@ def busy(task: dict) -> dict:
 
 def thread_environment(_task) -> dict:
     """The BLAS/OpenMP thread variables a worker sees."""
-    from fracid.parallel import THREAD_VARIABLES
+    from fracid.runtime.executors import THREAD_VARIABLES
 
     return {name: os.environ.get(name) for name in THREAD_VARIABLES}
 

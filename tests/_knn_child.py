@@ -29,8 +29,8 @@ def search(op, store=None, executor=None, stats=None):
 
 
 def main(store_path):
-    from fracid.parallel import make_executor
-    from fracid.store import RunStore
+    from fracid.runtime.executors import make_executor
+    from fracid.store.runs import RunStore
 
     op = operator()
     with RunStore(store_path) as store, make_executor(2) as executor:

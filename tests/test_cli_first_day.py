@@ -7,7 +7,7 @@ import re
 import pytest
 
 from fracid import cli
-from fracid.cli_init import numpydoc_parameters, runnable_pairs
+from fracid.cli.init import numpydoc_parameters, runnable_pairs
 
 PAIRS = runnable_pairs()
 
@@ -130,7 +130,7 @@ def test_check_prints_the_plan_with_unknowns_runs_and_time(tmp_path, capsys):
 
 
 def test_check_warns_of_a_slow_plan_naming_the_key(tmp_path, capsys, monkeypatch):
-    from fracid import cli_check
+    from fracid.cli import check as cli_check
 
     text = re.sub(r"^n = \S+", "n = 5000", small(init(tmp_path)), flags=re.M)
     (tmp_path / "fracid.toml").write_text(text, encoding="utf-8")

@@ -8,8 +8,8 @@ import pytest
 
 from _bar_study import stored_rows, write_bar_study
 from fracid import cli
-from fracid.exits import FILES, INPUT
-from fracid.lock import store_lock
+from fracid.runtime.exits import FILES, INPUT
+from fracid.runtime.locks import store_lock
 
 
 def identify(config, out, store, *extra):

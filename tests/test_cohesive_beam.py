@@ -63,7 +63,7 @@ def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.methods.knn import ParameterSpace
     from fracid.inverse.methods.strategy import identify
     from fracid.inverse.studies.twin import synthetic_data
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     beam = NotchedBeam(h_fine=4.0, h_coarse=8.0)  # coarse: data and model share the mesh
     op = ForwardOperator([Observation(beam, np.linspace(0.01, 0.3, 15), control="cmod")], PARAMS, ("ft", "Gf"),

@@ -94,7 +94,7 @@ def test_ranking_flags_ties_within_the_combined_errors():
 
 @pytest.fixture(scope="module")
 def executor():
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     with make_executor(2) as pool:
         yield pool

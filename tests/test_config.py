@@ -293,7 +293,8 @@ def test_sampling_reaches_the_data_and_keeps_the_measured_peak(tmp_path, samplin
 
 
 def test_a_bad_sampling_exits_2_naming_the_key(tmp_path, capsys):
-    from fracid import cli, exits
+    from fracid import cli
+    from fracid.runtime import exits
 
     path = write(tmp_path, variant("n_points = 40", 'n_points = 40\nsampling = "all"'))
     assert cli.main(["identify", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == exits.INPUT
@@ -496,7 +497,7 @@ def test_model_types_are_read_from_the_registry_when_loading(tmp_path, monkeypat
 
 def test_simulate_cohesive_beam_from_its_config(tmp_path):
     """`fracid simulate` with type = "cohesive-crack" on a coarse beam: a peaked, softening curve and its energy."""
-    from fracid.cli import main
+    from fracid.cli.dispatch import main
 
     assert main(["simulate", str(CONFIGS / "beam_cohesive_simulate.toml"), "--out", str(tmp_path), "--quiet"]) == 0
     with open(tmp_path / "curve.csv") as handle:
@@ -517,7 +518,7 @@ from fracid.models import MODEL_TYPES  # noqa: E402  (every registered model is 
 @pytest.mark.slow
 def test_size_effect_runs_any_model(tmp_path):
     """The size-effect series takes the config's forward model: here the cohesive crack, three depths."""
-    from fracid.cli import main
+    from fracid.cli.dispatch import main
 
     config = str(CONFIGS / "beam_cohesive_simulate.toml")
     assert main(["size-effect", config, "--sizes", "40", "50", "60", "--out", str(tmp_path), "--quiet"]) == 0

@@ -151,7 +151,7 @@ def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.methods.knn import ParameterSpace
     from fracid.inverse.methods.strategy import identify
     from fracid.inverse.studies.twin import synthetic_data
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     # coarse: data and model share the mesh. On this mesh Newton stalls beyond CMOD 0.15 mm, when the
     # band reaches the top element, under the loading plate (see the closing note of issue 7)

@@ -38,7 +38,7 @@ SETTINGS = {"n": 6, "k": 3, "groups": np.array_split(np.arange(CMOD.size), 3), "
 
 @pytest.fixture(scope="module")
 def executor():
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     with make_executor(2) as pool:
         yield pool

@@ -12,7 +12,7 @@ from fracid.inverse.core.sensitivity import (CentralDifferences, DirectDifferent
                                         sensitivity_label)
 from fracid.models import CohesiveCrackModel
 from fracid.specimens import SPECIMENS
-from fracid.store import RunStore
+from fracid.store.runs import RunStore
 
 BAR = fracid.BarWithWeakZone(n_elements=100)
 POINTS = np.linspace(0.004, 0.03, 16)  # end displacement [mm]: pre-peak, peak and softening

@@ -18,7 +18,7 @@ from fracid.data.dic.derived import crack_line
 from fracid.data.errors import DataError
 from fracid.fem.material.parameters import DamageParameters
 from fracid.fem.path.path_following import StepOptions
-from fracid.forward import simulate
+from fracid.models.forward import simulate
 from fracid.inverse.core.derived_observations import DerivedFieldObservation, derived_observation
 from fracid.inverse.core.forward_operator import ForwardOperator
 from fracid.inverse.core.observations import FieldObservation, ObservationKind, field_observation

@@ -7,7 +7,7 @@ import pytest
 
 from fracid.data.dic_noise import dic_kernel
 from fracid.fem.material.parameters import DamageParameters
-from fracid.forward import simulate
+from fracid.models.forward import simulate
 from fracid.models import probe_matrix
 from fracid.data.dic import CameraPlacement
 from fracid.inverse.studies.dic_twin import (inside_mesh, rigid_motion, speckle_grid, synthetic_dic,

@@ -107,7 +107,7 @@ BRITTLE = fracid.DamageParameters(E=37000.0, kappa_i=1e-4, beta=10000.0, c=1.0) 
 
 def _snap_back_failure(specimen, params, control):
     """The ConvergenceError of ``specimen`` under ``control`` and the command's (status, message) for it."""
-    from fracid import exits
+    from fracid.runtime import exits
 
     with pytest.raises(fracid.ConvergenceError) as info:
         fracid.simulate(specimen, params, control=control, stop_force_fraction=0.2)
@@ -118,7 +118,7 @@ def _snap_back_failure(specimen, params, control):
 def test_snap_back_under_deflection_is_named_and_cmod_advised():
     """A brittle beam under deflection control fails past the peak with the force falling steeply: the
     error says the curve snaps back and names cmod, which then traces the curve to 20 % of the peak."""
-    from fracid import exits
+    from fracid.runtime import exits
 
     from fracid.specimens import NotchedBeam
 

@@ -18,7 +18,7 @@ from hostile import TRUTH, bar_config, synthetic_curve, write_csv
 import fracid
 from fracid import cli
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.core import settings
+from fracid.settings import checks as settings
 from fracid.inverse.methods.knn_kalman import KnnSettings, population_search
 from fracid.inverse.methods.knn_settings import knn_from_table
 from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields

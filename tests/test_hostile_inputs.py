@@ -1,5 +1,5 @@
 """Hostile but realistic inputs, each run through the real ``fracid`` command (``python -m fracid``) as a
-subprocess in its own directory: the exit status of the contract (:mod:`fracid.exits`: 0 done, 1 a bug,
+subprocess in its own directory: the exit status of the contract (:mod:`fracid.runtime.exits`: 0 done, 1 a bug,
 2 bad input, 3 the computation failed, 4 files and storage, 130/143 interrupted), a few distinctive
 words of the message (paths of the case's directory removed first), and no traceback (except with
 ``--debug``).
@@ -32,7 +32,7 @@ import hostile_checks
 import hostile_data
 import hostile_files
 import hostile_mesh
-from fracid.lock import directory_lock
+from fracid.runtime.locks import directory_lock
 from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, _cells, _clean, _config_bytes,
                      _corrupt_store, _estimate_near_truth, _out_dir, _out_is_file, _read_only_out, _scaled, _units_row,
                      _unloading, bar_config, case, check, csv_case, run_fracid, sim_case, synthetic_curve, write_csv)

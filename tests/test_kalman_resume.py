@@ -16,7 +16,7 @@ import fracid
 from fracid.inverse.core import runs as runs_module
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.runs import StoredOperator, run_key
-from fracid.store import RunStore
+from fracid.store.runs import RunStore
 
 N_KNN = 8
 

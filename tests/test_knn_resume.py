@@ -12,8 +12,8 @@ import pytest
 from _bar_study import stored_rows
 from _knn_child import N_RUNS, operator, search
 
-from fracid.batch import BatchStats
-from fracid.store import RunStore
+from fracid.runtime.batch import BatchStats
+from fracid.store.runs import RunStore
 
 CHILD = Path(__file__).with_name("_knn_child.py")
 

@@ -1,6 +1,6 @@
 """Imports follow the floors of the README's Layout: no module of fracid imports a higher floor; the
 package's modules import one another without cycles; the command's modules share their plumbing through
-:mod:`fracid.cli_common`, never through one another's private names."""
+:mod:`fracid.cli.common`, never through one another's private names."""
 
 import ast
 from pathlib import Path
@@ -9,16 +9,14 @@ import fracid
 
 # floor of each top-level unit of the package: a module may import its own floor and those below
 FLOORS = {
-    "fem": 0, "field_error": 0, "stops": 0,
+    "settings": 0, "fem": 0,
     "specimens": 1,
-    "models": 2, "model_protocol": 2, "forward": 2, "data": 2, "store": 2, "store_records": 2, "tables": 2, "parallel": 2, "batch": 2, "progress": 2, "provenance": 2,
+    "models": 2, "data": 2, "store": 2, "runtime": 2,
     "inverse": 3,
     "report": 4,
     "config": 5,
-    "datasets": 5, "cli_datasets": 6,  # datasets.load reads a data set through its configuration
-    "cli": 6, "cli_common": 6, "cli_studies": 6, "cli_init": 6, "cli_check": 6, "exits": 6, "lock": 6, "outputs": 6,
-    "cli_compare": 6,
-    "__main__": 6, "__init__": 6,
+    "datasets": 5,  # datasets.load reads a data set through its configuration
+    "cli": 6, "__main__": 6, "__init__": 6,
 }
 
 
@@ -174,8 +172,8 @@ def test_no_import_cycle_at_module_level():
 
 def test_no_import_cycle_through_function_level_imports_but_the_known_ones():
     """With the imports inside functions too (fracid's lazy imports, which keep start-up fast), the only
-    cycles are those of :data:`KNOWN_LAZY_CYCLES`: the command (fracid.cli and its siblings, which share
-    fracid.cli_common) and the linear solvers (fracid.fem.path.linear_solvers, whose backends import
+    cycles are those of :data:`KNOWN_LAZY_CYCLES`: the command (fracid.cli.dispatch and its siblings, which share
+    fracid.cli.common) and the linear solvers (fracid.fem.path.linear_solvers, whose backends import
     fracid.fem.path.linear_backend) are in none."""
     new = [cycle for cycle in import_cycles(import_graph(lazy=True))
            if not any(set(cycle) <= known for known in KNOWN_LAZY_CYCLES)]
@@ -183,12 +181,12 @@ def test_no_import_cycle_through_function_level_imports_but_the_known_ones():
 
 
 def test_the_command_modules_import_no_private_name():
-    """fracid.cli, cli_studies, cli_init, cli_check and cli_common take only public names from other fracid
+    """fracid.cli.dispatch, cli_studies, cli_init, cli_check and cli_common take only public names from other fracid
     modules (``from fracid.x import _y`` or ``x._y`` on an imported fracid module is a hidden coupling)."""
     modules = _modules()
     private = []
     for module, path in modules.items():
-        if not module.startswith("fracid.cli"):
+        if not module.startswith("fracid.cli.dispatch"):
             continue
         tree = ast.parse(path.read_text(encoding="utf-8"))
         bound = set()  # local names of imported fracid modules

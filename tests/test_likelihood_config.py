@@ -7,7 +7,8 @@ import json
 import pytest
 
 from _bar_study import SMALL_POSTERIOR, write_bar_study
-from fracid import cli, exits
+from fracid import cli
+from fracid.runtime import exits
 from fracid.config import load_config
 from fracid.inverse.likelihood.settings import DiscretisationError, ModelError
 

@@ -8,7 +8,7 @@ from scipy.integrate import quad
 
 import fracid
 from fracid.data.covariance_matrix import Diagonal
-from fracid.inverse.core.settings import SettingError
+from fracid.settings.checks import SettingError
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.likelihood.correlation import block_modes
 from fracid.inverse.likelihood.discretisation import ORDER_RANGE, observed_order, richardson_error

@@ -76,7 +76,7 @@ GRADIENT_SPACE = ParameterSpace(("kappa_i", "beta"), [3e-5, 100.0], [3e-4, 3000.
 
 @pytest.fixture(scope="module")
 def executor():
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     with make_executor(2) as pool:
         yield pool

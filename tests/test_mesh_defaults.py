@@ -6,7 +6,7 @@ from dataclasses import replace
 import pytest
 
 from fracid.specimens import DogBone, NotchedBeam, WedgeSplitting
-from fracid.store import key_for
+from fracid.store.runs import key_for
 
 LONG = dict(depth=100.0, span=800.0, length=900.0, notch_depth=50.0, plate_width=10.0)  # benchmarks/mesh_defaults.py
 

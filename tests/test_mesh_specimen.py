@@ -326,7 +326,7 @@ def test_twin_identification_of_c_and_beta_on_a_triangle_meshed_beam(tmp_path):
 
 
 def test_an_edited_mesh_file_is_another_specimen(tmp_path):
-    from fracid.store import key_for
+    from fracid.store.runs import key_for
 
     path = write_msh(tmp_path / "strip.msh", *grid(2, 1, True), "triangle")
     first = strip(path)

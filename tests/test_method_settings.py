@@ -1,5 +1,5 @@
 """The inverse methods read and check their own ``[identify.<table>]`` settings (issue 26, item 1): the checkers of
-``fracid.inverse.core.settings`` (shared with the configuration's Checker), the methods' ``config_tables``,
+``fracid.settings.checks`` (shared with the configuration's Checker), the methods' ``config_tables``,
 ``from_config(tables, context)`` and ``config_template``, and ``[identify]`` allowing, checking and warning of the
 tables through the registry only."""
 
@@ -17,8 +17,8 @@ from hostile import bar_config, synthetic_curve, write_csv
 
 from fracid.config import MAX_POPULATION, ConfigError, build_method, load_config
 from fracid.config.checker import Checker
-from fracid.inverse.core import settings
-from fracid.inverse.core.settings import SettingError, SettingsContext
+from fracid.settings import checks as settings
+from fracid.settings.checks import SettingError, SettingsContext
 from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table
 from fracid.inverse.methods.registry import METHODS, config_tables, known_tables, method_from_tables, table_readers
 from fracid.inverse.methods.strategy import KalmanSettings, KnnGaussNewton, KnnKalman

@@ -13,13 +13,13 @@ import _batch_tasks as bt
 import numpy as np
 import pytest
 
-from fracid.batch import BatchStats, run_batch
-from fracid.parallel import (
+from fracid.runtime.batch import BatchStats, run_batch
+from fracid.runtime.executors import (
     THREAD_VARIABLES,
     SerialExecutor,
     make_executor,
 )
-from fracid.store import RunStore
+from fracid.store.runs import RunStore
 
 TESTS = str(Path(__file__).resolve().parent)
 PARENT_ENVIRONMENT = {name: os.environ.get(name) for name in THREAD_VARIABLES}
@@ -263,7 +263,7 @@ def test_filters_run_side_by_side_on_the_pool_and_share_the_store(tmp_path):
     from fracid.inverse.core.forward_operator import ForwardOperator, Observation
     from fracid.inverse.core.runs import StoredOperator
     from fracid.inverse.studies.uniqueness import multi_start
-    from fracid.parallel import concurrently, executor_width
+    from fracid.runtime.executors import concurrently, executor_width
 
     op = ForwardOperator([Observation(fracid.BarWithWeakZone(n_elements=40), np.linspace(0.004, 0.03, 6))],
                          fracid.DamageParameters(), ("c", "beta"))

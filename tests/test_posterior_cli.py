@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
-from fracid import cli, exits
+from fracid import cli
+from fracid.runtime import exits
 from fracid.inverse.sampling.posterior import PosteriorSettings, weighted_quantile
 
 PNG = b"\x89PNG\r\n\x1a\n"

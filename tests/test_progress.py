@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from fracid import progress
+from fracid.runtime import progress
 from hostile import bar_config, run_fracid, synthetic_curve, write_csv
 
 

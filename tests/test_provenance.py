@@ -1,4 +1,4 @@
-"""Provenance (fracid.provenance): collected, saved in result.json and loaded back, shown in the report,
+"""Provenance (fracid.store.provenance): collected, saved in result.json and loaded back, shown in the report,
 recorded in the run store; an old result.json without it and an old store without its table still open."""
 
 import dataclasses
@@ -14,8 +14,8 @@ import fracid
 from fracid.inverse.methods.knn import ParameterSpace
 from fracid.inverse.core.method import MethodResult
 from fracid.inverse.methods.strategy import IdentificationResult
-from fracid.provenance import collect, json_safe
-from fracid.store import RunStore
+from fracid.store.provenance import collect, json_safe
+from fracid.store.runs import RunStore
 
 BAR = fracid.BarWithWeakZone(n_elements=10)
 

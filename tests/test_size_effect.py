@@ -11,7 +11,7 @@ import fracid
 from fracid.inverse.studies.size_effect import nominal_strength, size_effect_series, specimen_size
 from fracid.inverse.studies.size_effect_law import SizeEffectFit, bazant_law, fit_size_effect
 from fracid.fem.path.path_following import ConvergenceError, PathResult
-from fracid.parallel import make_executor
+from fracid.runtime.executors import make_executor
 from fracid.report.figures import size_effect_figure, to_png
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone

@@ -16,7 +16,7 @@ from fracid.config import ConfigError, load_config
 from fracid.config.sections import specimen_error_key
 from fracid.fem.material.laws import HordijkLaw
 from fracid.fem.path.path_following import StepOptions
-from fracid.field_error import FieldError
+from fracid.settings.field_error import FieldError
 from fracid.models import (MODEL_TYPES, CohesiveCrackModel, CrackBandModel, DamageModel, ForwardModel, declared,
                            runs_on)
 from fracid.specimens import SPECIMENS, BarWithWeakZone, MeshSpecimen, NotchedBeam, TensionStrip

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid import exits
+from fracid.runtime import exits
 from fracid.specimens.dogbone import DogBone
 
 # c = 25 mm^2 (internal length 7 mm) is resolved by the dog-bone's 2 mm process-zone elements

@@ -68,7 +68,7 @@ def _bar_operator(lengths):
 
 @pytest.fixture(scope="module")
 def executor():
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     with make_executor(2) as ex:
         yield ex

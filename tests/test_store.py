@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.store import RunStore, key_for
-from fracid.store_records import decode_record, encode_record
+from fracid.store.runs import RunStore, key_for
+from fracid.store.records import decode_record, encode_record
 
 SRC = str(Path(fracid.__file__).resolve().parents[1])
 
@@ -121,7 +121,7 @@ def test_key_refuses_unknown_objects_naming_them():
 def test_keys_are_the_same_in_another_process():
     parts = {"model": "gradient", "x": [20000.0, 1e-4, 0.99, 300.0, 1.0], "mesh": {"h_fine": 1.0, "n": 200}}
     here = key_for(**parts)
-    code = "import json, sys; from fracid.store import key_for; print(key_for(**json.loads(sys.argv[1])))"
+    code = "import json, sys; from fracid.store.runs import key_for; print(key_for(**json.loads(sys.argv[1])))"
     env = dict(os.environ, PYTHONHASHSEED="12345")
     mixed = dict(reversed(list(parts.items())))
     args = [sys.executable, "-c", code, json.dumps(mixed)]
@@ -174,7 +174,7 @@ WRITER = textwrap.dedent(
     import sys
     sys.path.insert(0, {src!r})
     import numpy as np
-    from fracid.store import RunStore
+    from fracid.store.runs import RunStore
     store = RunStore(sys.argv[1])
     for i in range(100000):
         store.put(f"run{{i:06d}}", {{"i": i, "data": np.full(20000, float(i))}}, status="ok", seconds=0.0)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
-from fracid import cli, exits
+from fracid import cli
+from fracid.runtime import exits
 from fracid.inverse.sampling.posterior import PosteriorResult
 from fracid.inverse.studies.verdict import GAUSSIAN_MEASURE, POSTERIOR_MEASURE, Z_90, DataDescription, parameter_verdicts
 

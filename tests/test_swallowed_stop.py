@@ -8,8 +8,8 @@ import textwrap
 
 PROGRAM = textwrap.dedent("""
     import os, signal, sys
-    from fracid import exits
-    from fracid.batch import run_batch
+    from fracid.runtime import exits
+    from fracid.runtime.batch import run_batch
 
     class SwallowsInDel:
         def __del__(self):  # an exception raised here is unraisable: Python prints it and goes on

@@ -1,4 +1,4 @@
-"""fracid.tables: CSV that spreadsheets read back cell for cell, and JSON without NaN."""
+"""fracid.store.tables: CSV that spreadsheets read back cell for cell, and JSON without NaN."""
 
 import csv
 import json
@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from fracid.tables import cell, without_nan, write_csv_table
+from fracid.store.tables import cell, without_nan, write_csv_table
 
 
 def test_names_with_commas_quotes_and_line_breaks_come_back_as_one_cell(tmp_path):

@@ -23,7 +23,7 @@ SPACE = ParameterSpace(("c", "beta"), [5.0, 100.0], [80.0, 900.0], log=(True, Tr
 
 @pytest.fixture(scope="module")
 def matrix():
-    from fracid.parallel import make_executor
+    from fracid.runtime.executors import make_executor
 
     cases = dogbone_cases(BASE, h_fine=4.0, n_points=12)
     noise = {"force D50:relative": 0.02, "force D100:relative": 0.02, "force D200:relative": 0.02, "fpz D100": 2.0}

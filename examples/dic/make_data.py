@@ -33,7 +33,7 @@ CURVE_STD = 5.0
 
 def write_curve() -> Path:
     """Write load_cmod.csv: the force [N] against CMOD [mm] of a run at PARAMS, plus Gaussian noise of CURVE_STD."""
-    from fracid.forward import simulate
+    from fracid.models.forward import simulate
 
     run = simulate(BEAM, PARAMS, target=float(CURVE_CMOD[-1]), checkpoints=CURVE_CMOD)
     force = np.interp(CURVE_CMOD, run.control, run.force)

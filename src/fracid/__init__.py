@@ -15,7 +15,7 @@ _EXPORTS = {
     "PathResult": "fracid.fem.path.path_following",
     "StepOptions": "fracid.fem.path.path_following",
     "follow_path": "fracid.fem.path.path_following",
-    "simulate": "fracid.forward",
+    "simulate": "fracid.models.forward",
 }
 
 

@@ -4,14 +4,14 @@ imported, so that a Ctrl-C while the command starts ends it with a message, not 
 import os
 import sys
 
-from fracid.exits import describe, stop_signals, stopped_by
+from fracid.runtime.exits import describe, stop_signals, stopped_by
 
 
 def run() -> None:
-    """Run the command of ``sys.argv`` and exit with its status (see :mod:`fracid.exits`)."""
+    """Run the command of ``sys.argv`` and exit with its status (see :mod:`fracid.runtime.exits`)."""
     with stop_signals():
         try:
-            from fracid.cli import main
+            from fracid.cli.dispatch import main
         except KeyboardInterrupt as stop:
             print("fracid: stopped while starting; nothing was computed.", file=sys.stderr)
             status = describe(stop)[0]

@@ -12,7 +12,7 @@ from fracid.config.checker import show
 from fracid.config.registry import model_of, model_parameters, specimen_class
 from fracid.config.schema import Config, ConfigError, ExperimentConfig
 from fracid.config.vocabulary import DERIVED_KINDS
-from fracid.inverse.core.settings import SettingError
+from fracid.settings.checks import SettingError
 
 #: the kinds whose data come from a DIC displacement field: the field and the blocks derived from it
 FIELD_KINDS = ("field", *DERIVED_KINDS)
@@ -310,7 +310,7 @@ def simulate_settings(cfg: Config) -> dict:
     """Keyword arguments of a forward run besides the specimen and parameters: ``control``,
     ``target``, ``stop_force_fraction``, ``damage_threshold`` and ``field_steps`` (the VTK steps, or
     ``"last"`` when none are listed), as taken by ``build_model(cfg).simulate``; for the damage
-    models also ``regularization``, so that they are those of :func:`fracid.forward.simulate` too
+    models also ``regularization``, so that they are those of :func:`fracid.models.forward.simulate` too
     (drop it when calling the model's ``simulate``, which sets it itself)."""
     sim = cfg.simulate
     settings = {"control": cfg.specimen.control, "target": sim.target,

@@ -9,8 +9,8 @@ import tomllib
 from pathlib import Path
 
 from fracid.config.schema import ConfigError
-from fracid.inverse.core import settings
-from fracid.inverse.core.settings import SettingError, bytes_text, show
+from fracid.settings import checks as settings
+from fracid.settings.checks import SettingError, bytes_text, show
 
 __all__ = ["Checker", "MAX_CONFIG_BYTES", "STDIN", "bytes_text", "read_toml", "show"]
 
@@ -34,7 +34,7 @@ class Checker:
         raise ConfigError(f"{self.path}: {key} is missing (no value given); it is required: {allowed}")
 
     def checked(self, check, *args):
-        """``check(*args)`` (a checker of :mod:`fracid.inverse.core.settings`), its SettingError as this file's
+        """``check(*args)`` (a checker of :mod:`fracid.settings.checks`), its SettingError as this file's
         ConfigError."""
         try:
             return check(*args)
@@ -42,15 +42,15 @@ class Checker:
             self.fail(err.key, err.value, err.allowed)
 
     def table(self, key: str, value, allowed_keys) -> dict:
-        """``value``, a table with keys among ``allowed_keys`` (:func:`fracid.inverse.core.settings.table`)."""
+        """``value``, a table with keys among ``allowed_keys`` (:func:`fracid.settings.checks.table`)."""
         return self.checked(settings.table, key, value, allowed_keys)
 
     def number(self, key, value, allowed="must be a number", ok=lambda v: True) -> float:
-        """A finite number (not a bool) with ``ok(value)`` (:func:`fracid.inverse.core.settings.number`)."""
+        """A finite number (not a bool) with ``ok(value)`` (:func:`fracid.settings.checks.number`)."""
         return self.checked(settings.number, key, value, allowed, ok)
 
     def integer(self, key, value, allowed="must be an integer", ok=lambda v: True) -> int:
-        """An int (not a bool) with ``ok(value)`` (:func:`fracid.inverse.core.settings.integer`)."""
+        """An int (not a bool) with ``ok(value)`` (:func:`fracid.settings.checks.integer`)."""
         return self.checked(settings.integer, key, value, allowed, ok)
 
     def string(self, key, value, allowed="must be a string") -> str:
@@ -59,7 +59,7 @@ class Checker:
         return value
 
     def choice(self, key, value, choices) -> str:
-        """One of the strings ``choices`` (:func:`fracid.inverse.core.settings.choice`)."""
+        """One of the strings ``choices`` (:func:`fracid.settings.checks.choice`)."""
         return self.checked(settings.choice, key, value, choices)
 
     def pair(self, key, value, allowed) -> tuple[float, float]:

@@ -36,7 +36,7 @@ from fracid.config.field_experiments import FieldExperimentConfig
 from fracid.config.registry import specimen_class
 from fracid.config.schema import SpecimenConfig
 from fracid.config.vocabulary import ROLES
-from fracid.inverse.core.settings import is_number
+from fracid.settings.checks import is_number
 
 #: the keys of each derived kind
 DERIVED_KEYS = {

@@ -11,7 +11,7 @@ from fracid.config.registry import model_of, specimen_class
 from fracid.config.schema import IdentifyConfig, ModelConfig, SpecimenConfig
 from fracid.config.sections import range_text, valid_parameter
 from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD, IDENTIFY_KEYS
-from fracid.inverse.core.settings import SettingError, SettingsContext
+from fracid.settings.checks import SettingError, SettingsContext
 from fracid.inverse.methods import registry
 
 
@@ -95,7 +95,7 @@ def check_refinable(ck: Checker, specimen: SpecimenConfig, experiments, identify
 def _checked(ck: Checker, raw, name: str, tables: dict, context: SettingsContext, key: str) -> None:
     """Build the registered method ``name`` from ``tables`` (:func:`~fracid.inverse.methods.registry.
     method_from_tables`): a refused setting is this file's error, named ``identify.<key>`` (a
-    :class:`~fracid.inverse.core.settings.SettingError`'s own key, else ``identify.<key>`` with the table)."""
+    :class:`~fracid.settings.checks.SettingError`'s own key, else ``identify.<key>`` with the table)."""
     try:
         registry.method_from_tables(registry.METHODS[name], tables, context)
     except SettingError as err:
@@ -179,7 +179,7 @@ def method_from_config(identify: IdentifyConfig, n_y: int | None):
     Raises
     ------
     ValueError, TypeError
-        The method's refusal of its settings (a :class:`~fracid.inverse.core.settings.SettingError` names the
+        The method's refusal of its settings (a :class:`~fracid.settings.checks.SettingError` names the
         setting and what is allowed).
     """
     context = SettingsContext(n_y=n_y, parameters=identify.parameters)

@@ -15,7 +15,7 @@ from fracid.config.identify import check_refinable, read_identify
 from fracid.config.mesh_section import parameter_range
 from fracid.config.posterior import read_posterior
 from fracid.config.registry import model_of, section_reader, specimen_class
-from fracid.model_protocol import declared
+from fracid.models.protocol import declared
 from fracid.config.schema import (
     Config,
     ConfigError,
@@ -100,7 +100,7 @@ def _config_path(path) -> tuple[Path, bytes | None]:
 
 def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:
     """Warn when the element size in the process zone exceeds the length the model's mesh must resolve (its
-    :class:`~fracid.model_protocol.MeshLength`: the internal length l = sqrt(2 c) of a gradient or integral damage
+    :class:`~fracid.models.protocol.MeshLength`: the internal length l = sqrt(2 c) of a gradient or integral damage
     model, l / 5 of the PF-CZM) at the smallest value of its parameter (the given one, or the lower bound when it is
     identified): the band is then not resolved and the results depend on the mesh.
 

@@ -266,7 +266,7 @@ class ModelConfig:
 
     @property
     def regularization(self) -> str | None:
-        """The ``regularization`` argument of :func:`fracid.forward.simulate` for the damage models
+        """The ``regularization`` argument of :func:`fracid.models.forward.simulate` for the damage models
         (``"gradient"``, ``"local"``); None for a model that has none (e.g. the cohesive crack)."""
         return model_of(self.type, self.law).regularization
 

@@ -28,7 +28,7 @@ from fracid.config.vocabulary import (
     SIMULATE_KEYS,
     STUDY_KEYS,
 )
-from fracid.inverse.core.settings import is_integer
+from fracid.settings.checks import is_integer
 
 
 def range_text(cls, name: str) -> str:
@@ -119,7 +119,7 @@ def _field_kind(field: dataclasses.Field) -> str:
 
 def specimen_error_key(err: Exception, fields, given) -> str | None:
     """The specimen field an error of its validation is about: of the fields the error names (its
-    ``names``, a :class:`~fracid.field_error.FieldError`), the first the user gave, else the first.
+    ``names``, a :class:`~fracid.settings.field_error.FieldError`), the first the user gave, else the first.
     An error without ``names`` (a specimen class of another package) is searched for field names."""
     names = getattr(err, "names", None)
     if names is None:  # fallback: the field names in the message, in their order there

@@ -11,7 +11,7 @@ Grégoire beam keeps the files of the bundled demo (:mod:`fracid.data`, ``fracid
 >>> data = datasets.load("tinloi-que-wst")        # ExperimentalData: opening [mm], splitting force [N]
 
 On the command line: ``fracid datasets`` lists them, ``fracid init --dataset NAME -o FILE`` writes the
-configuration with the data file and the licence copied beside it (:mod:`fracid.cli_datasets`).
+configuration with the data file and the licence copied beside it (:mod:`fracid.cli.datasets`).
 """
 
 from __future__ import annotations

@@ -211,7 +211,7 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
     control_label : str, optional
         The fit figure's x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
     provenance : dict, optional
-        How the result was obtained (:func:`fracid.provenance.collect`); the result's ``provenance``
+        How the result was obtained (:func:`fracid.store.provenance.collect`); the result's ``provenance``
         when omitted. Shown last, collapsed: "How this was run".
     fields : dict of str -> dict, optional
         The coordinates of the displacement-field blocks, by block name: the observation kind's

@@ -20,7 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from fracid.inverse.studies.verdict import Z_90
-from fracid.tables import without_nan
+from fracid.store.tables import without_nan
 from fracid.report.figures import (
     COMPUTED,
     MEASURED,
@@ -278,7 +278,7 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
         Log axes of the corner plot per parameter (``ParameterSpace.log``).
     title : str
     provenance : dict, optional
-        How the run was made (:func:`fracid.provenance.collect`): in the page, collapsed, and in
+        How the run was made (:func:`fracid.store.provenance.collect`): in the page, collapsed, and in
         ``posterior.json`` under ``provenance``.
 
     Returns

@@ -201,7 +201,7 @@ def write_study(directory, study, data, *, title="fracid study", truth=None, siz
     """Write the study's JSON/CSV tables, figures (PNG) and HTML report into ``directory``; with a
     posterior, also the files of :func:`~fracid.report.posterior.write_posterior`.
 
-    ``provenance`` (:func:`fracid.provenance.collect`) is shown, collapsed, in the reports; the
+    ``provenance`` (:func:`fracid.store.provenance.collect`) is shown, collapsed, in the reports; the
     identification's own when omitted.
 
     Returns the paths written; a note in brackets (a string, not a path) for a posterior file skipped.

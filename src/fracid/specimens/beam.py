@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from fracid.field_error import FieldError
+from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
 from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth

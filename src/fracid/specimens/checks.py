@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from fracid.field_error import FieldError
+from fracid.settings.field_error import FieldError
 
 
 def require_positive(specimen, names, unit: str = "") -> None:
@@ -22,7 +22,7 @@ def resolve_defaults(specimen, defaults) -> None:
     value [mm], on a frozen dataclass.
 
     The specimen then holds the numbers its mesh uses, so its equality, its repr and its run key
-    (:func:`fracid.store.key_for`) are those of a specimen given these numbers explicitly.
+    (:func:`fracid.store.runs.key_for`) are those of a specimen given these numbers explicitly.
     ``dataclasses.replace`` copies the resolved numbers: build a new specimen to derive them afresh.
     """
     for name, derive in defaults.items():

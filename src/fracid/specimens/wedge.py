@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.field_error import FieldError
+from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
 from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import Description

@@ -20,7 +20,7 @@ from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 
-from fracid.field_error import FieldError
+from fracid.settings.field_error import FieldError
 
 
 class ParameterError(FieldError):

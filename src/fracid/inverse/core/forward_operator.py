@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 from fracid.inverse.core.observations import FieldObservation, Observation, ObservationKind, check_control_points
 from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
-from fracid.forward import model_with_regularization
+from fracid.models.forward import model_with_regularization
 from fracid.models import ConvergenceError, StepOptions, declared
 
 __all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RunRecord"]

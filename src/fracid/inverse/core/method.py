@@ -120,7 +120,7 @@ class MethodResult(GaussianEstimate):
     quantities : list of str
         The observed quantity of each block (``"force"``, ``"fpz_width"``, ...; empty if unknown).
     provenance : dict
-        How the result was obtained (:func:`fracid.provenance.collect`: version, command line,
+        How the result was obtained (:func:`fracid.store.provenance.collect`: version, command line,
         configuration, data files and their SHA-256, specimen, mesh, machine, date); empty if not given.
     error_terms : dict
         The error terms added to the data covariance (the mesh's discretisation error, the model's own

@@ -157,7 +157,7 @@ class Observation:
     damage_threshold: float = 0.0
 
     def __post_init__(self):
-        from fracid.forward import check_specimen
+        from fracid.models.forward import check_specimen
 
         check_specimen(self.specimen)
         object.__setattr__(self, "control_points", check_control_points(self.control_points))
@@ -287,7 +287,7 @@ class FieldObservation:
 
     def __post_init__(self):
         from fracid.models import probe_matrix
-        from fracid.forward import check_specimen
+        from fracid.models.forward import check_specimen
 
         check_specimen(self.specimen)
         object.__setattr__(self, "points", check_points(self.points))

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.core.forward_operator import RunRecord
-from fracid.batch import BatchStats, run_batch
-from fracid.store import key_for
+from fracid.runtime.batch import BatchStats, run_batch
+from fracid.store.runs import key_for
 
 
 #: The forward chain, relative to the package: what a forward run executes (the models, the finite

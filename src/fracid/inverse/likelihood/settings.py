@@ -10,14 +10,14 @@
     prior = "half-cauchy"
 
 :func:`discretisation_from_config` and :func:`model_error_from_config` check them (a
-:class:`~fracid.inverse.core.settings.SettingError` names the key relative to ``[identify]``).
+:class:`~fracid.settings.checks.SettingError` names the key relative to ``[identify]``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fracid.inverse.core import settings
+from fracid.settings import checks as settings
 
 DISCRETISATION_KEY, MODEL_ERROR_KEY = "discretisation_error", "model_error"
 DISCRETISATION_KINDS = ("off", "richardson")

@@ -208,7 +208,7 @@ def _computed(result) -> int:
 
 def _temporary_store(stack):
     """A run store in a temporary directory, removed when ``stack`` closes (the re-identifications reuse its runs)."""
-    from fracid.store import RunStore
+    from fracid.store.runs import RunStore
 
     directory = stack.enter_context(tempfile.TemporaryDirectory(prefix="fracid-terms-"))
     return stack.enter_context(RunStore(Path(directory) / "runs.sqlite"))

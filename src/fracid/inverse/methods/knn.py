@@ -161,10 +161,10 @@ def knn_search(operator, y_exp, C_exp, space: ParameterSpace, *, n=64, method="s
     k : int
         Neighbours averaged into x0 and C0.
     executor : Executor, optional
-        Runs the population in parallel (see :mod:`fracid.parallel`).
+        Runs the population in parallel (see :mod:`fracid.runtime.executors`).
     store : RunStore, optional
         Stored runs are reused, new ones stored as they finish (an interrupted population resumes).
-    stats : fracid.batch.BatchStats, optional
+    stats : fracid.runtime.batch.BatchStats, optional
         Filled with the numbers of runs computed, reused and failed.
     retry_failed : bool
         Run again the points stored as failed.

@@ -19,8 +19,8 @@ from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table, knn
 from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
 from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
-from fracid.inverse.core import settings
-from fracid.inverse.core.settings import SettingsContext, toml_line
+from fracid.settings import checks as settings
+from fracid.settings.checks import SettingsContext, toml_line
 from fracid.inverse.core.space import ParameterSpace
 
 #: the table of the Gauss-Newton stage's settings in ``[identify]``, and its keys
@@ -91,7 +91,7 @@ class KnnGaussNewton:
 
         Raises
         ------
-        fracid.inverse.core.settings.SettingError
+        fracid.settings.checks.SettingError
             A key or value refused (named relative to ``[identify]``: ``gauss-newton.tol``).
         """
         knn = knn_from_table(tables.get("knn", {}), context)

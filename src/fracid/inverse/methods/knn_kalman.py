@@ -23,12 +23,12 @@ from fracid.inverse.methods.knn import knn_search
 from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table, knn_template
 from fracid.inverse.core.method import MethodResult, check_problem, identification_bounds, result_fields
 from fracid.inverse.core.plans import StagePlan, plural, population_plan, runs_per_linearisation
-from fracid.inverse.core import settings
+from fracid.settings import checks as settings
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
-from fracid.inverse.core.settings import SettingsContext, toml_line
+from fracid.settings.checks import SettingsContext, toml_line
 from fracid.inverse.core.space import ParameterSpace
-from fracid.batch import BatchStats
+from fracid.runtime.batch import BatchStats
 
 
 def _knn_kalman_stages() -> dict:
@@ -114,7 +114,7 @@ def kalman_from_table(raw, n_y: int | None) -> KalmanSettings:
 
     Raises
     ------
-    fracid.inverse.core.settings.SettingError
+    fracid.settings.checks.SettingError
         Naming ``kalman.<key>``, the value and what is allowed.
     """
     raw = settings.table("kalman", raw, KALMAN_KEYS)
@@ -184,7 +184,7 @@ class KnnKalman:
 
         Raises
         ------
-        fracid.inverse.core.settings.SettingError
+        fracid.settings.checks.SettingError
             A key or value refused (named relative to ``[identify]``: ``kalman.groups``).
         """
         knn = knn_from_table(tables.get("knn", {}), context)
@@ -323,7 +323,7 @@ def _counters(operator):
 def kalman_progress(progress, groups, n_outputs, max_iterations):
     """A progress bar of the Kalman stage (linearisations: the first pass's steps, then one per pass);
     yields the filter's callback."""
-    from fracid.progress import progress_bar
+    from fracid.runtime.progress import progress_bar
 
     steps = n_outputs if groups is None else len(groups)
     total = steps + max_iterations - 1

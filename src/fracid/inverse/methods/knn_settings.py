@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fracid.inverse.core import settings
-from fracid.inverse.core.settings import SettingError, SettingsContext, bytes_text, toml_line
+from fracid.settings import checks as settings
+from fracid.settings.checks import SettingError, SettingsContext, bytes_text, toml_line
 
 
 @dataclass(frozen=True)

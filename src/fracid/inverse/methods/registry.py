@@ -10,8 +10,8 @@ counters and records in the result, the report's sections). A method meets
 A new method is a class and one line here (or ``METHODS[name] = cls`` from the user's code). Its settings
 come from the configuration's tables ``[identify.<table>]`` that it declares in ``config_tables`` (without it:
 the table of its name, ``[identify.<name>]``), read and checked by its ``from_config(tables, context)`` class
-method (:func:`method_from_tables`; the checkers and their :class:`~fracid.inverse.core.settings.SettingError`
-are in :mod:`fracid.inverse.core.settings`); ``config_template(tables)`` writes them for ``fracid init``. The
+method (:func:`method_from_tables`; the checkers and their :class:`~fracid.settings.checks.SettingError`
+are in :mod:`fracid.settings.checks`); ``config_template(tables)`` writes them for ``fracid init``. The
 configuration knows no method: it allows every table a registered method declares (:func:`known_tables`) and
 warns of one the chosen method does not read (:func:`table_readers`).
 """
@@ -117,12 +117,12 @@ def method_from_tables(cls, given: dict, context):
         An inverse method class.
     given : dict
         The ``[identify.<table>]`` tables given, by name.
-    context : fracid.inverse.core.settings.SettingsContext
+    context : fracid.settings.checks.SettingsContext
         The data's size ``n_y`` and the identified ``parameters``.
 
     Raises
     ------
-    fracid.inverse.core.settings.SettingError
+    fracid.settings.checks.SettingError
         A setting refused by the method, named relative to ``[identify]``.
     ValueError, TypeError
         Another refusal of the method; settings given to a method that takes none.

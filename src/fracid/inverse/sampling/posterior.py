@@ -422,7 +422,7 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
     error_likelihood`).
     """
     from fracid.inverse.likelihood.record import error_likelihood
-    from fracid.progress import batch_progress, progress_bar
+    from fracid.runtime.progress import batch_progress, progress_bar
 
     C_exp, marginal = data.covariance, None
     if getattr(identification, "error_terms", None):

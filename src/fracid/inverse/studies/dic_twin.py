@@ -181,7 +181,7 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     Parameters
     ----------
     specimen, params, model
-        As :func:`fracid.forward.simulate` (the gradient damage model if ``model`` is None).
+        As :func:`fracid.models.forward.simulate` (the gradient damage model if ``model`` is None).
     frames : array_like
         Increasing control values of the frames [mm] (e.g. CMOD); each is a step of the run.
     spacing : float
@@ -213,7 +213,7 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     -------
     SyntheticDic
     """
-    from fracid.forward import check_specimen, simulate
+    from fracid.models.forward import check_specimen, simulate
     from fracid.models import probe_matrix
 
     frames = _check_frames(frames)

@@ -14,7 +14,7 @@ space):
 
 Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the KNN prior's
 term, the objective the Kalman filter minimises), the chi^2, AIC and BIC. The models run side by side
-(:func:`fracid.parallel.concurrently`: a thread per model submitting its forward runs to the shared executor)
+(:func:`fracid.runtime.executors.concurrently`: a thread per model submitting its forward runs to the shared executor)
 and every run goes through the run store (the identification's stages under their own labels, the posterior
 and the Laplace run under ``compare:<label>``; the keys hold the model, so models never share a run and a
 rerun computes nothing). A model that fails is recorded with its reason and the others go on.
@@ -48,7 +48,7 @@ from fracid.inverse.studies.model_fit import candidate_operator
 from fracid.inverse.studies.study_result import describe_data
 from fracid.inverse.studies.uniqueness import bounds_covariance
 from fracid.inverse.studies.verdict import parameter_verdicts
-from fracid.parallel import concurrently
+from fracid.runtime.executors import concurrently
 
 __all__ = ["MODEL_FAILURES", "ComparisonResult", "Contender", "ModelScore", "compare", "contender"]
 

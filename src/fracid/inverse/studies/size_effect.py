@@ -16,7 +16,7 @@ import numpy as np
 
 from fracid.inverse.studies.size_effect_law import fit_size_effect
 from fracid.models import ConvergenceError
-from fracid.batch import run_batch
+from fracid.runtime.batch import run_batch
 
 __all__ = [
     "SizeEffectComparison",
@@ -133,10 +133,10 @@ def size_effect_series(params, specimens, *, model=None, executor=None, progress
     model : forward model, optional
         Any model of :mod:`fracid.models`; gradient damage if None.
     executor : Executor, optional
-        From :func:`fracid.parallel.make_executor`; the runs go to it together. None: one after
+        From :func:`fracid.runtime.executors.make_executor`; the runs go to it together. None: one after
         the other in this process.
     progress : None, bool or callable
-        As in :func:`fracid.batch.run_batch`.
+        As in :func:`fracid.runtime.batch.run_batch`.
 
     Returns
     -------

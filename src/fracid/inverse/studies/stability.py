@@ -16,7 +16,7 @@ import numpy as np
 
 from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.methods.kalman import kalman_filter
-from fracid.parallel import concurrently
+from fracid.runtime.executors import concurrently
 
 
 @dataclass

@@ -329,7 +329,7 @@ def _posterior_stage(operator, data, space, ident, settings, *, store, executor,
 @contextmanager
 def stage_bar(progress, total, description):
     """A progress bar over the filters of a study stage; yields its ``progress(done, total)`` callable."""
-    from fracid.progress import batch_progress, progress_bar
+    from fracid.runtime.progress import batch_progress, progress_bar
 
     with progress_bar(total, description, progress, unit="filter") as bar:
         yield batch_progress(bar)

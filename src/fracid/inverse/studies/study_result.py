@@ -12,7 +12,7 @@ import numpy as np
 from fracid.inverse.methods.knn import objective
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity
 from fracid.inverse.studies.verdict import DataDescription
-from fracid.tables import without_nan, write_csv_table
+from fracid.store.tables import without_nan, write_csv_table
 
 
 @dataclass

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from fracid.inverse.methods.kalman import kalman_filter
-from fracid.parallel import concurrently
+from fracid.runtime.executors import concurrently
 from fracid.inverse.core.sensitivity import ForwardRunError
 
 

@@ -26,7 +26,7 @@ import signal
 import sqlite3
 import sys
 
-from fracid.stops import RAISED_BY, HungUp, Terminated, received, raise_if_stopped, stopped_by  # noqa: F401 -- re-exported
+from fracid.runtime.stops import RAISED_BY, HungUp, Terminated, received, raise_if_stopped, stopped_by  # noqa: F401 -- re-exported
 
 OK, INTERNAL, INPUT, FAILED, FILES, MEMORY, INTERRUPTED, TERMINATED, HUNG_UP = 0, 1, 2, 3, 4, 5, 130, 143, 129
 
@@ -160,7 +160,7 @@ _DAMAGED = ("it is damaged (truncated, or not written by fracid); move it away (
 
 def _store_text(err, where) -> str:
     """The message of a run-store failure, by SQLite's result code: only a damaged file is to be moved away."""
-    if isinstance(err, _loaded("fracid.store", "NotARunStore")):
+    if isinstance(err, _loaded("fracid.store.runs", "NotARunStore")):
         return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
                 "output directory (--out DIR) or run store (--store FILE).")
     code = getattr(err, "sqlite_errorcode", None)

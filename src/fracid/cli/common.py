@@ -2,8 +2,8 @@
 claim, the directory's lock and run store, the executor of ``--workers`` / ``--scheduler``, the progress
 choice, the provenance record and the messages (``say``, ``warn``, ``wrote``).
 
-:mod:`fracid.cli` (the parser, the dispatch and simulate / identify / posterior / demo),
-:mod:`fracid.cli_studies`, :mod:`fracid.cli_init` and :mod:`fracid.cli_check` import from here, so none of
+:mod:`fracid.cli.dispatch` (the parser, the dispatch and simulate / identify / posterior / demo),
+:mod:`fracid.cli.studies`, :mod:`fracid.cli.init` and :mod:`fracid.cli.check` import from here, so none of
 them imports another's internals.
 """
 
@@ -55,8 +55,8 @@ def load(args, path, purpose):
 
 def out_dir(args, cfg) -> Path:
     """The output directory, made if needed, once the command's outputs are known to replace neither an
-    input of the run nor a file fracid did not write (:func:`fracid.outputs.claim_outputs`)."""
-    from fracid.outputs import claim_outputs
+    input of the run nor a file fracid did not write (:func:`fracid.store.outputs.claim_outputs`)."""
+    from fracid.store.outputs import claim_outputs
 
     out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
     if out.exists() and not out.is_dir():
@@ -81,8 +81,8 @@ def _inputs(cfg):
 def working_in(args, out, store=False):
     """The output directory's lock, and (``store``) its run store: ``OUT/runs.sqlite``, or the file of
     ``--store`` (shared between commands, under a lock of its own); the store's path goes to messages."""
-    from fracid.lock import directory_lock, store_lock
-    from fracid.store import RunStore
+    from fracid.runtime.locks import directory_lock, store_lock
+    from fracid.store.runs import RunStore
 
     shared = getattr(args, "store", None)
     with directory_lock(out):
@@ -97,9 +97,9 @@ def working_in(args, out, store=False):
 
 
 def shared_store(path) -> Path:
-    """The run store file of ``--store PATH``; :class:`~fracid.exits.UsageError` for a directory or a missing
+    """The run store file of ``--store PATH``; :class:`~fracid.runtime.exits.UsageError` for a directory or a missing
     directory."""
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     path = Path(path).expanduser()
     if path.is_dir():
@@ -119,8 +119,8 @@ def progress_choice(args):
 @contextlib.contextmanager
 def command_executor(args):
     """The executor of --workers / --scheduler; an unusable option is named (exit 2)."""
-    from fracid.exits import UsageError
-    from fracid.parallel import executor_session
+    from fracid.runtime.exits import UsageError
+    from fracid.runtime.executors import executor_session
 
     if args.scheduler is not None and args.workers is not None:
         raise UsageError(f"--workers {args.workers} and --scheduler {args.scheduler}: give one of them (the Dask "
@@ -136,8 +136,8 @@ def command_executor(args):
 
 
 def provenance(args, cfg, operator, space, store=None) -> dict:
-    """How this run was made (:func:`fracid.provenance.collect`), also kept in the run store's meta table."""
-    from fracid.provenance import collect
+    """How this run was made (:func:`fracid.store.provenance.collect`), also kept in the run store's meta table."""
+    from fracid.store.provenance import collect
 
     record = collect(argv=getattr(args, "argv", ["fracid"]), config=cfg, data_files=[e.file for e in cfg.experiments],
                      specimen=operator.observations[0].specimen, parameters=operator.base, bounds=space)

@@ -23,7 +23,7 @@ COLUMNS = (("NAME", "name"), ("SPECIMEN", "specimen"), ("MODEL", "model"), ("LIC
 
 def add_parser(sub) -> None:
     """The ``datasets`` subcommand, and ``--dataset NAME`` of ``init`` (added to the parser that
-    :func:`fracid.cli_init.add_parser` made, so that ``init`` keeps one parser)."""
+    :func:`fracid.cli.init.add_parser` made, so that ``init`` keeps one parser)."""
     p = sub.add_parser("datasets", help="list the bundled data sets (fracid init --dataset NAME writes one's config)")
     p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
     sub.choices["init"].add_argument(
@@ -70,7 +70,7 @@ def config_text(ds, references: dict, licence: str) -> str:
     str
         TOML text; the configuration's own text (and comments) otherwise unchanged.
     """
-    from fracid.inverse.core.settings import toml_value
+    from fracid.settings.checks import toml_value
 
     def reference(match):
         name = match.group(2)
@@ -88,9 +88,9 @@ def config_text(ds, references: dict, licence: str) -> str:
 def init_dataset(args) -> int:
     """``fracid init --dataset NAME [-o FILE] [--force]``: the configuration on standard output, or written
     to FILE with the data set's files copied beside it."""
-    from fracid.cli_init import DEMO_PAIR
+    from fracid.cli.init import DEMO_PAIR
     from fracid.datasets import get
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     ds = get(args.dataset)  # an unknown name: UnknownDataset, exit 2, the names listed
     if args.list or (args.specimen, args.model) != DEMO_PAIR:
@@ -114,7 +114,7 @@ def init_dataset(args) -> int:
 def _copies(ds, path: Path, force: bool) -> dict:
     """{file beside ``path``: installed file} for the data files and the licence, once nothing would be
     overwritten: ``path`` only with ``force``, a copy never (UsageError naming the file)."""
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     if path.is_dir():
         raise UsageError(f"-o {path}: a directory; give a file name such as {path / (ds.name + '.toml')}")

@@ -25,7 +25,7 @@ _write_lock = threading.Lock()
 @contextlib.contextmanager
 def progress_lines(enabled: bool = True):
     """Within: progress left to the default (``enabled=None`` of :func:`progress_bar`, ``progress=None``
-    of :func:`fracid.batch.run_batch`) prints lines when stderr is not a terminal."""
+    of :func:`fracid.runtime.batch.run_batch`) prints lines when stderr is not a terminal."""
     before, _state["lines"] = _state["lines"], bool(enabled)
     try:
         yield
@@ -149,7 +149,7 @@ def progress_bar(total: float, description: str, enabled: bool | None = None, un
 
 
 def batch_lines(description: str = "forward runs", failed=None):
-    """A ``progress(done, total)`` callable for :func:`fracid.batch.run_batch` printing lines; it
+    """A ``progress(done, total)`` callable for :func:`fracid.runtime.batch.run_batch` printing lines; it
     closes (its last line) when ``done`` reaches ``total``."""
     line = None
 
@@ -167,7 +167,7 @@ def batch_lines(description: str = "forward runs", failed=None):
 
 
 def batch_progress(bar):
-    """Adapter for :func:`fracid.batch.run_batch`'s ``progress(done, total)`` callable."""
+    """Adapter for :func:`fracid.runtime.batch.run_batch`'s ``progress(done, total)`` callable."""
 
     def report(done, total):
         bar.total = total

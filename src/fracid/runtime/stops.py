@@ -1,5 +1,5 @@
 """The stop signals this process received (SIGINT, SIGTERM, SIGHUP), on the lowest floor: the command's
-handlers (:func:`fracid.exits.stop_signals`) record them here, and long work below the command (the batch of
+handlers (:func:`fracid.runtime.exits.stop_signals`) record them here, and long work below the command (the batch of
 forward runs) asks :func:`raise_if_stopped` at its checkpoints."""
 
 from __future__ import annotations

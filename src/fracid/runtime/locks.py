@@ -1,7 +1,7 @@
 """Exclusive locks on an output directory and on a shared run store, so that two fracid processes never
-compute into one (a run store has one writer, :mod:`fracid.store`).
+compute into one (a run store has one writer, :mod:`fracid.store.runs`).
 
-A lock is an operating-system lock on a file (``.fracid.lock`` in the directory; ``<store>.fracid.lock``
+A lock is an operating-system lock on a file (``.fracid.runtime.locks`` in the directory; ``<store>.fracid.runtime.locks``
 beside a store given with ``--store``; ``fcntl.flock`` on POSIX, ``msvcrt.locking`` on Windows): it is
 released when the process ends in any way, SIGKILL included, so a stale lock file never blocks a rerun.
 """
@@ -12,13 +12,13 @@ import contextlib
 import os
 from pathlib import Path
 
-from fracid.exits import OutputInUse
+from fracid.runtime.exits import OutputInUse
 
-LOCK_NAME = ".fracid.lock"
+LOCK_NAME = ".fracid.runtime.locks"
 
 
 def directory_lock(directory):
-    """Hold the lock of ``directory`` for the duration; :class:`~fracid.exits.OutputInUse` if another
+    """Hold the lock of ``directory`` for the duration; :class:`~fracid.runtime.exits.OutputInUse` if another
     process holds it (the message names that process's pid)."""
     return _file_lock(Path(directory) / LOCK_NAME, f"the output directory {directory}",
                       "give another directory with --out DIR")
@@ -26,7 +26,7 @@ def directory_lock(directory):
 
 def store_lock(store):
     """Hold the lock of the run store file ``store`` (shared between commands with ``--store``) for the
-    duration; :class:`~fracid.exits.OutputInUse` if another process holds it."""
+    duration; :class:`~fracid.runtime.exits.OutputInUse` if another process holds it."""
     store = Path(store)
     return _file_lock(store.with_name(store.name + LOCK_NAME), f"the run store {store}",
                       "give another store with --store FILE")

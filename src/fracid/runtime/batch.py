@@ -1,5 +1,5 @@
 """A resumable batch runner for many forward runs: :func:`run_batch` maps a function over tasks on any
-executor of :mod:`fracid.parallel`; with a :class:`~fracid.store.RunStore` it skips tasks already stored
+executor of :mod:`fracid.runtime.executors`; with a :class:`~fracid.store.runs.RunStore` it skips tasks already stored
 and stores every run as soon as it finishes, so a study killed at any moment resumes where it stopped,
 losing only runs in flight.
 
@@ -18,10 +18,10 @@ import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from fracid.stops import raise_if_stopped
-from fracid.parallel import SerialExecutor, is_dask, is_executor, make_executor
-from fracid.progress import batch_lines, clock, is_terminal, lines_wanted
-from fracid.store_records import decode_record, encode_record
+from fracid.runtime.stops import raise_if_stopped
+from fracid.runtime.executors import SerialExecutor, is_dask, is_executor, make_executor
+from fracid.runtime.progress import batch_lines, clock, is_terminal, lines_wanted
+from fracid.store.records import decode_record, encode_record
 
 __all__ = ["BatchStats", "run_batch"]
 
@@ -79,20 +79,20 @@ def run_batch(function: Callable[[object], dict], tasks: Sequence, *, executor, 
     tasks : sequence
         Picklable arguments, one per run.
     executor
-        From :func:`~fracid.parallel.make_executor` (a SerialExecutor, a process pool, a dask Client) or any executor
+        From :func:`~fracid.runtime.executors.make_executor` (a SerialExecutor, a process pool, a dask Client) or any executor
         with ``submit``; anything else (e.g. ``2`` or ``"serial"``) is passed to :func:`make_executor`
         and the executor made is shut down at the end.
     store : RunStore, optional
         With ``keys``: tasks whose key is stored are not run, their record is loaded; every finished
         run is stored at once by this (the parent) process, failed runs included.
     keys : sequence of str, optional
-        One key per task (see :func:`fracid.store.key_for`). Tasks with equal keys run once and share
+        One key per task (see :func:`fracid.store.runs.key_for`). Tasks with equal keys run once and share
         their record.
     study : str
         Label stored with the runs.
     progress : None, bool or callable
         ``None``: a one-line progress report on stderr if stderr is a terminal (else lines of text within
-        :func:`fracid.progress.progress_lines`, as the command line does); ``False``: none;
+        :func:`fracid.runtime.progress.progress_lines`, as the command line does); ``False``: none;
         ``True``: the report on stderr in any case; a callable: called as ``progress(done, total)``.
     stats : BatchStats, optional
         Filled in (overwritten) with the counters of this call.
@@ -184,9 +184,9 @@ def _check_store_and_keys(tasks, store, keys):
     if store is None and keys is None:
         return None
     if store is None:
-        raise ValueError("keys= needs store= (a fracid.store.RunStore) to look the runs up in")
+        raise ValueError("keys= needs store= (a fracid.store.runs.RunStore) to look the runs up in")
     if keys is None:
-        raise ValueError("store= needs keys=, one per task (see fracid.store.key_for)")
+        raise ValueError("store= needs keys=, one per task (see fracid.store.runs.key_for)")
     keys = list(keys)
     if len(keys) != len(tasks):
         raise ValueError(f"got {len(keys)} keys for {len(tasks)} tasks; give one key per task")

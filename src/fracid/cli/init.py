@@ -19,7 +19,7 @@ import sys
 import tomllib
 from pathlib import Path
 
-from fracid.inverse.core.settings import COMMENT_COLUMN, toml_line
+from fracid.settings.checks import COMMENT_COLUMN, toml_line
 
 #: the parameters a first identification looks for, per ``[model] type`` (others: the two after E and nu)
 IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("kappa_i", "beta", "c"),
@@ -121,7 +121,7 @@ def runnable_pairs() -> list:
     return pairs
 
 
-#: ``key = value  # comment`` (:func:`fracid.inverse.core.settings.toml_line`)
+#: ``key = value  # comment`` (:func:`fracid.settings.checks.toml_line`)
 _line = toml_line
 
 
@@ -137,7 +137,7 @@ def _comments(text: str, width: int = 100) -> list:
 
 
 def _demo() -> dict:
-    from fracid.cli_common import demo_config_path
+    from fracid.cli.common import demo_config_path
 
     with open(demo_config_path(), "rb") as f:
         return tomllib.load(f)
@@ -295,7 +295,7 @@ def config_text(specimen: str, model: str) -> str:
         A TOML configuration that :func:`fracid.config.load_config` accepts and ``fracid simulate`` runs
         (``fracid identify`` too for the demo pair, whose data file is the bundled one).
     """
-    from fracid.cli_common import demo_config_path
+    from fracid.cli.common import demo_config_path
     from fracid.models import model_from_type
 
     demo = _demo() if (specimen, model) == DEMO_PAIR else None
@@ -318,7 +318,7 @@ def config_text(specimen: str, model: str) -> str:
 def run_init(args) -> int:
     """``fracid init``: print or write the configuration (``-o FILE``, not over an existing file unless
     ``--force``), or list the pairs (``--list``)."""
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     pairs = runnable_pairs()
     if args.list:

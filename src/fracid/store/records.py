@@ -1,6 +1,6 @@
 """Records of runs as JSON bytes: a JSON-like dict that may hold numpy arrays, stored losslessly
-(:func:`encode_record`, :func:`decode_record`); the form in which :class:`fracid.store.RunStore` keeps them
-and in which a batch's workers send them to the parent (:func:`fracid.batch.run_batch`).
+(:func:`encode_record`, :func:`decode_record`); the form in which :class:`fracid.store.runs.RunStore` keeps them
+and in which a batch's workers send them to the parent (:func:`fracid.runtime.batch.run_batch`).
 """
 
 from __future__ import annotations

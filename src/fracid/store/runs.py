@@ -2,10 +2,10 @@
 
 A run is identified by a key, the SHA-256 of a canonical JSON of everything that determines it
 (:func:`key_for`). Its record is a JSON-like dict that may hold numpy arrays, stored losslessly
-(:func:`fracid.store_records.encode_record`, :func:`fracid.store_records.decode_record`).
+(:func:`fracid.store.records.encode_record`, :func:`fracid.store.records.decode_record`).
 
 Concurrency: any number of processes may read a store, but only one process should write it. In a
-batch (:func:`fracid.batch.run_batch`) the workers compute and return records; the parent process
+batch (:func:`fracid.runtime.batch.run_batch`) the workers compute and return records; the parent process
 alone writes them. A :class:`RunStore` cannot be sent to another process.
 
 Durability: every :meth:`RunStore.put` is its own transaction. SQLite in WAL mode guarantees that a
@@ -30,7 +30,7 @@ from typing import Self
 
 import numpy as np
 
-from fracid.store_records import decode_record, encode_record, require_str_key
+from fracid.store.records import decode_record, encode_record, require_str_key
 
 __all__ = ["NotARunStore", "RunStore", "UndecodableRecord", "key_for"]
 

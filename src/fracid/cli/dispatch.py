@@ -6,7 +6,7 @@
     fracid posterior CONFIG   identify, then weighted samples of the parameters given the data (adaptive
                               importance sampling on the exact model): CSV, JSON, figures, HTML page
     fracid compare CONFIG     every model that runs on the specimen identified on the same data and ranked by
-                              log evidence (:mod:`fracid.cli_compare`): compare.json, figures, HTML report
+                              log evidence (:mod:`fracid.cli.compare`): compare.json, figures, HTML report
     fracid study CONFIG       the whole strategy through the method's stages: search, sensitivity, uniqueness,
                               refinement, multi-start, stability, prediction of held-out data, size effect;
                               a verdict per parameter
@@ -16,15 +16,15 @@
                               configured parameter values
     fracid size-effect CONFIG nominal strength versus size at the configured parameter values, Bazant fit
     fracid demo               identification of the bundled real test (Gregoire et al. 2013 beam)
-    fracid init               a commented configuration to start from (:mod:`fracid.cli_init`)
-    fracid check CONFIG       validate a configuration and print its plan and cost (:mod:`fracid.cli_check`)
+    fracid init               a commented configuration to start from (:mod:`fracid.cli.init`)
+    fracid check CONFIG       validate a configuration and print its plan and cost (:mod:`fracid.cli.check`)
     fracid datasets           the bundled data sets by name; fracid init --dataset NAME writes one's configuration
-                              (:mod:`fracid.cli_datasets`)
+                              (:mod:`fracid.cli.datasets`)
     fracid --version
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
 Every expected failure ends with a one-paragraph message and a documented exit status (see
-:mod:`fracid.exits`): 2 bad input, 3 the computation failed, 4 files and storage, 5 out of memory,
+:mod:`fracid.runtime.exits`): 2 bad input, 3 the computation failed, 4 files and storage, 5 out of memory,
 130 interrupted; ``--debug`` shows the traceback.
 """
 
@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli_common import (command_executor, demo_config_path, load, out_dir, progress_choice, provenance,
+from fracid.cli.common import (command_executor, demo_config_path, load, out_dir, progress_choice, provenance,
                                say, warn, working_in, wrote)
-from fracid.progress import progress_lines
+from fracid.runtime.progress import progress_lines
 
 __all__ = ["demo_config_path", "main", "provenance", "version"]
 
@@ -77,29 +77,30 @@ def _parser() -> argparse.ArgumentParser:
         if name == "size-effect":
             p.add_argument("--sizes", type=float, nargs="+", help="sizes D [mm] (default: those of the experiments)")
     sub.add_parser("demo", parents=[stored], help="identify the bundled real beam test (Gregoire et al. 2013)")
-    from fracid import cli_check, cli_init
+    from fracid.cli import check as cli_check
+    from fracid.cli import init as cli_init
 
     cli_init.add_parser(sub)
     cli_check.add_parser(sub, common)
-    from fracid import cli_compare
+    from fracid.cli import compare as cli_compare
 
     cli_compare.add_parser(sub, stored)
-    from fracid import cli_datasets
+    from fracid.cli import datasets as cli_datasets
 
     cli_datasets.add_parser(sub)  # `fracid datasets` and `fracid init --dataset NAME`
     return parser
 
 
 def version() -> str:
-    """The installed fracid's version (:func:`fracid.provenance.fracid_version`)."""
-    from fracid.provenance import fracid_version
+    """The installed fracid's version (:func:`fracid.store.provenance.fracid_version`)."""
+    from fracid.store.provenance import fracid_version
 
     return fracid_version()
 
 
 def run_simulate(args) -> int:
     from fracid.config import build_model, build_parameters, build_specimen, simulate_settings
-    from fracid.progress import progress_bar
+    from fracid.runtime.progress import progress_bar
     from fracid.report.figures import curve_figure, to_png
 
     cfg = load(args, args.config, "simulate")
@@ -165,7 +166,7 @@ def _write_identification(args, job, out, result) -> None:
     from fracid.report.field_figures import block_views
     from fracid.report.figures import rendered_once
     from fracid.report.html import write_report
-    from fracid.tables import write_csv_table
+    from fracid.store.tables import write_csv_table
 
     data = job.data
     result.save(out / "result.json")
@@ -206,7 +207,7 @@ def run_identify(args, config_path=None) -> int:
 def run_posterior_command(args) -> int:
     """``fracid identify``, then the posterior of the parameters sampled from its Gaussian on the exact model."""
     from fracid.config import posterior_settings
-    from fracid.exits import FAILED
+    from fracid.runtime.exits import FAILED
     from fracid.inverse.core.runs import StoredOperator
     from fracid.inverse.sampling.posterior import sample_posterior
     from fracid.report.posterior import write_posterior
@@ -285,8 +286,8 @@ def _write_figures(directory: Path, result, control, fields=None, views=None) ->
 
 
 def main(argv=None) -> int:
-    """Run the command; returns its exit status (see :mod:`fracid.exits`), never raises."""
-    from fracid import exits
+    """Run the command; returns its exit status (see :mod:`fracid.runtime.exits`), never raises."""
+    from fracid.runtime import exits
 
     args = None
     with exits.stop_signals():
@@ -314,11 +315,12 @@ def main(argv=None) -> int:
 
 def _dispatch(args) -> int:
     if args.command == "datasets" or getattr(args, "dataset", None) is not None:
-        from fracid import cli_datasets
+        from fracid.cli import datasets as cli_datasets
 
         return cli_datasets.run(args)
     if args.command in ("init", "check"):
-        from fracid import cli_check, cli_init
+        from fracid.cli import check as cli_check
+        from fracid.cli import init as cli_init
 
         return cli_init.run_init(args) if args.command == "init" else cli_check.run_check(args)
     if args.command == "simulate":
@@ -328,11 +330,11 @@ def _dispatch(args) -> int:
     if args.command == "posterior":
         return run_posterior_command(args)
     if args.command == "compare":
-        from fracid import cli_compare
+        from fracid.cli import compare as cli_compare
 
         return cli_compare.run_compare(args)
     if args.command in ("study", "uniqueness", "stability", "sensitivity", "size-effect"):
-        from fracid import cli_studies
+        from fracid.cli import studies as cli_studies
 
         return cli_studies.run(args)
     if args.out is None:  # not next to the bundled config inside the installation

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli_common import load, warn
+from fracid.cli.common import load, warn
 
 #: one forward run slower than this [s] is warned about
 SLOW_RUN = 30.0
@@ -127,7 +127,7 @@ def _timed_run(cfg, model, specimen, params, operator) -> float:
     """Seconds of one forward run at [model.parameters]: the identification's (``operator``) or the
     simulation's. A failed run raises (a ConvergenceError: exit 3)."""
     from fracid.config import simulate_settings
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     start = time.perf_counter()
     if operator is None:
@@ -182,7 +182,7 @@ def _duration(seconds: float) -> str:
 def run_check(args) -> int:
     """``fracid check``: print the plan of the configuration; exit 2 (with the message) if it is invalid."""
     from fracid.config import build_data, build_method, build_model, build_operator, build_parameters, build_specimen
-    from fracid.parallel import available_cores
+    from fracid.runtime.executors import available_cores
 
     cfg = load(args, args.config, "simulate")  # [[experiments]] and [identify] validated when present
     purpose = "identify" if cfg.experiments and cfg.identify is not None else "simulate"

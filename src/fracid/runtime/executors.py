@@ -1,7 +1,7 @@
 """Executors for many forward runs.
 
 :func:`make_executor` gives a ``concurrent.futures``-style executor: in-process (:class:`SerialExecutor`),
-a process pool, or a ``dask.distributed`` client. :func:`fracid.batch.run_batch` maps a function over
+a process pool, or a ``dask.distributed`` client. :func:`fracid.runtime.batch.run_batch` maps a function over
 tasks on any of them, resumably.
 
 Process pools use the ``"spawn"`` start method. ``fork`` copies the parent at an arbitrary moment:
@@ -105,7 +105,7 @@ def concurrently(function, items, executor, progress=None) -> list:
 
 
 def make_executor(workers=None, scheduler: str | None = None):
-    """An executor for :func:`fracid.batch.run_batch`.
+    """An executor for :func:`fracid.runtime.batch.run_batch`.
 
     Parameters
     ----------

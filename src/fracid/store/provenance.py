@@ -6,7 +6,7 @@ import it), the data files with their SHA-256, the specimen's geometry (its data
 size, the fixed parameters, the bounds, the date (UTC, ISO 8601) and the machine (platform, Python,
 numpy and scipy versions, CPU count). Results keep it (``MethodResult.provenance``, saved in
 ``result.json``), the HTML reports show it ("How this was run") and the run store records it per run
-label (:meth:`fracid.store.RunStore.put_meta`).
+label (:meth:`fracid.store.runs.RunStore.put_meta`).
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ damage_threshold, observables, sensitivities)``
     Its characteristic strain (and opening), and the specimen's default final control value [mm].
 
 A model of a few lines (``key``, ``parameters``, ``simulate``) inherits the rest from
-:class:`ModelDefaults`, or is completed by :func:`declared` (both of :mod:`fracid.model_protocol`,
+:class:`ModelDefaults`, or is completed by :func:`declared` (both of :mod:`fracid.models.protocol`,
 importable from here).
 
 The models below build their problem from the specimen's
@@ -54,7 +54,7 @@ from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOpt
 from fracid.fem.formulations.problem import FORMULATIONS
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
-from fracid.model_protocol import ForwardModel, MeshLength, ModelDefaults, declared, runs_on
+from fracid.models.protocol import ForwardModel, MeshLength, ModelDefaults, declared, runs_on
 from fracid.specimens.description import uniform, at_points, conditions, discretize
 
 

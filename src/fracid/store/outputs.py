@@ -13,7 +13,7 @@ import os
 from pathlib import Path
 from typing import Iterable
 
-from fracid.exits import UsageError
+from fracid.runtime.exits import UsageError
 
 #: the directory's record of the names fracid wrote there (files, or directories it fills)
 MANIFEST = ".fracid-written"
@@ -39,7 +39,7 @@ OUTPUTS = {
 
 
 #: outputs that fracid adds to rather than replaces: a run store copied from another output directory is
-#: reused (:class:`fracid.store.RunStore` refuses an SQLite database of another program)
+#: reused (:class:`fracid.store.runs.RunStore` refuses an SQLite database of another program)
 APPENDED = frozenset({"runs.sqlite"})
 
 

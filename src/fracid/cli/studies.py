@@ -1,7 +1,7 @@
 """The ``fracid`` commands that study the identification rather than make it: ``study`` (and its parts
-``uniqueness`` and ``stability``), ``sensitivity`` and ``size-effect``. :func:`fracid.cli.main` dispatches
+``uniqueness`` and ``stability``), ``sensitivity`` and ``size-effect``. :func:`fracid.cli.dispatch.main` dispatches
 here; the shared plumbing (loading, output directory and run store, executor, messages) is in
-:mod:`fracid.cli_common`.
+:mod:`fracid.cli.common`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli_common import (command_executor, load, out_dir, progress_choice, provenance, say, warn, working_in,
+from fracid.cli.common import (command_executor, load, out_dir, progress_choice, provenance, say, warn, working_in,
                                wrote)
 
 
@@ -45,7 +45,7 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
     base = next(iter(specimens.values()), None) or build_specimen(cfg)
     size_field = base.size_field
     if size_field is None:
-        from fracid.exits import UsageError
+        from fracid.runtime.exits import UsageError
 
         raise UsageError(f"the specimen {type(base).__name__} declares no size_field: a size-effect series cannot "
                          "scale it")
@@ -53,7 +53,7 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
         try:
             specimens.setdefault(float(D), replace(base, **{size_field: float(D)}))
         except ValueError as err:
-            from fracid.exits import UsageError
+            from fracid.runtime.exits import UsageError
 
             raise UsageError(f"--sizes {D:g}: not a valid {type(base).__name__}.{size_field} ({err})") from None
     return compare_size_effect(params, specimens, measured, calibrated, model=build_model(cfg), executor=executor,

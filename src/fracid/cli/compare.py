@@ -3,7 +3,7 @@ on the same data with its own parameters and bounds, ranked by log evidence
 (:func:`fracid.inverse.studies.model_comparison.compare`).
 
 The configuration's own model keeps its ``[identify]`` parameters and bounds (and its ``[model] law``); every
-other model gets what ``fracid init`` writes for it (:func:`fracid.cli_init.default_identification`: its
+other model gets what ``fracid init`` writes for it (:func:`fracid.cli.init.default_identification`: its
 usual parameters, bounds a factor 3 around their values), its other parameters the configuration's values
 where the names are shared (E, nu, and kappa_i, beta, c ... between the damage models), its class's defaults
 elsewhere. Every model is identified with ``[identify] method`` and its settings, and sampled with
@@ -18,7 +18,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from fracid.cli_common import command_executor, load, out_dir, provenance, say, warn, working_in, wrote
+from fracid.cli.common import command_executor, load, out_dir, provenance, say, warn, working_in, wrote
 from fracid.inverse.sampling.posterior import PosteriorSettings
 
 #: the sampler's settings when the configuration's [posterior] states nothing but the defaults (which are
@@ -48,8 +48,8 @@ def model_types(cfg, named=None) -> tuple[list, list]:
         specimen (exit 2).
     """
     from fracid.config import build_specimen
-    from fracid.exits import UsageError
-    from fracid.model_protocol import declared
+    from fracid.runtime.exits import UsageError
+    from fracid.models.protocol import declared
     from fracid.models import MODEL_TYPES
 
     unknown = [name for name in named or () if name not in MODEL_TYPES]
@@ -72,7 +72,7 @@ def model_types(cfg, named=None) -> tuple[list, list]:
 def model_config(cfg, kind: str):
     """``cfg`` for model type ``kind``: the configuration itself for its own model; for another, ``[model]`` of
     that type with the shared parameter values and ``[identify]`` of ``fracid init`` (module docstring)."""
-    from fracid.cli_init import default_identification
+    from fracid.cli.init import default_identification
     from fracid.config import build_parameters
     from fracid.config.schema import ModelConfig
     from fracid.models import model_from_type
@@ -110,7 +110,7 @@ def _contenders(args, cfg, data, kinds):
 def posterior_settings(args, cfg) -> PosteriorSettings:
     """The sampler's settings: ``[posterior]`` (or :data:`DEFAULT_POSTERIOR` when it states only the defaults),
     ``--samples`` and ``--rounds`` replacing theirs."""
-    from fracid.exits import UsageError
+    from fracid.runtime.exits import UsageError
 
     base = DEFAULT_POSTERIOR if cfg.posterior == PosteriorSettings() else cfg.posterior
     changes = {key: value for key, value in (("samples_per_round", args.samples), ("max_rounds", args.rounds))
@@ -124,7 +124,7 @@ def posterior_settings(args, cfg) -> PosteriorSettings:
 def run_compare(args) -> int:
     """``fracid compare``: its exit status (3 when no model gave a log evidence)."""
     from fracid.config import build_data, build_method
-    from fracid.exits import FAILED
+    from fracid.runtime.exits import FAILED
     from fracid.inverse.studies.model_comparison import compare
     from fracid.report.compare import write_compare
 
