@@ -273,7 +273,7 @@ def test_a_result_without_fields_keeps_its_report(tmp_path):
 
 
 def test_write_figures_writes_the_field_maps_as_png(field_report, tmp_path):
-    from fracid.cli.dispatch import _write_figures
+    from fracid.cli.identify import write_figures as _write_figures
 
     result, coordinates, covariance, _ = field_report
     _write_figures(tmp_path / "figures", result, result.control, fields={"dic": {**coordinates,

@@ -25,11 +25,12 @@ SLOW_PLAN = 3600.0
 SENSITIVITY_COST = 1.65
 
 
-def add_parser(sub, common) -> None:
+def add_parser(sub, parents) -> None:
     """The ``check`` subcommand's arguments (the common options: ``--workers`` sizes the time estimate)."""
-    p = sub.add_parser("check", parents=[common], help="validate a configuration and print its plan and cost")
+    p = sub.add_parser("check", parents=[parents.common], help="validate a configuration and print its plan and cost")
     p.add_argument("config", type=Path, help="TOML configuration file")
     p.add_argument("--no-time", action="store_true", help="do not time a forward run (no time estimate)")
+    p.set_defaults(run=run_check)
 
 
 def mesh_key(cfg) -> str:

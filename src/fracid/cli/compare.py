@@ -26,15 +26,16 @@ from fracid.inverse.sampling.posterior import PosteriorSettings
 DEFAULT_POSTERIOR = PosteriorSettings(samples_per_round=60, max_rounds=4, target_ess=200.0)
 
 
-def add_parser(sub, common) -> None:
+def add_parser(sub, parents) -> None:
     """The ``compare`` subcommand's arguments."""
-    p = sub.add_parser("compare", parents=[common],
+    p = sub.add_parser("compare", parents=[parents.stored],
                        help="identify every model that runs on the specimen and rank them by log evidence")
     p.add_argument("config", type=Path, help="TOML configuration file")
     p.add_argument("--models", nargs="+", metavar="MODEL",
                    help="[model] types to compare (default: every model that runs on the specimen)")
     p.add_argument("--samples", type=int, help="posterior draws per round (default: [posterior] samples_per_round)")
     p.add_argument("--rounds", type=int, help="posterior rounds at most (default: [posterior] max_rounds)")
+    p.set_defaults(run=run_compare)
 
 
 def model_types(cfg, named=None) -> tuple[list, list]:

@@ -21,14 +21,22 @@ COLUMNS = (("NAME", "name"), ("SPECIMEN", "specimen"), ("MODEL", "model"), ("LIC
            ("CITATION", "citation"))
 
 
-def add_parser(sub) -> None:
+def add_parser(sub, parents) -> None:
     """The ``datasets`` subcommand, and ``--dataset NAME`` of ``init`` (added to the parser that
     :func:`fracid.cli.init.add_parser` made, so that ``init`` keeps one parser)."""
     p = sub.add_parser("datasets", help="list the bundled data sets (fracid init --dataset NAME writes one's config)")
     p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
-    sub.choices["init"].add_argument(
+    p.set_defaults(run=run)
+    init = sub.choices["init"]
+    init.set_defaults(run=_init_or_dataset(init.get_default("run")))
+    init.add_argument(
         "--dataset", metavar="NAME", help="write the configuration of a bundled data set (`fracid datasets` lists "
                                           "them), its data file and licence copied beside -o FILE")
+
+
+def _init_or_dataset(run_init):
+    """``fracid init``'s run: :func:`run` when ``--dataset NAME`` is given, else ``run_init``."""
+    return lambda args: run(args) if args.dataset is not None else run_init(args)
 
 
 def run(args) -> int:

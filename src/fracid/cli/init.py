@@ -341,7 +341,7 @@ def run_init(args) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
+def add_parser(sub, parents) -> None:
     """The ``init`` subcommand's arguments."""
     p = sub.add_parser("init", help="write a commented configuration to start from")
     p.add_argument("--specimen", default=DEMO_PAIR[0], help=f"specimen type (default {DEMO_PAIR[0]})")
@@ -350,3 +350,4 @@ def add_parser(sub) -> None:
     p.add_argument("--force", action="store_true", help="replace an existing -o file")
     p.add_argument("--list", action="store_true", help="list the (specimen, model) pairs")
     p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
+    p.set_defaults(run=run_init)

@@ -15,6 +15,21 @@ from fracid.cli.common import (command_executor, load, out_dir, progress_choice,
                                wrote)
 
 
+def add_parser(sub, parents) -> None:
+    """The study commands' arguments: ``study``, ``uniqueness`` and ``stability`` keep a run store."""
+    for name, text, parent in (
+            ("study", "identification with uniqueness, stability and prediction checks, and a verdict", parents.stored),
+            ("uniqueness", "the study's uniqueness stages only: objective maps, valley, multi-start", parents.stored),
+            ("stability", "the study's stability stage only: identification on noisy replicates", parents.stored),
+            ("sensitivity", "sensitivities and information along the load history", parents.common),
+            ("size-effect", "nominal strength versus size and Bazant's size effect law", parents.common)):
+        p = sub.add_parser(name, parents=[parent], help=text)
+        p.add_argument("config", type=Path, help="TOML configuration file")
+        if name == "size-effect":
+            p.add_argument("--sizes", type=float, nargs="+", help="sizes D [mm] (default: those of the experiments)")
+        p.set_defaults(run=run)
+
+
 def run(args) -> int:
     """Run the study command ``args.command``; its exit status."""
     if args.command in _STUDY_PARTS:

@@ -25,7 +25,7 @@ from fracid.store.runs import key_for
 #: any depth), so that a new module is hashed without being listed; the ``fracid`` modules these
 #: import are added by :func:`forward_sources`. The inverse methods, the configuration, the reports
 #: and the command line are not: they choose the runs, they do not change a run's result.
-FORWARD_CHAIN = ("fem", "specimens", "models.py", "forward.py", "inverse/core/forward_operator.py")
+FORWARD_CHAIN = ("fem", "specimens", "models", "settings/field_error.py", "inverse/core/forward_operator.py")
 
 
 @functools.cache
