@@ -18,15 +18,8 @@ never the models' registry, the inverse methods, the configuration, the report, 
 
 from fracid.data.checks import require_positive_force
 from fracid.data.curves import Curve, curve_from_arrays, read_curve_csv
-from fracid.data.covariance_matrix import (
-    Block,
-    Covariance,
-    Dense,
-    Diagonal,
-    LowRankPlusDiagonal,
-    as_covariance,
-    block_diagonal,
-)
+from fracid.data.covariance_matrix import Block, Covariance, Dense, Diagonal, as_covariance, block_diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dataset import ExperimentalData, stack
 from fracid.data.errors import DataError, DataTypeError
 from fracid.data.dic import CameraPlacement, DicData, fit_placement, read_dic_frames, read_dic_vtk
