@@ -35,7 +35,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from fracid.fem.material.cohesive import hordijk_stress
-from fracid.fem.material.phase_field import C_ALPHA, SHAPES, a1 as a1_coefficient, geometric
+from fracid.fem.material.phase_field import C_ALPHA, SHAPES, a1 as a1_coefficient
 from fracid.fem.material.phase_field import degradation as _degradation
 from fracid.fem.material.phase_field_band import (
     QUAD_LIMIT,
@@ -75,11 +75,6 @@ def shape_parameters(shape):
         return SHAPES[shape]
     except (KeyError, TypeError):
         raise ValueError(f"unknown phase-field softening shape {shape!r}; allowed: {', '.join(SHAPES)}") from None
-
-
-def geometric_function(d):
-    """alpha(d) = 2 d - d^2 [-] of the phase field d [-] (array_like)."""
-    return geometric(d)[0]
 
 
 def degradation(d, E, ft, Gf, l, p, a2, a3):
