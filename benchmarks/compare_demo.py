@@ -1,6 +1,6 @@
 """``fracid compare`` on the Grégoire demo: every model that runs on the notched beam, ranked by log evidence.
 
-Runs ``fracid compare src/fracid/data/gregoire2013_beam4/demo.toml --out OUT --samples S --rounds R`` (the demo's
+Runs ``fracid compare src/fracid/datasets/gregoire2013_beam4/demo.toml --out OUT --samples S --rounds R`` (the demo's
 [identify] for gradient damage, ``fracid init``'s parameters and bounds for the others, the demo's [posterior]
 with S draws per round and R rounds at most), times it, and writes OUT/README.md: the settings, the wall time, the
 ranking table, the evidence with its error bars, the estimates, the failures and what to read in them. The run

@@ -1,7 +1,7 @@
 """Cost of a full-field (DIC-scale) observation with exact sensitivities on the demo beam (fracid issue 27).
 
 On the demo configuration (the Grégoire notched beam, gradient damage, h_fine 2 mm, kappa_i, beta and c;
-src/fracid/data/gregoire2013_beam4/demo.toml) at the demo's estimate, one process, serial runs:
+src/fracid/datasets/gregoire2013_beam4/demo.toml) at the demo's estimate, one process, serial runs:
 
 - one plain forward run (the data's CMOD checkpoints),
 - one run with exact sensitivities (direct differentiation) for (kappa_i, beta, c),

@@ -40,7 +40,7 @@ def run(bar, params, regularization, target):
     forms.softening_coupling = coupling  # integral_damage looks it up in its module at every call
     try:
         t0 = time.perf_counter()
-        result = fracid.simulate(bar, params, regularization=regularization, control="end_displacement",
+        result = fracid.simulate(bar, params, model=DamageModel(regularization), control="end_displacement",
                                  target=target, stop_force_fraction=None, field_steps=None)
         seconds = time.perf_counter() - t0
     finally:

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 import fracid
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.path.path_following import follow_path
-from fracid.models import CohesiveCrackModel, CrackBandModel
+from fracid.models import CohesiveCrackModel, CrackBandModel, DamageModel
 from fracid.report.figures import to_png
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.strip import TensionStrip
@@ -74,7 +74,7 @@ def bar_objectivity():
     for regularization in ("integral", "gradient", "local"):
         for n in (200, 400):
             bar = fracid.BarWithWeakZone(n_elements=n, profile="hat")
-            result, wall = _timed(lambda: fracid.simulate(bar, DAMAGE, regularization=regularization,
+            result, wall = _timed(lambda: fracid.simulate(bar, DAMAGE, model=DamageModel(regularization),
                                                           control="weak_zone_elongation", target=0.03,
                                                           stop_force_fraction=None))
             rows.append({"model": regularization, "n": n, "peak": result.peak_force, "final": result.force[-1],

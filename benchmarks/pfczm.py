@@ -38,8 +38,9 @@ from scipy.interpolate import PchipInterpolator
 import fracid
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import SHAPES
+from fracid.fem.material.phase_field_band import ultimate_opening
 from fracid.fem.material.phase_field_cohesive import (default_centre_values, localized_cohesive_law, target_law,
-                                                      traction_at_opening, ultimate_opening)
+                                                      traction_at_opening)
 from fracid.fem.material.ranges import ELASTIC, compose
 from fracid.fem.material.tsl import STRENGTH_AND_ENERGY, ShapeLaw
 from fracid.fem.path.path_following import follow_path

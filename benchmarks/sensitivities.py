@@ -1,7 +1,7 @@
 """Cost and accuracy of the sensitivities on the demo beam: direct differentiation against central differences.
 
 On the demo configuration (the Grégoire notched beam, gradient damage, kappa_i, beta and c identified;
-src/fracid/data/gregoire2013_beam4/demo.toml) at the demo's estimate, one process, serial runs, for each
+src/fracid/datasets/gregoire2013_beam4/demo.toml) at the demo's estimate, one process, serial runs, for each
 linear-solver backend:
 
 - the time of one forward run (the data's 24 CMOD checkpoints),

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fracid import datasets
 from fracid.config import (
     ConfigError,
     build_data,
@@ -21,7 +22,6 @@ from fracid.config import (
     load_config,
     simulate_settings,
 )
-from fracid.data import gregoire2013_beam4_path
 from fracid.inverse.core.forward_operator import ForwardOperator
 from fracid.inverse.methods.knn import ParameterSpace
 from fracid.inverse.methods.strategy import KnnSettings
@@ -110,7 +110,7 @@ vtk_steps = [20, 10]
 
 def write(tmp_path, text, name="study.toml"):
     """The configuration in tmp_path, with the bundled Gregoire data beside it."""
-    shutil.copy(gregoire2013_beam4_path(), tmp_path / "load_cmod.csv")
+    shutil.copy(datasets.path("gregoire2013-beam4"), tmp_path / "load_cmod.csv")
     path = tmp_path / name
     path.write_text(text)
     return path
@@ -662,7 +662,7 @@ def test_negated_or_zero_forces_are_refused(tmp_path, forces, words):
 def test_control_in_the_wrong_unit_is_refused(tmp_path):
     """The Gregoire CMOD (mm) declared in um would be fine; the same values scaled by 1000 as if um were mm
     reach 200 mm of CMOD, far past any failure of the beam: refused naming control_unit."""
-    raw = np.genfromtxt(gregoire2013_beam4_path(), delimiter=",", names=True)
+    raw = np.genfromtxt(datasets.path("gregoire2013-beam4"), delimiter=",", names=True)
     rows = "".join(f"{1000 * c},{f},{lo},{hi}\n" for c, f, lo, hi in
                    zip(raw["cmod_mm"], raw["load_mean_N"], raw["load_min_N"], raw["load_max_N"]))
     path = write(tmp_path, BEAM)

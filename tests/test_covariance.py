@@ -4,15 +4,8 @@ Kalman filter's information form against its gain form."""
 import numpy as np
 import pytest
 
-from fracid.data.covariance_matrix import (
-    DENSE_LIMIT,
-    Block,
-    Dense,
-    Diagonal,
-    LowRankPlusDiagonal,
-    as_covariance,
-    block_diagonal,
-)
+from fracid.data.covariance_matrix import DENSE_LIMIT, Block, Dense, Diagonal, as_covariance, block_diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.inverse.methods.kalman import assimilate, information_update, kalman_update
 
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from fracid import datasets
 from fracid.data import (
     Curve,
     DataError,
@@ -11,8 +12,6 @@ from fracid.data import (
     curve_from_arrays,
     from_envelope,
     from_repeats,
-    gregoire2013_beam4,
-    gregoire2013_beam4_path,
     local_block,
     read_curve_csv,
     require_positive_force,
@@ -510,8 +509,14 @@ def test_experimental_data_is_validated():
 # ------------------------------------------------------------------------------ bundled real data
 
 
+def gregoire_curves():
+    """The bundled Gregoire beam's mean, lower and upper curves (fracid.datasets, the one home of bundled data)."""
+    return read_curve_csv(datasets.path("gregoire2013-beam4"), control_column="cmod_mm",
+                          force_columns=["load_mean_N", "load_min_N", "load_max_N"])
+
+
 def test_gregoire_raw_file():
-    path = gregoire2013_beam4_path()
+    path = datasets.path("gregoire2013-beam4")
     assert path.is_file()
     mean, lower, upper = read_curve_csv(
         path, control_column="cmod_mm", force_columns=["load_mean_N", "load_min_N", "load_max_N"]
@@ -525,7 +530,7 @@ def test_gregoire_raw_file():
 
 
 def test_gregoire_bundled_data():
-    data = gregoire2013_beam4()
+    data = from_envelope(*gregoire_curves(), 40, rule="range/4", name="gregoire2013_beam4")
     assert data.y.shape == (40,) and data.covariance.shape == (40, 40)
     assert data.blocks == (("gregoire2013_beam4", 0, 40),)
     assert data.control[0] == pytest.approx(2e-5) and data.control[-1] == pytest.approx(0.2031462)
@@ -536,6 +541,16 @@ def test_gregoire_bundled_data():
     assert any("s = (max - min)/4 from the min/max envelope" in note for note in data.notes)
     assert any("1 backtracking point dropped" in note and "row 3" in note for note in data.notes)
     assert np.all(data.std > 0)
+
+
+def test_the_old_bundled_data_names_raise_and_name_the_new_path():
+    """fracid.data.gregoire2013_beam4[_path] are markers: the bundled data live in fracid.datasets."""
+    from fracid.data import gregoire2013_beam4, gregoire2013_beam4_path
+
+    with pytest.raises(TypeError, match=r"fracid.datasets.path\('gregoire2013-beam4'\)"):
+        gregoire2013_beam4_path()
+    with pytest.raises(TypeError, match=r"fracid.datasets.load\('gregoire2013-beam4'\)"):
+        gregoire2013_beam4(n_points=40)
 
 
 def test_block_weights_scale_the_objective_of_their_block():

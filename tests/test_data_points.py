@@ -4,7 +4,8 @@ measured points themselves, decimated by arc length to n_points (the ends and th
 import numpy as np
 import pytest
 
-from fracid.data import Curve, DataError, decimate, from_envelope, from_repeats, gregoire2013_beam4, with_std
+from fracid import datasets
+from fracid.data import Curve, DataError, decimate, from_envelope, from_repeats, read_curve_csv, with_std
 
 
 def softening_curve(n=400, peak_at=0.0237, source="test"):
@@ -74,7 +75,9 @@ def test_repeats_and_envelope_keep_the_peak_of_their_mean():
 
 def test_the_bundled_test_keeps_its_peak():
     for sampling in ("equally-spaced", "measured"):
-        data = gregoire2013_beam4(sampling=sampling)
+        curves = read_curve_csv(datasets.path("gregoire2013-beam4"), control_column="cmod_mm",
+                                force_columns=["load_mean_N", "load_min_N", "load_max_N"])
+        data = from_envelope(*curves, 40, sampling=sampling)
         assert data.n_y == 40 and data.y.max() == 978.6185 and data.control[np.argmax(data.y)] == 0.01934611
 
 
@@ -86,13 +89,14 @@ def test_bad_sampling_is_refused():
         with_std(curve, 5.0, 20, (0.10001, 0.10002), sampling="measured")
 
 
-def test_the_sampling_names_are_importable_where_they_were():
-    """The sampling moved to fracid.data.sampling; fracid.data.experimental still exports what it did."""
+def test_the_sampling_names_are_imported_from_where_they_are_defined():
+    """fracid.data offers the sampling and stacking names of fracid.data.sampling and fracid.data.dataset;
+    fracid.data.experimental, where they were before the split, no longer re-exports them (issue 37)."""
     import fracid.data as data
     from fracid.data import dataset, experimental, sampling
 
-    assert experimental.SAMPLINGS is sampling.SAMPLINGS is data.SAMPLINGS == ("equally-spaced", "measured")
-    assert experimental.decimate is sampling.decimate is data.decimate
-    assert experimental.sample_points is sampling.sample_points is data.sample_points
-    assert experimental.ExperimentalData is dataset.ExperimentalData is data.ExperimentalData
-    assert experimental.stack is dataset.stack is data.stack
+    assert sampling.SAMPLINGS is data.SAMPLINGS == ("equally-spaced", "measured")
+    assert sampling.decimate is data.decimate and sampling.sample_points is data.sample_points
+    assert dataset.stack is data.stack and dataset.ExperimentalData is data.ExperimentalData
+    for name in ("SAMPLINGS", "decimate", "sample_points", "stack"):
+        assert not hasattr(experimental, name), name

@@ -10,8 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from fracid import cli
-from fracid.data import gregoire2013_beam4_path
+from fracid import cli, datasets
 
 
 pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out
@@ -25,7 +24,7 @@ def test_demo_fits_the_gregoire_beam(tmp_path):
     measured, computed, cmod = fit["measured"], fit["computed"], fit["control_mm"]
     rms = np.sqrt(np.mean((computed - measured) ** 2))
     assert rms < 0.05 * measured.max(), (rms, measured.max())
-    raw = np.genfromtxt(gregoire2013_beam4_path(), delimiter=",", names=True)
+    raw = np.genfromtxt(datasets.path("gregoire2013-beam4"), delimiter=",", names=True)
     at_peak = np.argmin(np.abs(raw["cmod_mm"] - cmod[np.argmax(computed)]))
     assert raw["load_min_N"][at_peak] <= computed.max() <= raw["load_max_N"][at_peak]
     assert result["runs"]["knn_failed"] == 0 and result["converged"]

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from fracid.data.dic import DicData, field_block, frame_rigid_motions, opening_profile, process_zone_width
-from fracid.data.dic.derived import crack_line
+from fracid.specimens.crack_line import crack_line
 from fracid.data.errors import DataError
 from fracid.fem.material.parameters import DamageParameters
 from fracid.fem.path.path_following import StepOptions

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import fracid.data.dic_noise as dic_noise
-from fracid.data.covariance_matrix import Block, LowRankPlusDiagonal
+from fracid.data.covariance_matrix import Block
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dic_noise import dic_covariance, dic_frames_covariance, dic_kernel
 
 

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from fracid.data.covariance_matrix import Diagonal, LowRankPlusDiagonal
+from fracid.data.covariance_matrix import Diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dic import DicData, field_block
 from fracid.data.dic.rigid import RIGID_STD, fit_rigid_motion, rigid_modes, with_rigid_motion
 from fracid.data.dic_noise import dic_covariance

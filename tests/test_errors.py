@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import fracid
+from fracid.models import DamageModel
 
 
 @pytest.mark.parametrize(
@@ -62,7 +63,6 @@ def test_invalid_bar_is_named(changes, word):
         ({"target": float("inf")}, "target"),
         ({"control": "cmod"}, "unknown control 'cmod'"),
         ({"stop_force_fraction": 1.5}, "stop_force_fraction"),
-        ({"regularization": "nonlocal"}, "regularization"),
         ({"steps": fracid.StepOptions(initial=1.0), "target": 0.01}, "step initial"),
         ({"steps": fracid.StepOptions(grow=0.5)}, "grow"),
         ({"max_steps": 0}, "max_steps"),
@@ -72,6 +72,15 @@ def test_invalid_bar_is_named(changes, word):
 def test_impossible_requests_are_refused(kwargs, word):
     with pytest.raises(ValueError, match=word):
         fracid.simulate(fracid.BarWithWeakZone(n_elements=20), fracid.DamageParameters(), **kwargs)
+
+
+def test_the_regularization_shorthand_is_a_marker_naming_the_model():
+    """simulate(regularization=...) was removed (issue 37): the model is given as model=DamageModel(...)."""
+    bar, params = fracid.BarWithWeakZone(n_elements=20), fracid.DamageParameters()
+    with pytest.raises(TypeError, match=r"regularization='local'\) was removed: .*model=fracid.models.DamageModel\('local'\)"):
+        fracid.simulate(bar, params, regularization="local")
+    with pytest.raises(ValueError, match="regularization"):
+        fracid.simulate(bar, params, model=DamageModel("nonlocal"))
 
 
 def test_newton_options_are_checked():
@@ -90,13 +99,13 @@ def test_snap_back_under_end_displacement_fails_with_partial_result():
     params = fracid.DamageParameters(beta=100.0)
     bar = fracid.BarWithWeakZone(n_elements=200, profile="hat", length=400.0)
     with pytest.raises(fracid.ConvergenceError) as info:
-        fracid.simulate(bar, params, regularization="local", target=0.2, stop_force_fraction=0.05)
+        fracid.simulate(bar, params, model=DamageModel("local"), target=0.2, stop_force_fraction=0.05)
     partial = info.value.partial
     assert "end_displacement" in str(info.value) and "failed" in partial.status
     assert partial.n_steps > 2 and partial.peak_force > 0
     assert np.all(np.isfinite(partial.force))
     # the weak-zone elongation is monotonic through the snap-back and gets further
-    result = fracid.simulate(bar, params, regularization="local", control="weak_zone_elongation", target=0.1, stop_force_fraction=0.05)
+    result = fracid.simulate(bar, params, model=DamageModel("local"), control="weak_zone_elongation", target=0.1, stop_force_fraction=0.05)
     assert result.status.startswith("force below")
     end = result.observables["end_displacement"]
     assert np.any(np.diff(end) < 0)  # the end displacement goes back: snap-back traced

@@ -1,8 +1,10 @@
-"""Imports follow the floors of the README's Layout: no module of fracid imports a higher floor; the
+"""Imports follow the floors of the README's Layout: no module of fracid imports a higher floor (nor names one
+in a "fracid.module:name" string), no module of inverse/ or fem/ a higher sub-package (:data:`SUB_FLOORS`); the
 package's modules import one another without cycles; the command's modules share their plumbing through
 :mod:`fracid.cli.common`, never through one another's private names."""
 
 import ast
+import re
 from pathlib import Path
 
 import fracid
@@ -45,6 +47,99 @@ def test_no_module_imports_a_higher_floor():
     upward = sorted({(module, imported) for unit, imported, module in imports(root)
                      if FLOORS[imported] > FLOORS[unit]})
     assert upward == []
+
+
+#: floors of the sub-packages of a package (issue 37): within ``fracid.inverse`` and ``fracid.fem`` a module may
+#: import its own sub-package and those on a lower floor; the package's own ``__init__`` is above them all
+SUB_FLOORS = {
+    "inverse": {"core": 0, "likelihood": 1, "methods": 2, "sampling": 2, "studies": 3},
+    "fem": {"material": 0, "mesh": 1, "formulations": 2, "path": 3},
+}
+
+#: (importing module, imported sub-package) known to run up a floor today, kept so that the test passes now
+#: and fails on any other: the methods helper of issue 37 moves what these import down (GaussianEstimate to
+#: inverse.core); the lead empties it after the merge (an entry no longer found fails, so it only shrinks)
+KNOWN_UPWARD = {
+    ("inverse.core.method", "methods"),
+    ("inverse.likelihood.terms", "methods"),
+}
+
+#: "fracid.module:name" strings (an import hidden from the import statements) that run up a floor today:
+#: (module holding the string, the unit it names); the models/specimens helper of issue 37 removes it
+KNOWN_UPWARD_STRINGS = {("specimens.mesh", "config")}
+
+STRING_IMPORT = re.compile(r"^fracid\.([a-z_]+)(\.[a-z_.]+)?:[A-Za-z_]\w*$")
+
+
+def sub_imports(root: Path, package: str):
+    """(importing sub-package, imported sub-package, module) for every import between the sub-packages of
+    ``fracid.<package>`` (those inside functions too); a module directly in the package is named ``__init__``."""
+    for path in (root / package).rglob("*.py"):
+        parts = path.relative_to(root).with_suffix("").parts
+        sub = parts[1] if len(parts) > 2 else "__init__"
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [node.module] if isinstance(node, ast.ImportFrom) and node.module else \
+                [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            for name in names:
+                if name.startswith(f"fracid.{package}.") and name.split(".")[2] != sub:
+                    yield sub, name.split(".")[2], ".".join(parts)
+
+
+def upward_sub_imports(root: Path) -> set:
+    """{(module, imported sub-package)} of the imports that run up the floors of :data:`SUB_FLOORS`."""
+    found = set()
+    for package, floors in SUB_FLOORS.items():
+        top = max(floors.values()) + 1
+        for sub, imported, module in sub_imports(root, package):
+            if floors.get(imported, top) > floors.get(sub, top):
+                found.add((module, imported))
+    return found
+
+
+def test_every_sub_package_has_a_floor():
+    root = Path(fracid.__file__).parent
+    for package, floors in SUB_FLOORS.items():
+        subs = {p.name for p in (root / package).iterdir() if (p / "__init__.py").is_file()}
+        assert subs == set(floors), (package, sorted(subs ^ set(floors)))
+
+
+def test_no_module_imports_a_higher_sub_package_floor():
+    """inverse: core < likelihood < methods, sampling < studies; fem: material < mesh < formulations < path."""
+    upward = upward_sub_imports(Path(fracid.__file__).parent)
+    assert sorted(upward - KNOWN_UPWARD) == []
+
+
+def test_the_known_upward_imports_are_still_there():
+    """An entry of :data:`KNOWN_UPWARD` that is gone is removed from it (the list only shrinks)."""
+    assert sorted(KNOWN_UPWARD - upward_sub_imports(Path(fracid.__file__).parent)) == []
+
+
+def test_the_sub_package_floors_catch_an_upward_import(tmp_path):
+    for sub in ("core", "methods"):
+        (tmp_path / "inverse" / sub).mkdir(parents=True)
+    (tmp_path / "inverse" / "core" / "a.py").write_text("def f():\n    from fracid.inverse.methods.b import c\n")
+    (tmp_path / "inverse" / "methods" / "b.py").write_text("from fracid.inverse.core.a import f\n")
+    assert upward_sub_imports(tmp_path) == {("inverse.core.a", "methods")}
+
+
+def string_imports(root: Path) -> set:
+    """{(module, unit named)} of the "fracid.module:name" strings that name a higher floor than their module's."""
+    found = set()
+    for path in root.rglob("*.py"):
+        parts = path.relative_to(root).with_suffix("").parts
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                match = STRING_IMPORT.match(node.value)
+                if match and FLOORS.get(match.group(1), 0) > FLOORS[parts[0]]:
+                    found.add((".".join(parts), match.group(1)))
+    return found
+
+
+def test_no_module_names_a_higher_floor_in_a_module_name_string():
+    """A "fracid.config.x:NAME" string resolved at run time is an import: it follows the floors too."""
+    found = string_imports(Path(fracid.__file__).parent)
+    assert sorted(found - KNOWN_UPWARD_STRINGS) == []
+    assert sorted(KNOWN_UPWARD_STRINGS - found) == []  # a fixed entry is removed from the list
 
 
 def test_the_inverse_core_reaches_models_only_through_the_interface():

@@ -4,7 +4,8 @@ for every kind of base covariance."""
 import numpy as np
 import pytest
 
-from fracid.data.covariance_matrix import Block, Dense, Diagonal, LowRankPlusDiagonal
+from fracid.data.covariance_matrix import Block, Dense, Diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.covariance_update import LowRankUpdate, low_rank_update, plus_diagonal
 
 N = 7

@@ -3,13 +3,14 @@
 import pytest
 
 import fracid
+from fracid.models import DamageModel
 
 PARAMS = fracid.DamageParameters(alpha=0.99, beta=300.0, c=1.0)
 
 
 def run(n, regularization, profile, control, target):
     bar = fracid.BarWithWeakZone(n_elements=n, profile=profile)
-    result = fracid.simulate(bar, PARAMS, regularization=regularization, control=control, target=target, stop_force_fraction=None)
+    result = fracid.simulate(bar, PARAMS, model=DamageModel(regularization), control=control, target=target, stop_force_fraction=None)
     assert result.status == "target reached"
     return result.peak_force, result.observables["dissipated_energy"][-1], result.force[-1]
 

@@ -19,7 +19,7 @@ def test_the_own_mesh_example_validates_and_its_specimen_runs():
     cfg = load_config(EXAMPLE / "identify.toml", purpose="identify")
     assert cfg.specimen.type == "mesh"
     assert cfg.experiments[0].file.resolve() == (
-        EXAMPLE / "../../src/fracid/data/gregoire2013_beam4/load_cmod.csv").resolve()
+        EXAMPLE / "../../src/fracid/datasets/gregoire2013_beam4/load_cmod.csv").resolve()
     specimen = build_specimen(cfg)
     description = specimen.describe()
     assert description.cells.shape[1] == 6  # the linear Gmsh triangles run as T6

@@ -15,15 +15,15 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fracid.fem.material import phase_field_cohesive as pfc
+from fracid.fem.material.phase_field import SHAPES
+from fracid.fem.material.phase_field_band import ultimate_opening
 from fracid.fem.material.phase_field_cohesive import (
-    SHAPES,
     crack_opening,
     centre_stress,
     dissipated_energy,
     localized_cohesive_law,
     target_law,
     traction_at_opening,
-    ultimate_opening,
 )
 
 E, FT, GF = 20000.0, 2.4, 0.113

@@ -8,7 +8,7 @@ import textwrap
 
 PROGRAM = textwrap.dedent("""
     import os, signal, sys
-    from fracid.runtime import exits
+    from fracid.runtime import exits, stops
     from fracid.runtime.batch import run_batch
 
     class SwallowsInDel:
@@ -22,7 +22,7 @@ PROGRAM = textwrap.dedent("""
         print("went on", flush=True)
         try:
             run_batch(dict, [{"a": 1}, {"a": 2}], executor="serial", progress=False)
-        except exits.Terminated:
+        except stops.Terminated:
             print("raised again at the checkpoint", flush=True)
     os._exit(0)
 """)

@@ -28,7 +28,7 @@ def post_peak_state(regularization, params, bar, control=None, target=None):
     if control is None:
         control = "end_displacement" if regularization == "gradient" else "weak_zone_elongation"
         target = 0.025 if regularization == "gradient" else 0.005
-    result = fracid.simulate(bar, params, regularization=regularization, control=control, target=target,
+    result = fracid.simulate(bar, params, model=DamageModel(regularization), control=control, target=target,
                              stop_force_fraction=None, field_steps="all")
     problem = DamageModel(regularization).build(bar, params)
     k = result.n_steps - 2  # the last increment may be a sliver up to the target

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import fracid
+from fracid.models import DamageModel
 from fracid.report import write_vtk  # imports meshio only when writing
 from fracid.report.vtk import corner_to_nodes
 
@@ -50,7 +51,7 @@ def test_bar_round_trip(tmp_path, bar_state):
 
 def test_local_model_has_no_ebar(tmp_path):
     bar = fracid.BarWithWeakZone(n_elements=10)
-    result = fracid.simulate(bar, fracid.DamageParameters(), regularization="local", target=0.005, stop_force_fraction=None)
+    result = fracid.simulate(bar, fracid.DamageParameters(), model=DamageModel("local"), target=0.005, stop_force_fraction=None)
     fields = result.fields[result.n_steps]
     assert "ebar" not in fields
     mesh = meshio.read(write_vtk(tmp_path / "local.vtu", *bar.describe().output_mesh(), fields))

@@ -16,7 +16,7 @@ from fracid.specimens.beam import NotchedBeam
 
 HERE = Path(__file__).resolve().parent
 
-#: the demo's mesh and parameters (src/fracid/data/gregoire2013_beam4/demo.toml)
+#: the demo's mesh and parameters (src/fracid/datasets/gregoire2013_beam4/demo.toml)
 BEAM = NotchedBeam(h_fine=2.0, h_coarse=6.0)
 PARAMS = DamageParameters(E=36250.0, nu=0.2, kappa_i=6.6e-5, alpha=0.99, beta=600.0, c=9.0, eta=10.0)
 #: CMOD of the frames [mm]: rising branch, the peak (0.034 mm), softening

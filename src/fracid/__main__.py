@@ -4,7 +4,8 @@ imported, so that a Ctrl-C while the command starts ends it with a message, not 
 import os
 import sys
 
-from fracid.runtime.exits import describe, stop_signals, stopped_by
+from fracid.runtime.exits import describe, stop_signals
+from fracid.runtime.stops import stopped_by
 
 
 def run() -> None:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 def demo_config_path() -> Path:
     """The bundled demo configuration (next to the Gregoire data)."""
-    return Path(str(resources.files("fracid.data") / "gregoire2013_beam4" / "demo.toml"))
+    return Path(str(resources.files("fracid.datasets") / "gregoire2013_beam4" / "demo.toml"))
 
 
 def say(args, text) -> None:

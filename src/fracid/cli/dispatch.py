@@ -84,7 +84,7 @@ def version() -> str:
 
 def main(argv=None) -> int:
     """Run the command; returns its exit status (see :mod:`fracid.runtime.exits`), never raises."""
-    from fracid.runtime import exits
+    from fracid.runtime import exits, stops
 
     args = None
     with exits.stop_signals():
@@ -100,8 +100,8 @@ def main(argv=None) -> int:
         except SystemExit:
             raise
         except BaseException as err:  # noqa: BLE001 -- every failure becomes a message and an exit status
-            if not isinstance(err, KeyboardInterrupt) and exits.stopped_by() is not None:
-                err = exits.stopped_by()  # the signal, seen through the code it struck
+            if not isinstance(err, KeyboardInterrupt) and stops.stopped_by() is not None:
+                err = stops.stopped_by()  # the signal, seen through the code it struck
             status, text = exits.describe(err, store_path=getattr(args, "store_path", None),
                                           out=getattr(args, "out_dir", None))
             if getattr(args, "debug", False):

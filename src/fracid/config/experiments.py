@@ -28,7 +28,7 @@ from fracid.config.vocabulary import (
     LOCAL_UNITS,
     ROLES,
 )
-from fracid.data.experimental import SAMPLINGS
+from fracid.data.sampling import SAMPLINGS
 
 
 def _csv_table(ck: Checker, key: str, value, path: Path, delimiter: str, decimal: str, columns):

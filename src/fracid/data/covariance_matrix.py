@@ -7,8 +7,8 @@ covariance of a subset of the entries). Four kinds implement them:
 
 * :class:`Diagonal` ``diag(var)``: independent errors (what standard deviations give), O(n);
 * :class:`Dense` ``C``: any symmetric positive definite matrix (small n), Cholesky factor;
-* :class:`LowRankPlusDiagonal` ``diag(d) + U U^T``: independent errors plus k shared modes
-  (Woodbury identity and the matrix determinant lemma), O(n k^2);
+* :class:`~fracid.data.covariance_low_rank.LowRankPlusDiagonal` ``diag(d) + U U^T``: independent errors
+  plus k shared modes (Woodbury identity and the matrix determinant lemma), O(n k^2), in its own module;
 * :class:`Block` the block diagonal of any of these (stacked datasets).
 
 :func:`as_covariance` turns what the user gives (a covariance object, a 1-D array of variances, a
@@ -28,7 +28,7 @@ import scipy.linalg
 DENSE_LIMIT = 20_000
 
 
-def _rows(b, n: int, what: str) -> np.ndarray:
+def checked_rows(b, n: int, what: str) -> np.ndarray:
     """``b`` as a float array of n rows (a vector or a matrix of columns), checked."""
     b = np.asarray(b, dtype=float)
     if b.ndim not in (1, 2) or b.shape[0] != n:
@@ -36,11 +36,12 @@ def _rows(b, n: int, what: str) -> np.ndarray:
     return b
 
 
-def _column(v: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return v if b.ndim == 1 else v[:, None]  # v (n,) shaped to broadcast against b ((n,) or (n, k))
+def as_column(v: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``v`` (n,) shaped to broadcast against ``b``, a vector (n,) or a matrix of columns (n, k)."""
+    return v if b.ndim == 1 else v[:, None]
 
 
-def _index(index, n: int) -> np.ndarray:
+def checked_index(index, n: int) -> np.ndarray:
     """``index`` (slice, integers or booleans) as integer positions in range(n)."""
     if isinstance(index, slice):
         return np.arange(n)[index]
@@ -83,7 +84,8 @@ class Covariance:
 
     def noise_diag(self) -> np.ndarray:
         """The variances of the measurement noise alone: :meth:`diag` less the variance of nuisance modes (the
-        vague prior of a marginalised rigid motion, :class:`LowRankPlusDiagonal` ``nuisance``)."""
+        vague prior of a marginalised rigid motion, :class:`~fracid.data.covariance_low_rank.LowRankPlusDiagonal`
+        ``nuisance``)."""
         return self.diag()
 
     def dense(self) -> np.ndarray:
@@ -134,19 +136,19 @@ class Diagonal(Covariance):
         self.var, self.n = var, int(var.size)
 
     def solve(self, b):
-        b = _rows(b, self.n, "solve")
-        return b / _column(self.var, b)
+        b = checked_rows(b, self.n, "solve")
+        return b / as_column(self.var, b)
 
     def logdet(self) -> float:
         return float(np.sum(np.log(self.var)))
 
     def whiten(self, r):
-        r = _rows(r, self.n, "whiten")
-        return r / _column(np.sqrt(self.var), r)
+        r = checked_rows(r, self.n, "whiten")
+        return r / as_column(np.sqrt(self.var), r)
 
     def color(self, z):
-        z = _rows(z, self.n, "color")
-        return z * _column(np.sqrt(self.var), z)
+        z = checked_rows(z, self.n, "color")
+        return z * as_column(np.sqrt(self.var), z)
 
     def diag(self) -> np.ndarray:
         return self.var.copy()
@@ -155,7 +157,7 @@ class Diagonal(Covariance):
         return np.diag(self.var)
 
     def take(self, index) -> "Diagonal":
-        return Diagonal(self.var[_index(index, self.n)])
+        return Diagonal(self.var[checked_index(index, self.n)])
 
     def scaled(self, factors) -> "Diagonal":
         """D C D with D = diag(factors) (entry i multiplied by factors[i])."""
@@ -191,16 +193,16 @@ class Dense(Covariance):
         self.C, self.n = C, int(C.shape[0])
 
     def solve(self, b):
-        return scipy.linalg.cho_solve((self.L, True), _rows(b, self.n, "solve"))
+        return scipy.linalg.cho_solve((self.L, True), checked_rows(b, self.n, "solve"))
 
     def logdet(self) -> float:
         return float(2.0 * np.sum(np.log(np.diag(self.L))))
 
     def whiten(self, r):
-        return scipy.linalg.solve_triangular(self.L, _rows(r, self.n, "whiten"), lower=True)
+        return scipy.linalg.solve_triangular(self.L, checked_rows(r, self.n, "whiten"), lower=True)
 
     def color(self, z):
-        return self.L @ _rows(z, self.n, "color")
+        return self.L @ checked_rows(z, self.n, "color")
 
     def diag(self) -> np.ndarray:
         return np.diag(self.C).copy()
@@ -209,92 +211,12 @@ class Dense(Covariance):
         return self.C
 
     def take(self, index) -> "Dense":
-        index = _index(index, self.n)
+        index = checked_index(index, self.n)
         return Dense(self.C[np.ix_(index, index)])
 
     def scaled(self, factors) -> "Dense":
         f = np.asarray(factors, float)
         return Dense(self.C * np.outer(f, f))
-
-
-class LowRankPlusDiagonal(Covariance):
-    """C = diag(d) + U U^T: independent errors plus k shared modes (e.g. a calibration error).
-
-    Solved by the Woodbury identity, C^-1 = D^-1/2 (I - V K^-1 V^T) D^-1/2 with V = D^-1/2 U and
-    the capacitance K = I + V^T V (k x k); log det C = sum log d + log det K (matrix determinant
-    lemma); whitened by the symmetric square root (I + V V^T)^-1/2 from the thin SVD of V. O(n k^2).
-
-    Parameters
-    ----------
-    U : array_like, shape (n, k)
-        The shared modes [units of y].
-    d : array_like, shape (n,)
-        Variances of the independent part [units of y squared], > 0.
-    nuisance : int
-        The last ``nuisance`` columns of U are a vague prior on nuisance motions marginalised out (the rigid
-        motion of a DIC frame, :mod:`fracid.data.dic.rigid`), not measurement noise: :meth:`noise_diag` leaves
-        them out.
-    """
-
-    def __init__(self, U, d, *, name: str = "covariance", nuisance: int = 0):
-        self.D = Diagonal(d, name=name)
-        U = np.array(U, dtype=float)
-        if U.ndim == 1:
-            U = U[:, None]
-        if U.ndim != 2 or U.shape[0] != self.D.n:
-            raise ValueError(f"{name}: U has shape {U.shape}; expected ({self.D.n}, k) like d of {self.D.n} variances")
-        if not np.all(np.isfinite(U)):
-            raise ValueError(f"{name}: U holds NaN or infinite values")
-        U.setflags(write=False)
-        self.U, self.n = U, self.D.n
-        if not 0 <= int(nuisance) <= U.shape[1]:
-            raise ValueError(f"{name}: nuisance = {nuisance!r}; give 0 to {U.shape[1]} (the number of columns of U)")
-        self.nuisance = int(nuisance)
-        self._root_d = np.sqrt(self.D.var)
-        V = U / self._root_d[:, None]
-        self._capacitance = np.linalg.cholesky(np.eye(U.shape[1]) + V.T @ V)
-        self._Q, sigma, _ = np.linalg.svd(V, full_matrices=False)
-        self._s2 = sigma**2
-
-    def _sqrt_apply(self, w, power: float):
-        """(I + V V^T)^power w through the thin SVD V = Q diag(sigma) P^T."""
-        factor = (1.0 + self._s2) ** power - 1.0
-        return w + self._Q @ (_column(factor, w) * (self._Q.T @ w))
-
-    def solve(self, b):
-        b = _rows(b, self.n, "solve")
-        w = b / _column(self._root_d, b)
-        V = self.U / self._root_d[:, None]
-        w = w - V @ scipy.linalg.cho_solve((self._capacitance, True), V.T @ w)
-        return w / _column(self._root_d, b)
-
-    def logdet(self) -> float:
-        return self.D.logdet() + float(2.0 * np.sum(np.log(np.diag(self._capacitance))))
-
-    def whiten(self, r):
-        r = _rows(r, self.n, "whiten")
-        return self._sqrt_apply(r / _column(self._root_d, r), -0.5)
-
-    def color(self, z):
-        z = _rows(z, self.n, "color")
-        return self._sqrt_apply(z, 0.5) * _column(self._root_d, z)
-
-    def diag(self) -> np.ndarray:
-        return self.D.var + np.sum(self.U**2, axis=1)
-
-    def noise_diag(self) -> np.ndarray:
-        return self.D.var + np.sum(self.U[:, : self.U.shape[1] - self.nuisance] ** 2, axis=1)
-
-    def _dense(self) -> np.ndarray:
-        return np.diag(self.D.var) + self.U @ self.U.T
-
-    def take(self, index) -> "LowRankPlusDiagonal":
-        index = _index(index, self.n)
-        return LowRankPlusDiagonal(self.U[index], self.D.var[index], nuisance=self.nuisance)
-
-    def scaled(self, factors) -> "LowRankPlusDiagonal":
-        f = np.asarray(factors, float)
-        return LowRankPlusDiagonal(self.U * f[:, None], self.D.var * f**2, nuisance=self.nuisance)
 
 
 class Block(Covariance):
@@ -315,7 +237,7 @@ class Block(Covariance):
         self.n = int(self.offsets[-1])
 
     def _split(self, b, what):
-        b = _rows(b, self.n, what)
+        b = checked_rows(b, self.n, what)
         return [(block, b[start:stop]) for block, start, stop in zip(self.blocks, self.offsets[:-1], self.offsets[1:])]
 
     def solve(self, b):
@@ -342,7 +264,7 @@ class Block(Covariance):
     def take(self, index) -> Covariance:
         """The sub-covariance of the entries ``index``; in increasing order it stays block diagonal,
         otherwise it is the (small) dense matrix of those entries in the order given."""
-        index = _index(index, self.n)
+        index = checked_index(index, self.n)
         if np.any(np.diff(index) < 0):
             order = np.argsort(index, kind="stable")
             sorted_part = self.take(index[order]).dense()
@@ -413,5 +335,5 @@ def as_covariance(C, n: int | None = None, *, name: str = "covariance") -> Covar
     return C
 
 
-__all__ = ["DENSE_LIMIT", "Block", "Covariance", "Dense", "Diagonal", "LowRankPlusDiagonal", "as_covariance",
-           "block_diagonal"]
+__all__ = ["DENSE_LIMIT", "Block", "Covariance", "Dense", "Diagonal", "as_column", "as_covariance", "block_diagonal",
+           "checked_index", "checked_rows"]

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from fracid.data.covariance_matrix import (Block, Covariance, Dense, Diagonal, LowRankPlusDiagonal, as_covariance,
-                                           block_diagonal)
+from fracid.data.covariance_matrix import Block, Covariance, Dense, Diagonal, as_covariance, block_diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 
 
 def _vectors(b, n: int, what: str) -> np.ndarray:

@@ -6,10 +6,6 @@ A :class:`Curve` always has a strictly increasing control quantity [mm] and a fo
 control, then the backtracking rule (the only point-dropping rule, always reported in ``Curve.notes``).
 How a file is read (separators, decimal marks, thousands separators, lines above the header, encodings) is
 described in :mod:`fracid.data.table` and :mod:`fracid.data.cells`.
-
-The errors (:mod:`fracid.data.errors`), the reading of tables (:func:`read_table`, :func:`check_format`,
-:func:`delimiter_hint`, :func:`decimal_comma_hint`, ...) and :func:`require_positive_force` stay importable
-from this module, where they were defined before.
 """
 
 from __future__ import annotations
@@ -28,39 +24,11 @@ from fracid.data.arguments import (
     readonly_vector,
     unit_scale,
 )
-from fracid.data.cells import decimal_comma_hint
-from fracid.data.checks import DEFAULT_BACKTRACK_FRACTION, Labels, checked_curve, require_positive_force
-from fracid.data.errors import DataError, DataTypeError
-from fracid.data.table import (
-    DECIMALS,
-    DELIMITERS,
-    CsvTable,
-    check_format,
-    column_indices,
-    delimiter_hint,
-    iter_rows,
-    parse_table,
-    read_table,
-)
+from fracid.data.checks import Labels, checked_curve
+from fracid.data.errors import DataError
+from fracid.data.table import CsvTable, check_format, column_indices, parse_table, read_table
 
-__all__ = [
-    "DECIMALS",
-    "DEFAULT_BACKTRACK_FRACTION",
-    "DELIMITERS",
-    "Curve",
-    "CsvTable",
-    "DataError",
-    "DataTypeError",
-    "check_format",
-    "curve_from_arrays",
-    "decimal_comma_hint",
-    "delimiter_hint",
-    "integer_at_least",
-    "iter_rows",
-    "read_curve_csv",
-    "read_table",
-    "require_positive_force",
-]
+__all__ = ["Curve", "curve_from_arrays", "read_curve_csv"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -31,7 +31,8 @@ import numpy as np
 import scipy.linalg
 from scipy.spatial.distance import cdist
 
-from fracid.data.covariance_matrix import LowRankPlusDiagonal, block_diagonal
+from fracid.data.covariance_matrix import block_diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 
 #: largest number of points whose kernel is decomposed exactly (dense eigh); beyond, Nystrom
 EXACT_LIMIT = 2500

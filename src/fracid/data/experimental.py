@@ -17,8 +17,6 @@ The standard deviations, their floor (``std_floor``) and the covariance: :mod:`f
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
@@ -31,14 +29,10 @@ from fracid.data.covariance import (
     diagonal_data,
     envelope_divisor,
 )
-from fracid.data.curves import Curve, read_curve_csv
+from fracid.data.curves import Curve
 from fracid.data.dataset import ExperimentalData
 from fracid.data.errors import DataError, DataTypeError
 from fracid.data.sampling import RANGE_SLACK, interpolate, resolve_points
-
-# re-exported: importable from here as before the split (fracid.config.experiments imports SAMPLINGS)
-from fracid.data.dataset import stack as stack
-from fracid.data.sampling import SAMPLINGS as SAMPLINGS, decimate as decimate, sample_points as sample_points
 
 
 def _curve_notes(curves: Sequence[Curve]) -> list[str]:
@@ -309,50 +303,21 @@ def local_block(values_series, std, name: str = "local", *, points=None) -> Expe
     return diagonal_data(sample, y, s, name, notes)
 
 
-
-# ------------------------------------------------------------------------------------ bundled data
-
-
-def gregoire2013_beam4_path() -> Path:
-    """Path of the bundled load-CMOD CSV of Gregoire et al. (2013), beam 4 (see its README.md).
-
-    Columns: ``cmod_mm`` [mm], ``load_mean_N``, ``load_min_N``, ``load_max_N`` [N].
-    """
-    ref = resources.files("fracid.data") / "gregoire2013_beam4" / "load_cmod.csv"
-    path = Path(str(ref))
-    if not path.is_file():
-        raise DataError(
-            f"bundled data file missing: {path}; the package data of fracid.data was not installed "
-            "(pyproject [tool.setuptools.package-data])"
-        )
-    return path
+# ------------------------------------------------------------------------------------ removed names
 
 
-def gregoire2013_beam4(n_points: int = 40, control_range: tuple[float, float] | None = None,
-                       sampling: str = "equally-spaced") -> ExperimentalData:
-    """The bundled real test of Gregoire, Rojas-Solano & Pijaudier-Cabot (2013) as y_exp.
+def _moved(old: str, new: str):
+    """A marker for a removed name: calling it raises TypeError naming where the bundled data are now."""
+    def removed(*args, **kwargs):
+        raise TypeError(f"fracid.data.{old}() was removed: the bundled data have one home and one loader, "
+                        f"fracid.datasets; use {new}")
+    removed.__name__ = removed.__qualname__ = old
+    removed.__doc__ = f"Removed: use {new} (:mod:`fracid.datasets`); calling it raises TypeError."
+    return removed
 
-    Notched three-point bending beam, D = 50 mm; control CMOD [mm], force = load [N]. Built with
-    :func:`from_envelope` on the mean, min and max columns, rule s = (max - min)/4.
 
-    Parameters
-    ----------
-    n_points : int
-        Number of CMOD values (equally spaced, the measured peak kept, by default).
-    control_range : (float, float), optional
-        CMOD range [mm]; default the whole recorded range.
-    sampling : {"equally-spaced", "measured"}
-        See :func:`with_std`.
-
-    Returns
-    -------
-    ExperimentalData
-        One block ``"gregoire2013_beam4"``; notes hold the envelope rule and the backtracking row.
-    """
-    mean, lower, upper = read_curve_csv(
-        gregoire2013_beam4_path(),
-        control_column="cmod_mm",
-        force_columns=["load_mean_N", "load_min_N", "load_max_N"],
-    )
-    return from_envelope(mean, lower, upper, n_points, control_range, rule="range/4", name="gregoire2013_beam4",
-                         sampling=sampling)
+gregoire2013_beam4 = _moved(
+    "gregoire2013_beam4", "fracid.datasets.load('gregoire2013-beam4') (the demo's data), or from_envelope on "
+    "the curves of read_curve_csv(fracid.datasets.path('gregoire2013-beam4'), control_column='cmod_mm', "
+    "force_columns=['load_mean_N', 'load_min_N', 'load_max_N'])")
+gregoire2013_beam4_path = _moved("gregoire2013_beam4_path", "fracid.datasets.path('gregoire2013-beam4')")

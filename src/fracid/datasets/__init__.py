@@ -2,8 +2,9 @@
 
 Every data set has a folder here with a README (source repository, path and commit; licence; citation;
 geometry; units; what the scatter is) and the source's licence text; its data file(s) and its default
-configuration, which ``fracid identify`` runs as written (the data file named relative to it). The
-Grégoire beam keeps the files of the bundled demo (:mod:`fracid.data`, ``fracid demo``).
+configuration, which ``fracid identify`` runs as written (the data file named relative to it). This is the
+one home of bundled data and this module its one loader: the Grégoire beam's configuration is the demo's
+(``fracid demo``, :func:`fracid.cli.common.demo_config_path`).
 
 >>> from fracid import datasets
 >>> datasets.names()
@@ -12,6 +13,9 @@ Grégoire beam keeps the files of the bundled demo (:mod:`fracid.data`, ``fracid
 
 On the command line: ``fracid datasets`` lists them, ``fracid init --dataset NAME -o FILE`` writes the
 configuration with the data file and the licence copied beside it (:mod:`fracid.cli.datasets`).
+
+May import every package below the command (:func:`load` reads a data set through :mod:`fracid.config`);
+only the command imports it.
 """
 
 from __future__ import annotations
@@ -115,8 +119,9 @@ DATASETS = {ds.name: ds for ds in (
                      "37(10):1434-1452",
             licence="MIT (mark-hobbs/pypd)", specimen="notched-beam",
             model="gradient-damage", folder="datasets/gregoire2013_beam4",
-            licence_file="datasets/gregoire2013_beam4/LICENSE-pypd.txt", config="data/gregoire2013_beam4/demo.toml",
-            files=("data/gregoire2013_beam4/load_cmod.csv",)),
+            licence_file="datasets/gregoire2013_beam4/LICENSE-pypd.txt",
+            config="datasets/gregoire2013_beam4/demo.toml",
+            files=("datasets/gregoire2013_beam4/load_cmod.csv",)),
     Dataset(name="tinloi-que-wst",
             title="wedge-splitting test (LMC/EPFL), 200 x 200 x 97 mm: splitting force vs opening, one curve",
             citation="Que (2003), PhD thesis, UNSW Sydney (Tin-Loi & Que's identification of cohesive crack "

@@ -77,7 +77,7 @@ def model_with_regularization(model=None, regularization: str | None = None, *, 
     return model
 
 
-def simulate(specimen, params, *, model=None, regularization: str | None = None, **options) -> PathResult:
+def simulate(specimen, params, *, model=None, regularization: None = None, **options) -> PathResult:
     """Run a forward model on ``specimen`` with ``params``.
 
     Parameters
@@ -88,8 +88,8 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
         The model's parameters (:class:`~fracid.fem.material.parameters.DamageParameters` for the damage models).
     model : forward model, optional
         A model of :mod:`fracid.models`; the gradient damage model if None.
-    regularization : {"gradient", "local", "integral"}, optional
-        Shorthand for ``model=DamageModel(regularization)``.
+    regularization : None
+        Removed (issue 37): give ``model=DamageModel(regularization)``; any other value raises TypeError.
     **options
         ``control`` (the prescribed functional; the specimen's default if None), ``target`` (final
         control value [mm]; the specimen's default for the model if None), ``stop_force_fraction``
@@ -102,9 +102,12 @@ def simulate(specimen, params, *, model=None, regularization: str | None = None,
     ------
     TypeError
         Before the run: ``specimen`` is not a specimen object (e.g. its name), ``params`` not the
-        model's parameter class.
+        model's parameter class, or the removed ``regularization`` given.
     """
-    model = model_with_regularization(model, regularization)
+    if regularization is not None:
+        raise TypeError(f"simulate(regularization={regularization!r}) was removed: give the model, "
+                        f"model=fracid.models.DamageModel({regularization!r})")
+    model = model_with_regularization(model)
     check_specimen(specimen, model)
     check_parameters(model, params)
     return model.simulate(specimen, params, **options)

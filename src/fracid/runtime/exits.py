@@ -26,7 +26,7 @@ import signal
 import sqlite3
 import sys
 
-from fracid.runtime.stops import RAISED_BY, HungUp, Terminated, received, raise_if_stopped, stopped_by  # noqa: F401 -- re-exported
+from fracid.runtime.stops import RAISED_BY, HungUp, Terminated, received
 
 OK, INTERNAL, INPUT, FAILED, FILES, MEMORY, INTERRUPTED, TERMINATED, HUNG_UP = 0, 1, 2, 3, 4, 5, 130, 143, 129
 

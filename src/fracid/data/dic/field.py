@@ -15,7 +15,8 @@ import numpy as np
 import scipy.linalg
 
 from fracid.data.arguments import real_number
-from fracid.data.covariance_matrix import Covariance, Diagonal, LowRankPlusDiagonal, block_diagonal
+from fracid.data.covariance_matrix import Covariance, Diagonal, block_diagonal
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dataset import ExperimentalData
 from fracid.data.dic.data import DicData
 from fracid.data.errors import DataError, DataTypeError

@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.data.covariance_matrix import Covariance, LowRankPlusDiagonal
+from fracid.data.covariance_matrix import Covariance
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 
 #: prior std of the rigid translations [mm] (and of the rotation's displacement at the farthest point)
 RIGID_STD = 1.0

@@ -2,33 +2,8 @@
 J. Mech. Phys. Solids 103:72-99; Wu & Nguyen 2018, J. Mech. Phys. Solids 119:20-42), by quadrature, and the
 nominal softening laws its shapes stand for.
 
-**Model.** Phase field d in [0, 1] of length scale l [mm], geometric function alpha(d) = 2 d - d^2 (c_alpha = pi),
-degradation
-
-    g(d) = (1 - d)^p / ((1 - d)^p + Q(d)),   Q(d) = a1 d (1 + a2 d + a2 a3 d^2),   a1 = 4 E Gf / (pi l ft^2),
-
-and omega(d) = 1 / g(d) - 1 = Q(d) / (1 - d)^p. In a bar under the uniform stress sigma the band, loading
-everywhere during softening, solves Gf / (c_alpha l) (alpha'(d) - 2 l^2 d'') = -g'(d) Y with
-Y = sigma^2 / (2 E g^2), whose first integral from the band's edge (d = d' = 0) is
-
-    Gf / (c_alpha l) (alpha(d) - l^2 d'^2) = sigma^2 / (2 E) omega(d).
-
-At the band centre (d = d*, d' = 0) this fixes the stress,
-
-    sigma(d*)^2 = 2 E Gf R(d*) / (c_alpha l),   R(d) = alpha(d) / omega(d) = (2 - d) (1 - d)^p / (a1 P(d)),
-
-with P(d) = 1 + a2 d + a2 a3 d^2 (R(0) = 2 / a1, so sigma(0) = ft), and the crack opening, the inelastic
-elongation of the whole band, is
-
-    w = int (sigma / E) omega dx = 2 (sigma / E) l int_0^{d*} sqrt(omega(d) / (R(d) - R(d*))) dd,
-
-using |d'| = (1 / l) sqrt(omega (R(d) - R(d*))). The integrand behaves as sqrt(d) at d = 0 and as
-(d* - d)^(-1/2) at d*: it is integrated as sqrt(omega(d) / d / D(d)) against the algebraic weight
-d^(1/2) (d* - d)^(-1/2) (QUADPACK's QAWS, ``scipy.integrate.quad(weight="alg")``), with the divided
-difference D(d) = (R(d) - R(d*)) / (d* - d) > 0 evaluated without cancellation (it tends to -R'(d*)). For d*
-near 1, beyond d = 0.9 the integral runs over u = 1 - d in decades (the integrand grows like u^-p), so that
-1 - d and d* - d keep their relative accuracy. Checked against integrating the phase-field equation itself
-across the band (tests): ~1e-14 relative.
+The band itself (the first integral of the phase-field equation, the stress and the opening of a band of
+centre d* by quadrature, the ultimate opening): :mod:`fracid.fem.material.phase_field_band`.
 
 **What comes out.** Since a1 l = 4 E Gf / (pi ft^2), both sigma and w are free of l: the law is exact in l,
 not an approximation (the 1 / l of a1 cancels in R / a1 and in l sqrt(omega / R)). In units ft and Gf / ft,
@@ -55,24 +30,26 @@ Units: stresses [MPa], lengths [mm], Gf [N/mm].
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from fracid.fem.material.cohesive import hordijk_stress
-from fracid.fem.material.phase_field import C_ALPHA, SHAPES, a1 as a1_coefficient, geometric
-from fracid.fem.material.phase_field import degradation as _degradation, shape_polynomial
+from fracid.fem.material.phase_field import C_ALPHA, SHAPES, a1 as a1_coefficient
+from fracid.fem.material.phase_field import degradation as _degradation
+from fracid.fem.material.phase_field_band import (
+    QUAD_LIMIT,
+    band_opening,
+    band_stress,
+    check_law_parameters,
+    dlog_r,
+    rho,
+)
 
 #: Cornelissen / Hordijk's constants of the nominal law: c1, c2 and wc ft / Gf
 HORDIJK_C1 = 3.0
 HORDIJK_C2 = 6.93
 HORDIJK_WC = 5.1361
-
-# quadrature tolerances of one opening
-_EPSREL = 1e-12
-_LIMIT = 200
 
 
 # ------------------------------------------------------------------------------------------ the model's functions
@@ -100,109 +77,11 @@ def shape_parameters(shape):
         raise ValueError(f"unknown phase-field softening shape {shape!r}; allowed: {', '.join(SHAPES)}") from None
 
 
-def geometric_function(d):
-    """alpha(d) = 2 d - d^2 [-] of the phase field d [-] (array_like)."""
-    return geometric(d)[0]
-
-
 def degradation(d, E, ft, Gf, l, p, a2, a3):
     """g(d) [-] of :func:`fracid.fem.material.phase_field.degradation` with a1 from (E, ft, Gf, l), validated."""
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     return _degradation(d, a1_coefficient(E, ft, Gf, l), p, a2, a3)[0]
 
-
-def _validate(E, ft, Gf, l, p, a2, a3):
-    for name, value in (("E", E), ("ft", ft), ("Gf", Gf), ("l", l)):
-        if not (np.isscalar(value) and np.isreal(value) and math.isfinite(value) and value > 0.0):
-            raise ValueError(f"{name} = {value!r}: must be a finite positive number")
-    for name, value in (("p", p), ("a2", a2), ("a3", a3)):
-        if not (np.isscalar(value) and np.isreal(value) and math.isfinite(value)):
-            raise ValueError(f"{name} = {value!r}: must be a finite number")
-    if p < 2.0:
-        raise ValueError(f"p = {p!r}: must be >= 2 (for p < 2 the opening closes again as d* -> 1)")
-    d = np.linspace(0.0, 1.0, 401)
-    if np.min(shape_polynomial(d, a2, a3)) <= 0.0:
-        raise ValueError(f"a2 = {a2!r}, a3 = {a3!r}: 1 + a2 d + a2 a3 d^2 must stay positive on [0, 1]")
-    # the stress must fall monotonically with d*: R = alpha / omega strictly decreasing on [0, 1)
-    d = d[:-1]
-    if np.max(_dlogR(d, p, a2, a3)) >= 0.0:
-        raise ValueError(f"(p, a2, a3) = ({p!r}, {a2!r}, {a3!r}): the stress sigma(d*) is not decreasing")
-
-
-def _rho(d, p, a2, a3, u=None):
-    """rho(d) = a1 R(d) = a1 alpha / omega = (2 - d) u^p / P(d) [-], u = 1 - d (pass it when it is known more
-    accurately than 1 - d); sigma^2 / ft^2 = rho(d*) / 2."""
-    u = np.maximum(1.0 - d, 0.0) if u is None else u
-    return (2.0 - d) * u**p / shape_polynomial(d, a2, a3)
-
-
-def _dlogR(d, p, a2, a3, u=None):
-    """d log R / d d = -1 / (2 - d) - p / u - P'(d) / P(d), u = 1 - d > 0."""
-    u = 1.0 - d if u is None else u
-    return -1.0 / (2.0 - d) - p / u - (a2 + 2.0 * a2 * a3 * d) / shape_polynomial(d, a2, a3)
-
-
-def _opening_integral(d_star, delta, p, a2, a3):
-    """K(d*) = int_0^{d*} sqrt(phi(d) / (rho(d) - rho(d*))) dd [-] (delta = 1 - d*, both given accurately),
-    phi = omega / a1 = d P(d) / (1 - d)^p, so that w = (8 Gf / (pi ft)) (sigma / ft) K.
-
-    The integrand is sqrt(phi / d / D) d^(1/2) (d* - d)^(-1/2) with the divided difference
-    D = (rho(d) - rho(d*)) / (d* - d) > 0, evaluated without cancellation as follows. With rho = A B / P,
-    A = 2 - d, B = (1 - d)^p and [f] = (f(d*) - f(d)) / (d* - d): [A] = -1, [P] = a2 + a2 a3 (d + d*),
-    [B] = -u^(p - 1) (1 - q^p) / (1 - q) with u = 1 - d, q = delta / u (1 - q = (d* - d) / u), [AB] =
-    A(d*) [B] - B(d) and D = -([AB] P(d) - A(d) B(d) [P]) / (P(d) P(d*)); D -> -rho'(d*) at d = d*. The
-    algebraic end factors go to QUADPACK's weight (QAWS). For d* > 0.95, beyond d = 0.9 the integral runs over
-    u = 1 - d in decades of u (the integrand grows like u^-p, and u, d* - d = u - delta keep their relative accuracy).
-    """
-    if d_star <= 0.0:
-        return 0.0
-    Py = 1.0 + a2 * d_star + a2 * a3 * d_star * d_star
-    Ay = 1.0 + delta
-    tiny = np.finfo(float).tiny
-
-    def smooth(d, u, gap):  # sqrt(phi / d / D) at d = 1 - u, gap = d* - d: bounded and smooth on [0, d*]
-        m = min(gap / u, 1.0)
-        ratio = -math.expm1(p * math.log1p(-m)) / m if 0.0 < m < 1.0 else (p if m <= 0.0 else 1.0 / m)
-        Bx = u**p
-        Px = 1.0 + a2 * d + a2 * a3 * d * d
-        drop = -((Ay * -(Bx / u) * ratio - Bx) * Px - (2.0 - d) * Bx * (a2 + a2 * a3 * (d + d_star))) / (Px * Py)
-        return math.sqrt(Px / Bx / max(drop, tiny))
-
-    def options(wvar):
-        return dict(weight="alg", wvar=wvar, epsabs=0.0, epsrel=_EPSREL, limit=_LIMIT)
-
-    if d_star <= 0.95:  # one piece over d, both end factors in the weight
-        value, _ = quad(lambda d: smooth(d, 1.0 - d, d_star - d), 0.0, d_star, **options((0.5, -0.5)))
-        return value
-    # d in [0, 0.9]: weight d^(1/2); the factor (d* - d)^(-1/2) is smooth there (d* - d >= 0.05)
-    total, _ = quad(lambda d: smooth(d, 1.0 - d, d_star - d) / math.sqrt(d_star - d), 0.0, 0.9, **options((0.5, 0.0)))
-    # u in decades [10^-(k+1), 10^-k] while 10^-(k+1) > 4 delta, then [delta, 10^-K] with weight (u - delta)^(-1/2)
-    k = 1
-    while 10.0 ** -(k + 1) > 4.0 * delta:
-        value, _ = quad(lambda u: smooth(1.0 - u, u, u - delta) * math.sqrt((1.0 - u) / (u - delta)),
-                        10.0 ** -(k + 1), 10.0**-k, epsabs=0.0, epsrel=_EPSREL, limit=_LIMIT)
-        total += value
-        k += 1
-    value, _ = quad(lambda u: smooth(1.0 - u, u, u - delta) * math.sqrt(1.0 - u), delta, 10.0**-k,
-                    **options((-0.5, 0.0)))
-    return total + value
-
-
-def _stress(d_star, delta, E, ft, Gf, l, p, a2, a3):
-    """sigma(d*) [MPa] (delta = 1 - d*) in the dimensional form sqrt(2 E Gf R / (c_alpha l)), R = rho / a1."""
-    R = _rho(d_star, p, a2, a3, u=delta) / a1_coefficient(E, ft, Gf, l)
-    return math.sqrt(2.0 * E * Gf * R / (C_ALPHA * l))
-
-
-def _opening(d_star, delta, E, ft, Gf, l, p, a2, a3):
-    """w(d*) [mm] for d* in [0, 1] (delta = 1 - d*, both given accurately), inputs already validated:
-    w = 2 (sigma / E) l int sqrt(omega / (R - R*)) dd = 2 (sigma / E) l a1 K (omega = a1 phi, R = rho / a1)."""
-    if d_star <= 0.0:
-        return 0.0
-    if delta <= 0.0:
-        return ultimate_opening(ft, Gf, p, a2, a3)
-    sigma = _stress(d_star, delta, E, ft, Gf, l, p, a2, a3)
-    return 2.0 * sigma * l * a1_coefficient(E, ft, Gf, l) * _opening_integral(d_star, delta, p, a2, a3) / E
 
 
 # ------------------------------------------------------------------------------------------------- the law itself
@@ -233,36 +112,10 @@ def centre_stress(centre_values, E, ft, Gf, l, p, a2, a3):
     ndarray
         sigma [MPa], like ``centre_values``.
     """
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     d = _centre_values(centre_values)
-    R = _rho(d, p, a2, a3) / a1_coefficient(E, ft, Gf, l)
+    R = rho(d, p, a2, a3) / a1_coefficient(E, ft, Gf, l)
     return np.sqrt(2.0 * E * Gf * R / (C_ALPHA * l))
-
-
-def ultimate_opening(ft, Gf, p, a2, a3):
-    """Opening w_u [mm] where the law reaches sigma = 0 (the limit d* -> 1).
-
-    For p = 2, w_u = 2 sqrt(2 (1 + a2 + a2 a3)) Gf / ft (linear shape: 2 Gf / ft; Cornelissen shape:
-    5.1362 Gf / ft); for p > 2 the law has an infinite tail and w_u = inf.
-
-    Parameters
-    ----------
-    ft : float
-        Tensile strength [MPa].
-    Gf : float
-        Fracture energy [N/mm].
-    p, a2, a3 : float
-        Softening shape [-].
-
-    Returns
-    -------
-    float
-        w_u [mm] (``inf`` for p > 2).
-    """
-    _validate(1.0, ft, Gf, 1.0, p, a2, a3)
-    if p > 2.0:
-        return math.inf
-    return 2.0 * math.sqrt(2.0 * shape_polynomial(1.0, a2, a3)) * Gf / ft
 
 
 def crack_opening(centre_values, E, ft, Gf, l, p, a2, a3):
@@ -284,13 +137,14 @@ def crack_opening(centre_values, E, ft, Gf, l, p, a2, a3):
     Returns
     -------
     ndarray
-        w [mm], like ``centre_values``: 0 at d* = 0, :func:`ultimate_opening` at d* = 1.
+        w [mm], like ``centre_values``: 0 at d* = 0,
+        :func:`~fracid.fem.material.phase_field_band.ultimate_opening` at d* = 1.
     """
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     d = _centre_values(centre_values)
     w = np.zeros_like(d)
     for index, d_star in np.ndenumerate(d):
-        w[index] = _opening(float(d_star), 1.0 - float(d_star), E, ft, Gf, l, p, a2, a3)
+        w[index] = band_opening(float(d_star), 1.0 - float(d_star), E, ft, Gf, l, p, a2, a3)
     return w
 
 
@@ -314,11 +168,11 @@ def default_centre_values(p, a2, a3, stress_fraction=1e-3, n_linear=121, n_tail=
     ndarray
         Increasing d* [-], starting with 0.
     """
-    _validate(1.0, 1.0, 1.0, 1.0, p, a2, a3)
+    check_law_parameters(1.0, 1.0, 1.0, 1.0, p, a2, a3)
     if not 0.0 < stress_fraction < 1.0:
         raise ValueError(f"stress_fraction = {stress_fraction!r}: must lie in (0, 1)")
     # sigma^2 / ft^2 = rho / 2 falls monotonically from 1 (d* = 0) to 0 (d* = 1)
-    d_end = brentq(lambda d: float(_rho(d, p, a2, a3)) - 2.0 * stress_fraction**2, 0.0, 1.0, xtol=1e-15)
+    d_end = brentq(lambda d: float(rho(d, p, a2, a3)) - 2.0 * stress_fraction**2, 0.0, 1.0, xtol=1e-15)
     if d_end <= 0.9:
         return np.linspace(0.0, d_end, n_linear)
     head = np.linspace(0.0, 0.9, n_linear)
@@ -352,7 +206,7 @@ def localized_cohesive_law(E, ft, Gf, l, p, a2, a3, centre_values=None):
     sigma : ndarray
         Traction [MPa].
     """
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     d = default_centre_values(p, a2, a3) if centre_values is None else _centre_values(centre_values)
     return crack_opening(d, E, ft, Gf, l, p, a2, a3), centre_stress(d, E, ft, Gf, l, p, a2, a3)
 
@@ -375,10 +229,11 @@ def traction_at_opening(w, E, ft, Gf, l, p, a2, a3):
     Returns
     -------
     ndarray
-        sigma [MPa], like w: ft at w = 0; 0 from the law's last opening on (:func:`ultimate_opening` for
-        p = 2; for p > 2 the opening at d* = 1 - 1e-14, where sigma is below 1e-17 ft).
+        sigma [MPa], like w: ft at w = 0; 0 from the law's last opening on
+        (:func:`~fracid.fem.material.phase_field_band.ultimate_opening` for p = 2; for p > 2 the opening at
+        d* = 1 - 1e-14, where sigma is below 1e-17 ft).
     """
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     w = np.asarray(w, dtype=float)
     if not np.all(np.isfinite(w)) or np.any(w < 0.0):
         raise ValueError("the openings w must be finite and >= 0")
@@ -387,7 +242,7 @@ def traction_at_opening(w, E, ft, Gf, l, p, a2, a3):
     delta_grid = np.concatenate([np.linspace(1.0, 0.1, 10), 10.0 ** -np.arange(2.0, 15.0)])
     if p == 2.0:
         delta_grid = np.append(delta_grid, 0.0)  # w(d* = 1) = w_u, finite
-    w_grid = np.array([_opening(1.0 - float(x), float(x), *args) for x in delta_grid])
+    w_grid = np.array([band_opening(1.0 - float(x), float(x), *args) for x in delta_grid])
     sigma = np.zeros_like(w)
     for index, wi in np.ndenumerate(w):
         if wi == 0.0:
@@ -398,12 +253,12 @@ def traction_at_opening(w, E, ft, Gf, l, p, a2, a3):
         k = int(np.searchsorted(w_grid, wi, side="right"))
         lo, hi = float(delta_grid[k]), float(delta_grid[k - 1])  # delta bracket, lo < hi
         if lo >= 0.5:  # small d*: solve for d* itself
-            d_star = brentq(lambda d: _opening(d, 1.0 - d, *args) - wi, 1.0 - hi, 1.0 - lo, xtol=1e-300, rtol=1e-14)
+            d_star = brentq(lambda d: band_opening(d, 1.0 - d, *args) - wi, 1.0 - hi, 1.0 - lo, xtol=1e-300, rtol=1e-14)
             delta = 1.0 - d_star
         else:
-            delta = brentq(lambda x: _opening(1.0 - x, x, *args) - wi, lo, hi, xtol=1e-300, rtol=1e-14)
+            delta = brentq(lambda x: band_opening(1.0 - x, x, *args) - wi, lo, hi, xtol=1e-300, rtol=1e-14)
             d_star = 1.0 - delta
-        sigma[index] = _stress(d_star, delta, *args)
+        sigma[index] = band_stress(d_star, delta, *args)
     return sigma
 
 
@@ -426,15 +281,16 @@ def dissipated_energy(E, ft, Gf, l, p, a2, a3):
     float
         The dissipated energy per unit crack area [N/mm]: Gf to ~1e-10 relative (see the tests).
     """
-    _validate(E, ft, Gf, l, p, a2, a3)
+    check_law_parameters(E, ft, Gf, l, p, a2, a3)
     args = (E, ft, Gf, l, p, a2, a3)
 
     def integrand(delta):  # w (-dsigma / dd*) at d* = 1 - delta
         d = 1.0 - delta
-        return -_opening(d, delta, *args) * 0.5 * _stress(d, delta, *args) * float(_dlogR(d, p, a2, a3, u=delta))
+        slope = float(dlog_r(d, p, a2, a3, u=delta))
+        return -band_opening(d, delta, *args) * 0.5 * band_stress(d, delta, *args) * slope
 
     def piece(a, b):
-        return quad(integrand, a, b, epsabs=0.0, epsrel=1e-11, limit=_LIMIT)[0]
+        return quad(integrand, a, b, epsabs=0.0, epsrel=1e-11, limit=QUAD_LIMIT)[0]
 
     # delta from 1 to 0.1, then by decades down to 1e-14
     edges = np.concatenate([[1.0], 10.0 ** -np.arange(1.0, 15.0)])
@@ -466,7 +322,7 @@ def target_law(shape, w, ft, Gf):
         sigma [MPa], like w.
     """
     shape_parameters(shape)
-    _validate(1.0, ft, Gf, 1.0, *SHAPES[shape])
+    check_law_parameters(1.0, ft, Gf, 1.0, *SHAPES[shape])
     w = np.asarray(w, dtype=float)
     if not np.all(np.isfinite(w)) or np.any(w < 0.0):
         raise ValueError("the openings w must be finite and >= 0")

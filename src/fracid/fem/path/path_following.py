@@ -16,6 +16,7 @@ from fracid.fem.path import linear_solvers
 from fracid.fem.path.linear_solvers import SingularMatrixError
 from fracid.fem.formulations.protocol import initial_history
 from fracid.fem.path.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
+from fracid.fem.path.step_sizes import StepSizes, check_steps
 
 
 @dataclass
@@ -174,15 +175,6 @@ def _check_request(problem, control, target, stop_force_fraction, max_steps):
         raise ValueError(f"max_steps = {max_steps!r}; it must be a positive integer")
 
 
-def _check_steps(steps: StepOptions, target):
-    for name in ("initial", "maximum", "minimum"):
-        value = getattr(steps, name)
-        if value is not None and not (math.isfinite(value) and 0 < value <= target):
-            raise ValueError(f"step {name} = {value!r} [mm]; it must be positive and not above the target {target}")
-    if not (steps.grow >= 1.0 and 0.0 < steps.shrink < 1.0):
-        raise ValueError(f"step grow = {steps.grow}, shrink = {steps.shrink}: need grow >= 1 and 0 < shrink < 1")
-
-
 def follow_path(
     problem,
     control: str,
@@ -251,68 +243,10 @@ def follow_path(
         that converged.
     """
     _check_request(problem, control, target, stop_force_fraction, max_steps)
-    _check_steps(steps, target)
+    check_steps(steps, target)
     sampler = None if probes is None else ProbeSampler(problem, probes, checkpoints)
     run = _Run(problem, control, linear_solver, newton, observers, field_steps, sensitivities, sampler)
-    return run.trace(_StepSizes(steps, target, checkpoints), max_steps, stop_force_fraction, callback)
-
-
-class _StepSizes:
-    """The adaptive sequence of increments of :class:`StepOptions`: cut after a failure, grown after an easy
-    step, jumping to damage onset while the response is linear."""
-
-    def __init__(self, steps: StepOptions, target: float, checkpoints):
-        self.steps, self.target = steps, target
-        self.base = steps.initial  # reference increment; set from the onset of damage when not given
-        self.step = self.base if self.base is not None else 1e-3 * target  # elastic probe
-        self.first_step = self.step
-        self.marks = np.sort(np.asarray([] if checkpoints is None else checkpoints, dtype=float))
-        self.elastic = True
-
-    def increment(self, tau: float) -> float:
-        """The next increment from ``tau``: the current step, ending at the target or the next checkpoint."""
-        increment = min(self.step, self.target - tau)
-        ahead = self.marks[self.marks > tau * (1.0 + 1e-12) + 1e-15]
-        if ahead.size and ahead[0] < tau + increment:
-            increment = ahead[0] - tau
-        return increment
-
-    def cut(self, increment: float) -> bool:
-        """Shrink the step after ``increment`` failed; whether it fell below the minimum step."""
-        steps = self.steps
-        self.step = increment * steps.shrink
-        minimum = steps.minimum if steps.minimum is not None else 1e-4 * (self.base or self.first_step)
-        return self.step < minimum
-
-    def advance(self, tau: float, increment: float, iterations: int, onset_ratio: float) -> None:
-        """Set the next step after ``increment`` converged at ``tau`` in ``iterations`` Newton iterations.
-
-        Parameters
-        ----------
-        tau : float
-            The control reached [mm].
-        increment : float
-            The increment that converged [mm].
-        iterations : int
-        onset_ratio : float
-            The problem's ``onset_ratio`` of the converged history: in (0, 1) while no point has damaged.
-        """
-        steps = self.steps
-        if self.elastic and 0.0 < onset_ratio < 1.0 and steps.jump_to_onset:
-            # linear response so far: jump to just below damage onset
-            tau_onset = tau / onset_ratio
-            self.base = self.base if self.base is not None else tau_onset / 20.0
-            # land half a small step below onset, so the next step clearly crosses it
-            # (landing on it exactly would leave the crossing to rounding)
-            self.step = max(tau_onset - 0.5 * self.base * steps.onset_fraction - tau, self.base * steps.onset_fraction)
-            return
-        self.base = self.base if self.base is not None else increment
-        if self.elastic:  # this step crossed damage onset: go on with small steps, growing again
-            self.elastic = False
-            self.step = self.base * steps.onset_fraction
-            return
-        maximum = steps.maximum if steps.maximum is not None else steps.max_factor * self.base
-        self.step = min(increment * steps.grow if iterations <= steps.easy_iterations else increment, maximum)
+    return run.trace(StepSizes(steps, target, checkpoints), max_steps, stop_force_fraction, callback)
 
 
 class _Run:
@@ -333,7 +267,7 @@ class _Run:
                            and (linear_solver is None or isinstance(linear_solver, str)) else None)
         self.derivative_tau = None  # the control of the step whose derivatives are in flight
 
-    def trace(self, sizes: _StepSizes, max_steps, stop_force_fraction, callback) -> PathResult:
+    def trace(self, sizes: StepSizes, max_steps, stop_force_fraction, callback) -> PathResult:
         """Converged steps up to the target or a stop criterion (see :func:`follow_path`)."""
         stats, recorder = self.stats, self.recorder
         factor = None  # a factorization to start the next increment with (the derivatives' or the last iteration's)

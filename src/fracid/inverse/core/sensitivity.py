@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fracid.data.covariance_matrix import Block, Dense, Diagonal, LowRankPlusDiagonal, as_covariance
+from fracid.data.covariance_matrix import Block, Dense, Diagonal, as_covariance
+from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.inverse.core.forward_operator import RunRecord
 
 
