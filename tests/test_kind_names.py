@@ -41,7 +41,7 @@ def registries() -> dict:
 #: string literals of registered kind names outside their rooms today, per module (55 in all for these five
 #: registries); lowered as the kinds bring their own adapters
 PENDING = {
-    "fracid.cli.dispatch": 1,
+    "fracid.cli.identify": 1,
     "fracid.cli.init": 17,
     "fracid.config.builders": 6,
     "fracid.config.mesh_section": 1,
