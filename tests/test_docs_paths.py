@@ -29,16 +29,6 @@ PENDING = {
     ("README.md", "fracid.fem.tsl.TractionSeparationLaw"),
     ("README.md", "fracid.inverse.method.InverseMethod"),
     ("README.md", "fracid.inverse.observations.ObservationKind"),
-    ("README.md", "src/fracid/data/gregoire2013_beam4"),
-    ("README.md", "src/fracid/data/gregoire2013_beam4/README.md"),
-    ("README.md", "src/fracid/data/gregoire2013_beam4/demo.toml"),
-    ("docs/compare/README.md", "src/fracid/data/gregoire2013_beam4/demo.toml"),
-    ("docs/cross_model/README.md", "src/fracid/data/gregoire2013_beam4/README.md"),
-    ("docs/demo/README.md", "src/fracid/data/gregoire2013_beam4/demo.toml"),
-    ("docs/posterior/README.md", "src/fracid/data/gregoire2013_beam4"),
-    ("docs/study/README.md", "src/fracid/data/gregoire2013_beam4/README.md"),
-    ("docs/study/README.md", "src/fracid/data/gregoire2013_beam4/demo.toml"),
-    ("docs/theory.md", "src/fracid/data/gregoire2013_beam4"),
 }
 
 
