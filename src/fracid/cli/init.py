@@ -197,14 +197,14 @@ def default_identification(model_type: str, params) -> tuple:
     Returns
     -------
     tuple
-        The identified names (the model's ``first_identified``), ``{name: [lower, upper]}``
-        (:func:`fracid.models.plausibility.first_bounds`) and the names sampled in log scale (beta: its range
-        spans decades).
+        The identified names (the model's ``first_identified``, else the two after E and nu), ``{name: [lower,
+        upper]}`` (:func:`fracid.models.plausibility.first_bounds`) and the names sampled in log scale (beta:
+        its range spans decades).
     """
     from fracid.models import declared, model_from_type
     from fracid.models.plausibility import first_bounds
 
-    names = list(declared(model_from_type(model_type)).first_identified)
+    names = list(declared(model_from_type(model_type)).first_identified or params.names()[2:4])
     bounds = {name: first_bounds(type(params), name, getattr(params, name)) for name in names}
     return names, bounds, [name for name in names if name == "beta"]
 

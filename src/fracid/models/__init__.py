@@ -30,8 +30,9 @@ damage_threshold, observables, sensitivities)``
     only source of the resolution warning and of a Gmsh mesh's unit check.
 ``laws`` : mapping
     The laws a configuration may name (``[model] law``): name -> factory of its ``law`` field.
-``first_identified`` : tuple of str
-    The parameters a first identification looks for (``fracid init``, ``fracid compare``).
+``first_identified`` : tuple of str or None
+    The parameters a first identification looks for (``fracid init``, ``fracid compare``); None: the two after
+    E and nu.
 ``specimen_starts`` : mapping
     Specimen class -> :class:`~fracid.models.protocol.SpecimenStart`, the fields ``fracid init`` writes.
 

@@ -74,7 +74,7 @@ class ForwardModel(Protocol):
     regularization: str | None
     mesh_length: MeshLength | None
     laws: Mapping
-    first_identified: tuple
+    first_identified: tuple | None
     specimen_starts: Mapping
 
     def simulate(self, specimen, params, **options): ...
@@ -106,11 +106,9 @@ class ModelDefaults:
     #: specimen class -> the :class:`SpecimenStart` ``fracid init`` writes for this model on it
     specimen_starts: ClassVar[Mapping] = _NONE
 
-    @property
-    def first_identified(self) -> tuple:
-        """The parameters a first identification looks for (``fracid init``, ``fracid compare``): here the two
-        after E and nu."""
-        return tuple(self.parameters.names()[2:4])
+    #: the parameters a first identification looks for (``fracid init``, ``fracid compare``); None: the two
+    #: after E and nu of its parameter class
+    first_identified: ClassVar[tuple | None] = None
 
     def why_not(self, specimen) -> str | None:
         return None
@@ -132,6 +130,18 @@ class _Declared(ModelDefaults):
     defaults of :class:`ModelDefaults` (whose methods then see the model's members through the wrapper)."""
 
     model: object
+
+    # declared here too: a runtime-checkable protocol looks members up statically, past __getattribute__
+    @property
+    def key(self) -> str:
+        return self.model.key
+
+    @property
+    def parameters(self) -> type:
+        return self.model.parameters
+
+    def simulate(self, specimen, params, **options):
+        return self.model.simulate(specimen, params, **options)
 
     def __getattribute__(self, name):
         model = object.__getattribute__(self, "model")
