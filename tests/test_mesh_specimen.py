@@ -150,15 +150,15 @@ def test_files_meshio_cannot_read_say_which_formats_to_export(tmp_path, capsys, 
 def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     """The count from the corners and elements is exact for one piece without holes; beyond
     MAX_UNKNOWNS the configuration refuses the mesh before it is built."""
-    from fracid.config import schema
-    from fracid.config.mesh_section import check_mesh_size
+    from fracid.specimens import protocol
     from fracid.specimens.mesh import mesh_size, mesh_unknowns
+    from fracid.specimens.mesh_section import check_mesh_size
 
     for triangles in (True, False):
         points, cells = grid(5, 3, triangles)[:2]
         mesh = plane_mesh(points, [("triangle" if triangles else "quad", cells)], {})
         assert mesh_unknowns(mesh.n_vertices, len(mesh.cells)) == 2 * len(mesh.nodes) + mesh.n_vertices
-    monkeypatch.setattr(schema, "MAX_UNKNOWNS", 100)
+    monkeypatch.setattr(protocol, "MAX_UNKNOWNS", 100)
     path = write_msh(tmp_path / "big.msh", *grid(6, 2, True), "triangle")
     assert mesh_size(path) == (21, 24)
     with pytest.raises(MeshError, match=r"big.msh: 24 elements and 21 corner nodes make about 151 unknowns .*"
@@ -167,22 +167,23 @@ def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     assert read_mesh(path).n_vertices == 21  # the limit is the configuration's, not the reader's
 
 
-def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-damage"):
-    """The ConfigError of :func:`check_mesh_units` on the strip drawn ``size`` times its size in mm (None if none)."""
+def units_error(tmp_path, size, c=4.0, scale=1.0, bounds=None, model="gradient-damage", parameters=None):
+    """The ConfigError of the mesh's unit check (:func:`fracid.config.sections.check_specimen_section`) on the strip
+    drawn ``size`` times its size in mm (None if none)."""
     from types import SimpleNamespace
 
     from fracid.config import ConfigError
     from fracid.config.checker import Checker
-    from fracid.config.mesh_section import check_mesh_units
     from fracid.config.schema import ModelConfig, SpecimenConfig
+    from fracid.config.sections import check_specimen_section
 
     path = write_msh(tmp_path / "units.msh", *grid(6, 2, True, L * size, H * size), "triangle")
     options = dict(path=str(path), thickness=T, scale=scale, supports=(("left", "x"), ("origin", "y")),
                    loads=(("right", "x", True, 1.0),), controls=(("elongation", (("right", "x", 1.0),)),))
     identify = bounds and SimpleNamespace(parameters=("beta", "c"), lower=(100.0, bounds[0]), upper=(900.0, bounds[1]))
     try:
-        check_mesh_units(Checker(tmp_path / "cfg.toml"), ModelConfig(model, (("c", c),)),
-                         SpecimenConfig("mesh", "elongation", tuple(options.items())), identify)
+        check_specimen_section(Checker(tmp_path / "cfg.toml"), ModelConfig(model, (("c", c),) if parameters is None else parameters),
+                               SpecimenConfig("mesh", "elongation", tuple(options.items())), identify)
     except ConfigError as err:
         return str(err)
     return None
@@ -203,6 +204,19 @@ def test_a_mesh_in_metres_or_micrometres_is_a_unit_error(tmp_path):
     assert "leave scale out" in units_error(tmp_path, 1.0, scale=1000.0)  # a mesh in mm with scale = 1000
     assert units_error(tmp_path, 1e-3, model="local-damage") is None  # no internal length
     assert units_error(tmp_path, 1.0) is None
+
+
+def test_the_unit_check_reads_the_models_mesh_length(tmp_path):
+    """The check is the model's MeshLength's, not the damage models' c alone: a PF-CZM (h <= l / 5) on a mesh
+    drawn in metres or micrometres is refused too, naming l and its unit."""
+    metres = units_error(tmp_path, 1e-3, model="pf-czm", parameters=())
+    assert "units.msh" in metres and "smaller than l / 5 (a fifth of the length scale) = 0.5 mm" in metres
+    assert "(with l = 2.5 mm (default))" in metres and "scale = 1000" in metres
+    micrometres = units_error(tmp_path, 1e3, model="pf-czm", parameters=(("l", 4.0),))
+    assert "more than 100 times l / 5 (a fifth of the length scale) = 0.8 mm (with l = 4 mm)" in micrometres
+    assert "that l is in mm" in micrometres
+    assert units_error(tmp_path, 1.0, model="pf-czm", parameters=()) is None
+    assert units_error(tmp_path, 1e-3, model="cohesive-crack", parameters=()) is None  # no length to resolve
 
 
 def test_bad_specimen_fields():

@@ -43,7 +43,7 @@ def test_without_a_law_the_crack_model_keeps_hordijks():
 
 @pytest.mark.parametrize("law_line, model, keep, words", [
     ('law = "cubic"', "cohesive-crack", False, ("model.law = 'cubic'", "'hordijk'", "'linear'", "'bilinear'")),
-    ('law = "linear"', "gradient-damage", False, ("model.law = 'linear'", "takes no law by name")),
+    ('law = "linear"', "gradient-damage", False, ("model.law = 'linear'", "must be one of 'exponential'")),
     ('law = "linear"', "cohesive-crack", True, ("model.parameters.c1", "LinearSofteningParameters")),
 ])
 def test_a_law_that_does_not_apply_is_refused_by_name(tmp_path, law_line, model, keep, words):
@@ -54,6 +54,25 @@ def test_a_law_that_does_not_apply_is_refused_by_name(tmp_path, law_line, model,
     with pytest.raises(ConfigError) as info:
         load_config(path, purpose="simulate")
     assert all(word in str(info.value) for word in words), str(info.value)
+
+
+def test_the_damage_models_name_their_laws_from_the_registry(tmp_path, monkeypatch):
+    """The damage models declare the damage laws of DAMAGE_LAWS: the exponential law by name, and a law
+    registered there is accepted by [model] law with no change to the models or the configuration."""
+    from dataclasses import replace
+
+    from fracid.fem.material import laws
+    from fracid.models import model_from_type
+
+    assert model_from_type("gradient-damage", "exponential") == model_from_type("gradient-damage")
+    monkeypatch.setitem(laws.DAMAGE_LAWS, "steep", lambda: replace(laws.DamageLaw(), name="steep"))
+    model = model_from_type("local-damage", "steep")
+    assert model.key == "local-damage-steep" and model.regularization == "local"
+    path = tmp_path / "cfg.toml"
+    path.write_text(BASE.split("[model.parameters]")[0].replace('type = "cohesive-crack"\n',
+                                                                 'type = "gradient-damage"\nlaw = "steep"\n')
+                    + "[specimen]" + BASE.split("[specimen]")[1], encoding="utf-8")
+    assert build_model(load_config(path, purpose="simulate")).key == "gradient-damage-steep"
 
 
 def test_fracid_simulate_runs_the_linear_law_with_its_higher_peak(tmp_path):

@@ -6,7 +6,9 @@ default, unit, allowed values and meaning. The meanings are read from the numpyd
 of the classes' docstrings (:func:`numpydoc_parameters`), the ranges and units from the parameter classes.
 The notched beam with the gradient-damage model starts from the bundled demo (Grégoire et al. 2013): its
 values, its identification settings and its data file; the other pairs get an ``[[experiments]]`` block
-commented out, to fill in with the lab's file. The Gmsh mesh specimen is not offered: it needs the user's
+commented out, to fill in with the lab's file. What a model needs written it declares itself: the parameters a
+first identification looks for (``first_identified``), the specimen fields changed for it (``specimen_starts``)
+and the usual ranges of its parameters (:mod:`fracid.models.plausibility`). The Gmsh mesh specimen is not offered: it needs the user's
 ``.msh`` (README, "Your own specimen: a Gmsh mesh").
 """
 
@@ -21,19 +23,9 @@ from pathlib import Path
 
 from fracid.settings.checks import COMMENT_COLUMN, toml_line
 
-#: the parameters a first identification looks for, per ``[model] type`` (others: the two after E and nu)
-IDENTIFIED = {"gradient-damage": ("kappa_i", "beta", "c"), "integral-damage": ("kappa_i", "beta", "c"),
-              "local-damage": ("kappa_i", "beta"), "cohesive-crack": ("ft", "Gf"), "crack-band": ("ft", "Gf"),
-              "pf-czm": ("ft", "Gf")}
 #: (specimen, model) whose configuration is the bundled demo's, with its data file
 DEMO_PAIR = ("notched-beam", "gradient-damage")
 _ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
-#: specimen fields changed from their defaults for a pair, and why (the written comment says so)
-_PF_MESH = "a finer mesh where the crack runs, h <= l / 5 = 0.5 mm, resolves the phase field's band (l = 2.5 mm)"
-PAIR_SPECIMEN = {("wedge-splitting", "crack-band"): ({"h_fine": 4.0}, "at h_fine = 5 the crack band stops converging "
-                                                      "after the peak (cmod 0.046 mm); 4 runs through"),
-                 **{(kind, "pf-czm"): ({"h_fine": 0.5}, _PF_MESH) for kind in ("notched-beam", "dogbone", "wedge-splitting")},
-                 ("strip", "pf-czm"): ({"n_elements": 201}, _PF_MESH)}
 #: comment column of the written ``key = value`` lines
 _COLUMN = COMMENT_COLUMN
 
@@ -191,17 +183,6 @@ def _experiment_lines(experiment: dict | None) -> list:
     return lines + [_line(key, value, _EXPERIMENT_COMMENTS.get(key, ""), commented) for key, value in block.items()]
 
 
-def _bounds(cls, name: str, value: float) -> list:
-    """Bounds around ``value``: a factor 3 each way, inside the usual range and the valid one."""
-    from fracid.models import USUAL_RANGES
-
-    low, high = cls.valid_bounds([name])
-    usual = USUAL_RANGES.get(name, (-float("inf"), float("inf")))
-    lower = max(value / 3.0, usual[0], float(low[0]))
-    upper = min(value * 3.0, usual[1], float(high[0]))
-    return [float(f"{lower:.3g}"), float(f"{upper:.3g}")]
-
-
 def default_identification(model_type: str, params) -> tuple:
     """What ``fracid init`` identifies for a model without the demo's settings: (names, bounds, log names).
 
@@ -216,11 +197,15 @@ def default_identification(model_type: str, params) -> tuple:
     Returns
     -------
     tuple
-        The identified names (:data:`IDENTIFIED`, or the two parameters after E and nu), ``{name: [lower,
-        upper]}`` and the names sampled in log scale (beta: its range spans decades).
+        The identified names (the model's ``first_identified``, else the two after E and nu), ``{name: [lower,
+        upper]}`` (:func:`fracid.models.plausibility.first_bounds`) and the names sampled in log scale (beta:
+        its range spans decades).
     """
-    names = list(IDENTIFIED.get(model_type, params.names()[2:4]))
-    bounds = {name: _bounds(type(params), name, getattr(params, name)) for name in names}
+    from fracid.models import declared, model_from_type
+    from fracid.models.plausibility import first_bounds
+
+    names = list(declared(model_from_type(model_type)).first_identified or params.names()[2:4])
+    bounds = {name: first_bounds(type(params), name, getattr(params, name)) for name in names}
     return names, bounds, [name for name in names if name == "beta"]
 
 
@@ -274,10 +259,13 @@ def _start_values(specimen: str, model: str) -> tuple:
         if model == DEMO_PAIR[1]:
             params = demo["model"]["parameters"]
             notes.append("The parameter values are those of the demo, fitted to the Gregoire et al. (2013) beam.")
-    if (specimen, model) in PAIR_SPECIMEN:
-        changes, why = PAIR_SPECIMEN[specimen, model]
-        shape = {**shape, **changes}
-        notes.append(f"Specimen: {why}.")
+    from fracid.models import declared, model_from_type
+    from fracid.specimens import SPECIMENS
+
+    start = declared(model_from_type(model)).specimen_starts.get(SPECIMENS[specimen])
+    if start is not None:
+        shape = {**shape, **start.fields}
+        notes.append(f"Specimen: {start.why}.")
     return params, shape, notes
 
 

@@ -139,11 +139,12 @@ def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> No
 
 def _unusual_values(cfg: Config, params) -> str:
     """``"; or model.parameters.kappa_i = 0.009 (usual: ...)"`` for the given values outside their usual range."""
-    from fracid.models import USUAL_RANGES, usual_range_text
+    from fracid.models import usual_range_text, usual_ranges
 
+    usual = usual_ranges()
     unusual = [f"model.parameters.{name} = {value:g} (usual: {usual_range_text(name)})"
                for name, value in dict(cfg.model.parameters).items()
-               if name in USUAL_RANGES and not USUAL_RANGES[name][0] <= value <= USUAL_RANGES[name][1]]
+               if name in usual and not usual[name][0] <= value <= usual[name][1]]
     return "; or " + ", ".join(unusual) if unusual else ""
 
 

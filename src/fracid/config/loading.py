@@ -12,9 +12,8 @@ from pathlib import Path
 from fracid.config.checker import MAX_CONFIG_BYTES, STDIN, Checker, read_toml
 from fracid.config.experiments import read_experiments
 from fracid.config.identify import check_refinable, read_identify
-from fracid.config.mesh_section import parameter_range
 from fracid.config.posterior import read_posterior
-from fracid.config.registry import model_of, section_reader, specimen_class
+from fracid.config.registry import model_of, parameter_range, specimen_class
 from fracid.models.protocol import declared
 from fracid.config.schema import (
     Config,
@@ -24,6 +23,7 @@ from fracid.config.schema import (
 )
 from fracid.config.sections import (
     check_model_runs_on,
+    check_specimen_section,
     field_key,
     read_model,
     read_output,
@@ -75,9 +75,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     simulate = read_simulate(ck, raw.get("simulate"))
     study = read_study(ck, raw.get("study"))
     posterior = read_posterior(ck, raw.get("posterior"))
-    section = section_reader(specimen_class(specimen.type))
-    if section is not None:  # the checks of a specimen's own section (a mesh's units against l)
-        section.check(ck, model, specimen, identify)
+    check_specimen_section(ck, model, specimen, identify)  # a mesh's units against the model's mesh length
     _mesh_warnings(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
                   identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,

@@ -3,34 +3,14 @@
 The model types are read from :data:`fracid.models.MODEL_TYPES` at each call, the specimen types from
 :data:`fracid.specimens.SPECIMENS` (each a :class:`~fracid.specimens.protocol.Specimen`, asked for its
 controls, observables, limits and its ``[specimen]`` section): a model or specimen registered there,
-from a test file too, needs no change here.
+from a test file too, needs no change here. A specimen that reads its own ``[specimen]`` table declares the
+reader (its ``config_section``), which :mod:`fracid.config.sections` calls.
 """
 
 from __future__ import annotations
 
-import importlib
-from dataclasses import dataclass
-from typing import Callable
-
 from fracid.specimens import SPECIMENS
-
-
-@dataclass(frozen=True)
-class SpecimenSection:
-    """The reader of a ``[specimen]`` section that is not the specimen's dataclass fields (a specimen
-    class names it in its ``config_section``).
-
-    Parameters
-    ----------
-    read : callable (checker, raw table, base directory, type name) -> SpecimenConfig
-        Validates the section (every key, the files it names) and returns it.
-    check : callable (checker, ModelConfig, SpecimenConfig, IdentifyConfig or None) -> None
-        The checks joining the section with the model and the identification (e.g. the mesh's units
-        against the internal length), raising ConfigError.
-    """
-
-    read: Callable
-    check: Callable
+from fracid.specimens.protocol import SpecimenSection
 
 
 def model_types() -> tuple:
@@ -67,13 +47,21 @@ def specimen_class(kind: str):
 
 
 def section_reader(cls) -> SpecimenSection | None:
-    """The :class:`SpecimenSection` of a specimen class that declares one (its ``config_section``,
-    ``"module:name"``), or None when its dataclass fields are the section's keys."""
-    where = cls.config_section
-    if where is None:
-        return None
-    module, _, name = where.partition(":")
-    return getattr(importlib.import_module(module), name)
+    """The reader of the ``[specimen]`` table of a specimen class that declares one (its ``config_section``),
+    or None when its dataclass fields are the table's keys."""
+    return cls.config_section
+
+
+def parameter_range(model, identify, name: str, unit: str) -> tuple:
+    """((smallest value, where), (largest value, where)) of the model's parameter ``name`` [``unit``] and the bounds
+    of ``name`` when it is identified (``where`` in words, e.g. ``"c = 4 mm^2 (default)"``)."""
+    value = getattr(model_parameters(model), name)
+    values = [(value, f"{name} = {value:g} {unit}" + ("" if name in dict(model.parameters) else " (default)"))]
+    if identify is not None and name in identify.parameters:
+        i = identify.parameters.index(name)
+        values += [(identify.lower[i], f"the lower bound {name} = {identify.lower[i]:g} {unit} of identify.bounds.{name}"),
+                   (identify.upper[i], f"the upper bound {name} = {identify.upper[i]:g} {unit} of identify.bounds.{name}")]
+    return min(values), max(values)
 
 
 def _build(specimen):

@@ -13,7 +13,8 @@ import re
 from pathlib import Path
 
 from fracid.config.checker import Checker, bytes_text, show
-from fracid.config.registry import model_of, model_types, section_reader, specimen_class, specimen_types
+from fracid.config.registry import (model_of, model_types, parameter_range, section_reader, specimen_class,
+                                   specimen_types)
 from fracid.config.schema import (
     ConfigError,
     ModelConfig,
@@ -28,7 +29,9 @@ from fracid.config.vocabulary import (
     SIMULATE_KEYS,
     STUDY_KEYS,
 )
+from fracid.models.protocol import declared
 from fracid.settings.checks import is_integer
+from fracid.specimens.protocol import SectionError
 
 
 def range_text(cls, name: str) -> str:
@@ -209,7 +212,11 @@ def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
     cls = specimen_class(kind)
     reader = section_reader(cls)
     if reader is not None:
-        return reader.read(ck, raw, base if base is not None else ck.path.parent, kind)
+        try:
+            control, options = reader.read(ck, raw, base if base is not None else ck.path.parent, cls)
+        except SectionError as err:
+            raise ConfigError(f"{ck.path}: {err}") from None
+        return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
     fields = {f.name: f for f in dataclasses.fields(cls)}
     ck.table("specimen", raw, ("type", "control", *fields))
     options = specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
@@ -218,6 +225,23 @@ def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
     control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
     check_specimen_size(ck, "specimen", kind, cls, options, options)
     return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
+
+
+def check_specimen_section(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, identify) -> None:
+    """The check of a specimen's own ``[specimen]`` reader (:func:`~fracid.config.registry.section_reader`; e.g.
+    a mesh's units) against the length the model's mesh must resolve (its
+    :class:`~fracid.models.protocol.MeshLength`; none: nothing to check) over the values of its parameter given
+    and identified (:func:`~fracid.config.registry.parameter_range`)."""
+    cls = specimen_class(specimen.type)
+    reader = section_reader(cls)
+    mesh_length = declared(model_of(model.type, model.law)).mesh_length
+    if reader is None or mesh_length is None:
+        return
+    extremes = parameter_range(model, identify, mesh_length.parameter, mesh_length.unit)
+    try:
+        reader.check(cls(**dict(specimen.options)), mesh_length, extremes)
+    except SectionError as err:
+        raise ConfigError(f"{ck.path}: {err}") from None
 
 
 def read_output(ck: Checker, raw, base: Path) -> OutputConfig:

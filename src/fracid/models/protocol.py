@@ -1,11 +1,18 @@
 """The written contract of a forward model, :class:`ForwardModel` (described in :mod:`fracid.models`),
 the defaults of a model that declares only ``key``, ``parameters`` and ``simulate``
-(:class:`ModelDefaults`, :func:`declared`) and :func:`runs_on`."""
+(:class:`ModelDefaults`, :func:`declared`) and :func:`runs_on`.
+
+Everything the outer ring (the configuration, ``fracid init``, ``fracid compare``) asks of a model is a
+member here with its default: the length its mesh must resolve (:class:`MeshLength`), the laws a
+configuration may name, the parameters a first identification looks for and the specimen fields
+``fracid init`` changes for it (:class:`SpecimenStart`). No caller probes a model with ``getattr``.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, ClassVar, NamedTuple, Protocol, runtime_checkable
+from types import MappingProxyType
+from typing import Callable, ClassVar, Mapping, NamedTuple, Protocol, runtime_checkable
 
 
 class MeshLength(NamedTuple):
@@ -35,6 +42,26 @@ class MeshLength(NamedTuple):
     advice: str | None = None
 
 
+class SpecimenStart(NamedTuple):
+    """The specimen fields ``fracid init`` writes for a model instead of the specimen's defaults, and why
+    (the written configuration's comment says so).
+
+    Attributes
+    ----------
+    fields : dict
+        Field name -> value (e.g. ``{"h_fine": 0.5}`` [mm]).
+    why : str
+        The reason in words, e.g. ``"a finer mesh ... resolves the phase field's band"``.
+    """
+
+    fields: dict
+    why: str
+
+
+#: no laws by name, no specimen fields changed (the read-only defaults of :class:`ModelDefaults`)
+_NONE = MappingProxyType({})
+
+
 @runtime_checkable
 class ForwardModel(Protocol):
     """The written contract of a forward model (see the module docstring)."""
@@ -45,6 +72,10 @@ class ForwardModel(Protocol):
     differentiates_observers: bool
     observer_names: tuple
     regularization: str | None
+    mesh_length: MeshLength | None
+    laws: Mapping
+    first_identified: tuple | None
+    specimen_starts: Mapping
 
     def simulate(self, specimen, params, **options): ...
 
@@ -59,8 +90,10 @@ class ForwardModel(Protocol):
 
 class ModelDefaults:
     """The capabilities of a model that declares nothing more than ``key``, ``parameters`` and ``simulate``:
-    it runs on every specimen, differentiates nothing, has no observers of its own and no regularisation,
-    and takes the specimen's default target with no characteristic scales."""
+    it runs on every specimen, differentiates nothing, has no observers of its own, no regularisation, no
+    length its mesh must resolve and no laws by name, takes the specimen's default target with no
+    characteristic scales, a first identification looks for the two parameters after E and nu, and
+    ``fracid init`` writes the specimens' defaults for it."""
 
     differentiable: ClassVar[tuple] = ()
     differentiates_observers: ClassVar[bool] = False
@@ -68,6 +101,14 @@ class ModelDefaults:
     regularization: ClassVar[str | None] = None
     #: the length its mesh must resolve (:class:`MeshLength`), None: no such length
     mesh_length: ClassVar[MeshLength | None] = None
+    #: the laws a configuration may name (``[model] law``): name -> factory of the ``law`` field's value
+    laws: ClassVar[Mapping] = _NONE
+    #: specimen class -> the :class:`SpecimenStart` ``fracid init`` writes for this model on it
+    specimen_starts: ClassVar[Mapping] = _NONE
+
+    #: the parameters a first identification looks for (``fracid init``, ``fracid compare``); None: the two
+    #: after E and nu of its parameter class
+    first_identified: ClassVar[tuple | None] = None
 
     def why_not(self, specimen) -> str | None:
         return None
@@ -85,10 +126,12 @@ class ModelDefaults:
 
 @dataclass(frozen=True)
 class _Declared(ModelDefaults):
-    """A model of a few lines with the capabilities of :class:`ModelDefaults` (:func:`declared`)."""
+    """A model of a few lines completed by :func:`declared`: what it declares is its own, the rest the
+    defaults of :class:`ModelDefaults` (whose methods then see the model's members through the wrapper)."""
 
     model: object
 
+    # declared here too: a runtime-checkable protocol looks members up statically, past __getattribute__
     @property
     def key(self) -> str:
         return self.model.key
@@ -100,11 +143,17 @@ class _Declared(ModelDefaults):
     def simulate(self, specimen, params, **options):
         return self.model.simulate(specimen, params, **options)
 
+    def __getattribute__(self, name):
+        model = object.__getattribute__(self, "model")
+        if not name.startswith("__") and name != "model" and hasattr(model, name):
+            return getattr(model, name)
+        return object.__getattribute__(self, name)
+
 
 def declared(model) -> ForwardModel:
     """``model`` itself when it declares every capability of :class:`ForwardModel`, else ``model``
-    completed with the defaults of :class:`ModelDefaults` (it must have ``key``, ``parameters`` and
-    ``simulate``).
+    completed with the defaults of :class:`ModelDefaults` for the members it lacks (it must have ``key``,
+    ``parameters`` and ``simulate``).
 
     Raises
     ------

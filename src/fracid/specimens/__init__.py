@@ -6,7 +6,11 @@ what :class:`~fracid.specimens.protocol.Specimen` asks (its control names, the f
 the local ``observables`` its damage models record, its defaults, the field a size-effect series
 scales and the limits of its mesh); a size-effect specimen also has ``characteristic_size`` and
 ``nominal_section``. Every specimen is registered alike: the built-in geometries, the tension strip
-and the user's own mesh (``"mesh"``, read from a Gmsh file).
+and the user's own mesh (``"mesh"``, read from a Gmsh file). A specimen declares the control that follows a
+snap-back (``snap_back_control``) and, when its ``[specimen]`` table is not its dataclass fields, the reader of
+that table (``config_section``, a :class:`~fracid.specimens.protocol.SpecimenSection`).
+
+The package may import :mod:`fracid.fem` and :mod:`fracid.settings` only (floor 1).
 """
 
 from fracid.specimens.bar import BarWithWeakZone
@@ -20,11 +24,6 @@ from fracid.specimens.wedge import WedgeSplitting
 SPECIMENS = {"notched-beam": NotchedBeam, "dogbone": DogBone, "bar": BarWithWeakZone, "wedge-splitting": WedgeSplitting,
              "strip": TensionStrip, "mesh": MeshSpecimen}
 
-#: the control of each specimen that grows through a snap-back (an opening across the crack)
-SNAP_BACK_CONTROLS = {NotchedBeam: "cmod", BarWithWeakZone: "weak_zone_elongation", DogBone: "elongation",
-                      TensionStrip: "band_opening", WedgeSplitting: "cmod"}
-
-
 def snap_back_control(control: str, functionals) -> str | None:
     """The control to use instead of ``control`` when the curve snaps back under it, or None.
 
@@ -33,16 +32,18 @@ def snap_back_control(control: str, functionals) -> str | None:
     control : str
         The control the analysis failed under.
     functionals : iterable of str
-        The functionals of the failed problem: the specimen is the one whose controls are all among
-        them and include ``control`` (None for a specimen of one's own mesh, or when ``control`` is
-        already the one that follows snap-back).
+        The functionals of the failed problem: the specimen is the registered one (:data:`SPECIMENS`) whose
+        controls are all among them and include ``control``, and its declared ``snap_back_control`` the answer
+        (None for a specimen that declares none, e.g. one's own mesh, or when ``control`` is already the one
+        that follows snap-back).
     """
     names = set(functionals)
-    for kind, indirect in SNAP_BACK_CONTROLS.items():
-        if control in kind.controls and set(kind.controls) <= names and indirect != control:
+    for kind in SPECIMENS.values():
+        indirect = kind.snap_back_control
+        if indirect is not None and control in kind.controls and set(kind.controls) <= names and indirect != control:
             return indirect
     return None
 
 
-__all__ = ["BarWithWeakZone", "DogBone", "MeshSpecimen", "NotchedBeam", "Specimen", "SNAP_BACK_CONTROLS", "SPECIMENS",
+__all__ = ["BarWithWeakZone", "DogBone", "MeshSpecimen", "NotchedBeam", "Specimen", "SPECIMENS",
            "TensionStrip", "WedgeSplitting", "snap_back_control"]

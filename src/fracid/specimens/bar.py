@@ -62,6 +62,8 @@ class BarWithWeakZone(SpecimenDefaults):
 
     default_control = "end_displacement"
     controls: ClassVar[tuple] = ("end_displacement", "weak_zone_elongation")
+    #: the control that grows through a snap-back (an opening across the crack)
+    snap_back_control: ClassVar[str] = "weak_zone_elongation"
     observables: ClassVar[tuple] = ("damaged_zone_width",)
     size_field: ClassVar[str] = "length"
     steps_per_target: ClassVar[None] = None  # the path follower's default steps

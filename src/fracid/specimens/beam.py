@@ -69,6 +69,8 @@ class NotchedBeam(FineSizeDefaults):
 
     default_control = "cmod"
     controls: ClassVar[tuple] = ("cmod", "deflection")
+    #: the control that grows through a snap-back (an opening across the crack)
+    snap_back_control: ClassVar[str] = "cmod"
     observables: ClassVar[tuple] = ("fpz_width",)
     size_field: ClassVar[str] = "depth"
 

@@ -77,6 +77,8 @@ class DogBone(FineSizeDefaults):
 
     default_control = "elongation"
     controls: ClassVar[tuple] = ("elongation", "platen_displacement")
+    #: the control that grows through a snap-back (an opening across the crack)
+    snap_back_control: ClassVar[str] = "elongation"
     observables: ClassVar[tuple] = ("fpz_width",)
     size_field: ClassVar[str] = "size"
 

@@ -23,8 +23,10 @@ from typing import ClassVar
 import numpy as np
 
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
+from fracid.specimens.mesh_section import SECTION
 from fracid.specimens.mesh_reading import MeshError, PlaneMesh, mesh_size, mesh_unknowns, plane_mesh, read_mesh
-from fracid.specimens.protocol import BYTES_PER_UNKNOWN, MAX_UNKNOWNS, Resolution, SizeEstimate, SpecimenDefaults
+from fracid.specimens.protocol import (BYTES_PER_UNKNOWN, MAX_UNKNOWNS, Resolution, SizeEstimate, SpecimenDefaults,
+                                       SpecimenSection)
 
 __all__ = ["MeshError", "MeshSpecimen", "PlaneMesh", "mesh_size", "mesh_unknowns", "plane_mesh", "read_mesh",
            "write_gmsh"]
@@ -85,7 +87,7 @@ class MeshSpecimen(SpecimenDefaults):
     checksum: str = ""
 
     #: ``[specimen] type = "mesh"`` is read by its own section (file, group lists), not by its fields
-    config_section: ClassVar[str] = "fracid.config.mesh_section:SECTION"
+    config_section: ClassVar[SpecimenSection] = SECTION
 
     def __post_init__(self):
         if not self.checksum and os.path.isfile(self.path):

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import Callable, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -64,6 +64,32 @@ class Resolution:
     h: float
     text: str
     advice: str
+
+
+class SectionError(ValueError):
+    """A ``[specimen]`` table refused by the specimen's own reader (:class:`SpecimenSection`): the message names
+    the key and the value; the configuration prefixes it with the file's path."""
+
+
+@dataclass(frozen=True)
+class SpecimenSection:
+    """The reader of a ``[specimen]`` table that is not the specimen's dataclass fields (a specimen class
+    declares it as its ``config_section``), in the specimen's own room.
+
+    Parameters
+    ----------
+    read : callable (checker, raw table, base directory, specimen class) -> (control, options)
+        Validates the table (every key, the files it names) with the configuration's checker (duck-typed:
+        ``table``, ``missing``, ``file``, ``number``, ``string``, ``choice``, ``fail``), raising its errors
+        or :class:`SectionError`; returns the control's name and the specimen's fields (a dict).
+    check : callable (specimen, mesh length, extremes) -> None
+        The check joining the table with the model and the identification: ``mesh length`` is the model's
+        :class:`~fracid.models.protocol.MeshLength` (when it has one), ``extremes`` ((smallest value, where),
+        (largest value, where)) of its parameter; raises :class:`SectionError` (e.g. a mesh drawn in metres).
+    """
+
+    read: Callable
+    check: Callable
 
 
 @dataclass(frozen=True)
@@ -116,13 +142,15 @@ class Specimen(Protocol):
     ``control_names`` are the names of its controls (the first is ``default_control``; a mesh
     specimen's ``controls`` field holds their definitions), ``observables`` the local observables its
     damage models record [mm], ``size_field`` the field a size-effect series scales (None: no series).
-    ``config_section`` names the module attribute ``"module:name"`` that reads and checks its
-    ``[specimen]`` section when that is not its dataclass fields (None: the fields are the keys).
+    ``config_section`` reads and checks its ``[specimen]`` section when that is not its dataclass fields
+    (a :class:`SpecimenSection`; None: the fields are the keys). ``snap_back_control`` is the control that
+    grows through a snap-back (an opening across the crack; None: none is known).
     ``default_instance()`` is the specimen with its defaults (None when it needs the user's input).
     """
 
     size_field: str | None
-    config_section: str | None
+    config_section: SpecimenSection | None
+    snap_back_control: str | None
 
     @property
     def control_names(self) -> tuple: ...
@@ -178,7 +206,8 @@ class SpecimenDefaults:
     """
 
     size_field: ClassVar[str | None] = None
-    config_section: ClassVar[str | None] = None
+    config_section: ClassVar[SpecimenSection | None] = None
+    snap_back_control: ClassVar[str | None] = None
     steps_per_target: ClassVar[float | None] = 60.0
     observables: ClassVar[tuple] = ()
 

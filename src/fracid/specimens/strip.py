@@ -43,6 +43,8 @@ class TensionStrip(SpecimenDefaults):
 
     default_control = "band_opening"
     controls: ClassVar[tuple] = ("band_opening", "elongation")
+    #: the control that grows through a snap-back (an opening across the crack)
+    snap_back_control: ClassVar[str] = "band_opening"
     observables: ClassVar[tuple] = ()
     steps_per_target: ClassVar[float] = 50.0
 

@@ -7,6 +7,8 @@ groups name the ligament, the support and the loading piece, and :class:`MeshSpe
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import math
 from dataclasses import dataclass
 
@@ -98,6 +100,8 @@ class WedgeSplitting(FineSizeDefaults):
 
     default_control = "cmod"
     controls = ("cmod",)
+    #: the control that grows through a snap-back (an opening across the crack)
+    snap_back_control: ClassVar[str] = "cmod"
     observables = ("fpz_width",)
 
     def __post_init__(self):

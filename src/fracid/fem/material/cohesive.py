@@ -24,7 +24,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.special import gammainc
 
-from fracid.fem.material.ranges import ParameterRange, ParameterSet
+from fracid.fem.material.ranges import ELASTIC_USUAL, ParameterRange, ParameterSet
 from fracid.fem.material.tsl import secant_unloading
 
 
@@ -37,6 +37,8 @@ _RANGES = {
     "c1": _R(0.0, True, None, False, "-"),
     "c2": _R(0.0, False, None, False, "-"),
 }
+#: concrete: ft of 2 to 5 MPa, Gf ~ 0.1 N/mm, Hordijk's c1 = 3, c2 = 6.93
+_USUAL = {**ELASTIC_USUAL, "ft": (0.5, 20.0), "Gf": (0.005, 1.0), "c1": (0.0, 10.0), "c2": (1.0, 20.0)}
 
 
 def _incomplete_moment(n, c, x):
@@ -243,6 +245,7 @@ class CohesiveParameters(ParameterSet):
     c2: float = 6.93
 
     ranges: ClassVar[dict] = _RANGES
+    usual_ranges: ClassVar[dict] = _USUAL
 
     def __post_init__(self):
         super().__post_init__()

@@ -2,7 +2,7 @@
 
 A formulation (gradient, local or integral damage; the crack band; the cohesive interface) takes a
 law and asks it for values and derivatives; it never names the law's parameters. Damage laws:
-:class:`DamageLaw`; traction-separation laws (the contract: :class:`fracid.fem.material.tsl.TractionSeparationLaw`):
+:class:`DamageLaw`, by name in :data:`DAMAGE_LAWS`; traction-separation laws (the contract: :class:`fracid.fem.material.tsl.TractionSeparationLaw`):
 :class:`HordijkLaw`, :class:`LinearSoftening`, :class:`BilinearSoftening`, by name in
 :data:`TRACTION_SEPARATION_LAWS`. A new law is a new
 object with the same methods (see :class:`DamageLaw`), nothing else changes. The parameter
@@ -137,6 +137,11 @@ class DamageLaw:
         _, d_kappa = self.softening.damage(kappa, params)
         partial = self.softening.parameter_derivatives(kappa, params)
         return np.array([-float(partial[name][0]) / float(d_kappa[0]) if name in partial else 0.0 for name in names])
+
+
+#: The damage laws by name (a configuration's ``[model] law`` of the damage models); a law of other parts is
+#: given in Python (``DamageLaw(softening=..., name=...)``) or registered here under its name
+DAMAGE_LAWS = {law.name: law for law in (DamageLaw,)}
 
 
 # ------------------------------------------------------------------------------------------------

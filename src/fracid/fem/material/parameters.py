@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from fracid.fem.material.ranges import ParameterRange, ParameterSet
+from fracid.fem.material.ranges import ELASTIC_USUAL, ParameterRange, ParameterSet
 
 _R = ParameterRange
 _RANGES = {
@@ -17,6 +17,9 @@ _RANGES = {
     "c": _R(0.0, False, None, False, "mm^2"),
     "eta": _R(1.0, True, None, False, "-"),
 }
+#: concrete: kappa_i ~ 1e-4 (ft / E), c of a few mm^2, beta of a few hundred
+_USUAL = {**ELASTIC_USUAL, "kappa_i": (2.0e-5, 1.0e-3), "alpha": (0.0, 1.0), "beta": (10.0, 1.0e4), "c": (0.01, 1000.0),
+          "eta": (1.0, 30.0)}
 
 
 @dataclass(frozen=True)
@@ -57,3 +60,4 @@ class DamageParameters(ParameterSet):
     eta: float = 10.0
 
     ranges: ClassVar[dict] = _RANGES
+    usual_ranges: ClassVar[dict] = _USUAL

@@ -35,14 +35,17 @@ SHAPES = {"linear": (2.0, -0.5, 0.0), "exponential": (2.5, 2.0 ** (5.0 / 3.0) - 
 
 LENGTH = (Field("l", 2.5, ParameterRange(0.0, False, None, False, "mm"),
                 "Length scale of the phase field (Wu's b): a numerical parameter, the band's half-width is "
-                "pi l / 2; the mesh needs h <= l / 5 where the crack runs"),)
+                "pi l / 2; the mesh needs h <= l / 5 where the crack runs", (0.1, 50.0)),)
 
 
 def _shape_fields(p, a2, a3):
-    return (Field("p", p, ParameterRange(2.0, True, None, False, "-"), "Exponent of (1 - d) in the degradation"),
+    # usual: near Wu's shapes (p = 2..2.5, a2 = -0.5..1.4, a3 = 0..0.7)
+    return (Field("p", p, ParameterRange(2.0, True, None, False, "-"), "Exponent of (1 - d) in the degradation",
+                  (1.5, 5.0)),
             Field("a2", a2, ParameterRange(-0.5, True, None, False, "-"),
-                  "Softening shape: 2nd coefficient of Q(d) = a1 d (1 + a2 d + a2 a3 d^2)"),
-            Field("a3", a3, ParameterRange(None, False, None, False, "-"), "Softening shape: 3rd coefficient of Q(d)"))
+                  "Softening shape: 2nd coefficient of Q(d) = a1 d (1 + a2 d + a2 a3 d^2)", (-0.5, 5.0)),
+            Field("a3", a3, ParameterRange(None, False, None, False, "-"), "Softening shape: 3rd coefficient of Q(d)",
+                  (0.0, 5.0)))
 
 
 def shape_polynomial(d, a2, a3):

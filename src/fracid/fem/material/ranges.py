@@ -2,7 +2,9 @@
 
 A model's parameter class is a frozen dataclass that derives from :class:`ParameterSet` and lists
 its fields' valid ranges in the class attribute ``ranges`` (name -> :class:`ParameterRange`, in the
-order of the fields); it then has ``names``, ``units``, ``valid_bounds``, ``replace``, ``as_array``
+order of the fields) and, beside them, the usual ranges of quasi-brittle materials in ``usual_ranges``
+(name -> (lower, upper) in the parameter's unit; a parameter without one is never called implausible); it
+then has ``names``, ``units``, ``valid_bounds``, ``replace``, ``as_array``
 and ``from_array``, the interface the inverse code relies on (:mod:`fracid.models`).
 
 A parameter class can also be composed from parts (:func:`compose`): the elastic part
@@ -73,6 +75,9 @@ class ParameterSet:
     """Mixin of the parameter dataclasses: validation on construction and the vector interface."""
 
     ranges: ClassVar[dict[str, ParameterRange]] = {}
+    #: name -> (lower, upper): the values usual for quasi-brittle materials (concrete, mortar, rock), wide on
+    #: purpose, in the parameter's unit; a value far outside is almost surely another unit or scale
+    usual_ranges: ClassVar[dict[str, tuple[float, float]]] = {}
 
     def __post_init__(self):
         for name, rng in self.ranges.items():
@@ -121,17 +126,23 @@ class ParameterSet:
 
 class Field(NamedTuple):
     """One parameter of a composed parameter class: its name, default value, valid range (with the
-    unit) and meaning in a few words (for the docstring, e.g. ``"Young's modulus"``)."""
+    unit), meaning in a few words (for the docstring, e.g. ``"Young's modulus"``) and usual range
+    ((lower, upper) for quasi-brittle materials, in the unit of the range; None: none)."""
 
     name: str
     default: float
     range: ParameterRange
     meaning: str
+    usual: tuple | None = None
 
 
 #: The elastic part of every model's parameters: Young's modulus E [MPa] and Poisson's ratio nu [-]
-ELASTIC = (Field("E", 30000.0, ParameterRange(0.0, False, None, False, "MPa"), "Young's modulus of the bulk"),
-           Field("nu", 0.2, ParameterRange(-1.0, False, 0.5, False, "-"), "Poisson's ratio of the bulk"))
+ELASTIC = (Field("E", 30000.0, ParameterRange(0.0, False, None, False, "MPa"), "Young's modulus of the bulk",
+                 (5.0e3, 1.0e5)),
+           Field("nu", 0.2, ParameterRange(-1.0, False, 0.5, False, "-"), "Poisson's ratio of the bulk", (0.0, 0.45)))
+
+#: the usual ranges of the elastic part (a hand-written parameter class takes them from here)
+ELASTIC_USUAL = {f.name: f.usual for f in ELASTIC}
 
 
 def _docstring(summary: str, fields) -> str:
@@ -196,7 +207,8 @@ def compose(class_name: str, *parts, summary: str = "", defaults: dict | None = 
     """
     fields = _checked_fields(parts, defaults or {})
     members = dict(namespace or {})
-    members.update(ranges={f.name: f.range for f in fields}, __doc__=_docstring(summary or f"Parameters of {class_name}.",
+    members.update(ranges={f.name: f.range for f in fields},
+                   usual_ranges={f.name: f.usual for f in fields if f.usual is not None}, __doc__=_docstring(summary or f"Parameters of {class_name}.",
                                                                                fields))
     if check is not None:
         def __post_init__(self):

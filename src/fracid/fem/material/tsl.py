@@ -198,9 +198,10 @@ class ScaledLaw:
 
 #: The part of a shape law's parameters common to all: the strength and the fracture energy
 STRENGTH_AND_ENERGY = (
-    Field("ft", 3.0, ParameterRange(0.0, False, None, False, "MPa"), "Tensile strength, traction at zero opening"),
+    Field("ft", 3.0, ParameterRange(0.0, False, None, False, "MPa"), "Tensile strength, traction at zero opening",
+          (0.5, 20.0)),
     Field("Gf", 0.1, ParameterRange(0.0, False, None, False, "N/mm"),
-          "Fracture energy, area under the traction-opening law"),
+          "Fracture energy, area under the traction-opening law", (0.005, 1.0)),
 )
 
 

@@ -1,5 +1,8 @@
 """``[specimen] type = "mesh"``: the user's own plane-stress test from a Gmsh mesh and the names of its
-physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
+physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`), read and checked here, in the specimen's room:
+the configuration passes its checker in (``table``, ``missing``, ``file``, ``number``, ``string``, ``choice``,
+``fail``: duck-typed, no import of :mod:`fracid.config`) and turns a :class:`~fracid.specimens.protocol.SectionError`
+into its own error, prefixed with the file's path.
 
 .. code-block:: toml
 
@@ -22,28 +25,40 @@ physical groups (:class:`fracid.specimens.mesh.MeshSpecimen`).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
-from fracid.config import schema
-from fracid.config.checker import Checker, ConfigError, bytes_text
-from fracid.config.registry import SpecimenSection, model_parameters
-from fracid.config.schema import SpecimenConfig
+from fracid.settings.checks import bytes_text
+from fracid.specimens import protocol
+from fracid.specimens.mesh_reading import MeshError, mesh_size, mesh_unknowns
+from fracid.specimens.protocol import SectionError, SpecimenSection, element_sides
 
 _KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
          "crack", "regions")
 _COMPONENT = "must be 'x' or 'y'"
-#: an element side this many times the largest internal length l is taken for a unit mistake
+#: an element side this many times the largest length the mesh must resolve is taken for a unit mistake
 _COARSEST = 100.0
 #: a mesh whose extent is below this many units is probably drawn in metres
 _METRES = 5.0
 
 
-def mesh_specimen(ck: Checker, raw: dict, base: Path, kind: str = "mesh") -> SpecimenConfig:
-    """The validated ``[specimen]`` of a mesh (registered as ``kind``): the file is read and every group
-    named is checked."""
+def mesh_specimen(ck, raw: dict, base: Path, cls) -> tuple:
+    """The validated ``[specimen]`` table of a mesh: (control, options of ``cls``, the specimen class); the file
+    is read and every group named is checked.
+
+    Parameters
+    ----------
+    ck : checker
+        The configuration's checker (duck-typed: ``table``, ``missing``, ``file``, ``number``, ``string``,
+        ``choice``, ``fail``), whose errors name the key and the value.
+    raw : dict
+        The ``[specimen]`` table.
+    base : Path
+        The directory relative file names start from.
+    cls : type
+        The specimen class (:class:`~fracid.specimens.mesh.MeshSpecimen` or a subclass).
+    """
     ck.table("specimen", raw, _KEYS)
     for key in ("file", "thickness", "supports", "loads", "controls"):
         if key not in raw:
@@ -64,8 +79,8 @@ def mesh_specimen(ck: Checker, raw: dict, base: Path, kind: str = "mesh") -> Spe
     }
     names = tuple(name for name, _ in options["controls"])
     control = ck.choice("specimen.control", raw.get("control", names[0]), names)
-    _check_mesh(ck, options)
-    return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
+    _check_mesh(cls, options)
+    return control, options
 
 
 _ALLOWED = {
@@ -161,103 +176,74 @@ def _regions(ck, value) -> tuple:
     return tuple(out)
 
 
-def _check_mesh(ck: Checker, options: dict) -> None:
+def _check_mesh(cls, options: dict) -> None:
     """Count the mesh's unknowns, then read the mesh and describe the specimen once: a bad mesh, one too
-    large or a group it lacks is a config error."""
-    from fracid.specimens.mesh import MeshSpecimen
-
+    large or a group it lacks is a :class:`SectionError`."""
     try:
         check_mesh_size(options["path"])
-        MeshSpecimen(**options).describe()
+        cls(**options).describe()
     except ImportError as err:
-        raise ConfigError(f"{ck.path}: specimen.file: {err}") from None
+        raise SectionError(f"specimen.file: {err}") from None
     except ValueError as err:
         text = str(err).removeprefix(f"{options['path']}: ")  # the file is named once
-        raise ConfigError(f"{ck.path}: specimen.file = {options['path']!r}: {text}") from None
+        raise SectionError(f"specimen.file = {options['path']!r}: {text}") from None
 
 
 def check_mesh_size(path: str) -> None:
-    """Raise MeshError, before the mesh is built, when its unknowns exceed :data:`MAX_UNKNOWNS` (the limit
-    of the built-in specimens' meshes)."""
-    from fracid.specimens.mesh import MeshError, mesh_size, mesh_unknowns
-
+    """Raise MeshError, before the mesh is built, when its unknowns exceed
+    :data:`~fracid.specimens.protocol.MAX_UNKNOWNS` (the limit of the built-in specimens' meshes)."""
     n_vertices, n_cells = mesh_size(path)
     unknowns = mesh_unknowns(n_vertices, n_cells)
-    if unknowns > schema.MAX_UNKNOWNS:
+    if unknowns > protocol.MAX_UNKNOWNS:
         raise MeshError(
             f"{path}: {n_cells:,} elements and {n_vertices:,} corner nodes make about {unknowns:,} unknowns once "
-            f"fracid adds the mid-edge nodes, needing about {bytes_text(unknowns * schema.BYTES_PER_UNKNOWN)} of memory "
-            f"in a forward run ({schema.BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most "
-            f"{schema.MAX_UNKNOWNS:,} unknowns are allowed: use a coarser mesh (small elements only where the crack "
+            f"fracid adds the mid-edge nodes, needing about {bytes_text(unknowns * protocol.BYTES_PER_UNKNOWN)} of memory "
+            f"in a forward run ({protocol.BYTES_PER_UNKNOWN:,} bytes per unknown, measured); at most "
+            f"{protocol.MAX_UNKNOWNS:,} unknowns are allowed: use a coarser mesh (small elements only where the crack "
             "runs; a few elements per internal length l = sqrt(2 c) are enough)")
 
 
-def check_mesh_units(ck: Checker, model, specimen: SpecimenConfig, identify) -> None:
-    """Refuse a mesh whose size is implausible against the internal length l = sqrt(2 c) of a gradient or
-    integral damage model, a sign of a unit mistake (a mesh drawn in metres without ``scale = 1000``, or in
-    micrometres): l larger than the whole mesh for the smallest c considered, or the smallest element side
-    more than :data:`_COARSEST` times l for the largest c considered (c given or default, and the bounds of
-    ``[identify.bounds] c`` when c is identified).
+def check_mesh_units(specimen, mesh_length, extremes) -> None:
+    """Refuse a mesh whose size is implausible against the length the model's mesh must resolve, a sign of a
+    unit mistake (a mesh drawn in metres without ``scale = 1000``, or in micrometres): that length larger than
+    the whole mesh for the smallest parameter value considered, or the smallest element side more than
+    :data:`_COARSEST` times it for the largest.
 
     Parameters
     ----------
-    ck : Checker
-        The configuration's checker (its path starts the message).
-    model : ModelConfig
-        The validated ``[model]``.
-    specimen : SpecimenConfig
-        The validated ``[specimen]`` of a mesh (:data:`SECTION`).
-    identify : IdentifyConfig or None
-        The validated ``[identify]``, if any.
+    specimen : MeshSpecimen
+        The specimen of the validated ``[specimen]`` table.
+    mesh_length : MeshLength
+        The model's (:class:`~fracid.models.protocol.MeshLength`: its ``parameter``, ``unit``, ``length`` and
+        ``text``), e.g. the internal length l = sqrt(2 c) of a gradient damage model.
+    extremes : tuple
+        ((smallest value, where), (largest value, where)) of its parameter, given or default and the bounds of
+        an identified one, ``where`` in words.
 
     Raises
     ------
-    ConfigError
-        Naming the file, the mesh's extent in its units and in mm, ``specimen.scale``, c and l.
+    SectionError
+        Naming the file, the mesh's extent in its units and in mm, ``specimen.scale``, the parameter and the length.
     """
-    if model.regularization not in ("gradient", "integral"):
-        return
-    from fracid.specimens.mesh import MeshSpecimen
-    from fracid.specimens.protocol import element_sides
-
-    built = MeshSpecimen(**dict(specimen.options))
-    description = built.describe()
-    extent = np.ptp(description.nodes, axis=0) / built.scale  # mesh units
-    size = (f"specimen.file = {built.path!r}: the mesh spans {extent[0]:.6g} x {extent[1]:.6g} units of its own, "
-            f"{extent[0] * built.scale:.6g} x {extent[1] * built.scale:.6g} mm with specimen.scale = {built.scale:g} "
-            "(mm per unit)")
-    (small, small_where), (large, large_where) = c_range(model, identify)
-    length = math.sqrt(2.0 * small)
-    if length > extent.max() * built.scale:
+    description = specimen.describe()
+    scale, name, unit = specimen.scale, mesh_length.parameter, mesh_length.unit
+    extent = np.ptp(description.nodes, axis=0) / scale  # mesh units
+    size = (f"specimen.file = {specimen.path!r}: the mesh spans {extent[0]:.6g} x {extent[1]:.6g} units of its own, "
+            f"{extent[0] * scale:.6g} x {extent[1] * scale:.6g} mm with specimen.scale = {scale:g} (mm per unit)")
+    (small, small_where), (large, large_where) = extremes
+    length = mesh_length.length(small)
+    if length > extent.max() * scale:
         hint = ("is the mesh drawn in metres? then set scale = 1000 under [specimen] (mm per mesh unit)"
-                if extent.max() < _METRES else "check specimen.scale (mm per mesh unit) and that c is in mm^2")
-        raise ConfigError(f"{ck.path}: {size}, smaller than the internal length l = sqrt(2 c) = {length:.3g} mm "
-                          f"(with {small_where}): {hint}")
-    length, side = math.sqrt(2.0 * large), element_sides(description)[0]
+                if extent.max() < _METRES else f"check specimen.scale (mm per mesh unit) and that {name} is in {unit}")
+        raise SectionError(f"{size}, smaller than {mesh_length.text} = {length:.3g} mm (with {small_where}): {hint}")
+    length, side = mesh_length.length(large), element_sides(description)[0]
     if side > _COARSEST * length:
-        hint = ("is the mesh drawn in mm? then leave scale out (1, the default)" if built.scale > 1 else
+        hint = ("is the mesh drawn in mm? then leave scale out (1, the default)" if scale > 1 else
                 "scale = 0.001 for a mesh drawn in micrometres")
-        raise ConfigError(f"{ck.path}: {size}; its smallest element side, {side:.6g} mm, is more than "
-                          f"{_COARSEST:g} times the internal length l = sqrt(2 c) = {length:.3g} mm (with "
-                          f"{large_where}): check specimen.scale ({hint}) and that c is in mm^2")
+        raise SectionError(f"{size}; its smallest element side, {side:.6g} mm, is more than {_COARSEST:g} times "
+                           f"{mesh_length.text} = {length:.3g} mm (with {large_where}): check specimen.scale ({hint}) "
+                           f"and that {name} is in {unit}")
 
 
-def c_range(model, identify) -> tuple:
-    """((smallest c, where), (largest c, where)) [mm^2] of the model's c and the bounds of an identified c."""
-    return parameter_range(model, identify, "c", "mm^2")
-
-
-def parameter_range(model, identify, name: str, unit: str) -> tuple:
-    """((smallest value, where), (largest value, where)) of the model's parameter ``name`` [``unit``] and the bounds
-    of ``name`` when it is identified."""
-    value = getattr(model_parameters(model), name)
-    values = [(value, f"{name} = {value:g} {unit}" + ("" if name in dict(model.parameters) else " (default)"))]
-    if identify is not None and name in identify.parameters:
-        i = identify.parameters.index(name)
-        values += [(identify.lower[i], f"the lower bound {name} = {identify.lower[i]:g} {unit} of identify.bounds.{name}"),
-                   (identify.upper[i], f"the upper bound {name} = {identify.upper[i]:g} {unit} of identify.bounds.{name}")]
-    return min(values), max(values)
-
-
-#: the ``[specimen]`` section of :class:`~fracid.specimens.mesh.MeshSpecimen` (its ``config_section``)
+#: the ``[specimen]`` table of :class:`~fracid.specimens.mesh.MeshSpecimen` (its ``config_section``)
 SECTION = SpecimenSection(read=mesh_specimen, check=check_mesh_units)
