@@ -42,9 +42,8 @@ def registries() -> dict:
 #: registries); lowered as the kinds bring their own adapters
 PENDING = {
     "fracid.cli.identify": 1,
-    "fracid.cli.init": 17,
+    "fracid.cli.init": 3,
     "fracid.config.builders": 6,
-    "fracid.config.mesh_section": 1,
     "fracid.config.schema": 1,
     "fracid.config.sections": 1,
     "fracid.data.dic.derived": 1,

@@ -66,7 +66,7 @@ KNOWN_UPWARD = {
 
 #: "fracid.module:name" strings (an import hidden from the import statements) that run up a floor today:
 #: (module holding the string, the unit it names); the models/specimens helper of issue 37 removes it
-KNOWN_UPWARD_STRINGS = {("specimens.mesh", "config")}
+KNOWN_UPWARD_STRINGS: set = set()
 
 STRING_IMPORT = re.compile(r"^fracid\.([a-z_]+)(\.[a-z_.]+)?:[A-Za-z_]\w*$")
 

@@ -21,7 +21,6 @@ PENDING = {
     "inverse/core/observations.py",
     "inverse/sampling/posterior.py",
     "inverse/studies/study.py:run_study",
-    "models/__init__.py",
     "report/field_figures.py",
 }
 
