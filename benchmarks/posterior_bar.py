@@ -27,7 +27,7 @@ import numpy as np
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.methods.strategy import identify

@@ -23,8 +23,8 @@ from fracid.config import (
 )
 from fracid.data import gregoire2013_beam4_path
 from fracid.inverse.core.forward_operator import ForwardOperator
-from fracid.inverse.methods.knn import ParameterSpace
-from fracid.inverse.methods.strategy import KnnSettings
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn_settings import KnnSettings
 from fracid.fem.material.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone

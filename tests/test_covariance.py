@@ -13,7 +13,7 @@ from fracid.data.covariance_matrix import (
     as_covariance,
     block_diagonal,
 )
-from fracid.inverse.methods.kalman import assimilate, information_update, kalman_update
+from fracid.inverse.methods.assimilation import assimilate, information_update, kalman_update
 
 
 def _spd(n, seed):

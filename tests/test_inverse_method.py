@@ -10,9 +10,12 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
-from fracid.inverse.methods.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
+from fracid.inverse.methods.kalman_settings import KalmanSettings
+from fracid.inverse.methods.knn_kalman import IdentificationResult, KnnKalman
+from fracid.inverse.methods.knn_settings import KnnSettings
+from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.study import StudySettings
 from fracid.inverse.studies.twin import synthetic_data
 

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.forward_operator import RunRecord
 from fracid.inverse.sampling.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior, weighted_quantile
 

@@ -121,7 +121,7 @@ def test_all_runs_failed_is_a_computation_failure():
     from types import SimpleNamespace
 
     from fracid.inverse.core.forward_operator import RunRecord
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.core.sensitivity import ForwardRunError
     from fracid.inverse.sampling.posterior import sample_posterior
 

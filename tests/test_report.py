@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from fracid.inverse.methods.strategy import IdentificationResult
+from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.report import fit_metrics, write_report
 
 figures = pytest.importorskip("fracid.report.figures")  # needs matplotlib

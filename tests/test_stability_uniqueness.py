@@ -5,7 +5,8 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace, knn_from_population
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn import knn_from_population
 from fracid.inverse.studies.stability import noisy_replicates, stability
 from fracid.inverse.studies.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_level
 from fracid.inverse.studies.verdict import DataDescription, parameter_verdicts

@@ -10,7 +10,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from fracid.data.covariance_matrix import as_covariance
-from fracid.inverse.core.space import ParameterSpace  # also importable from here, as before
+from fracid.inverse.core.space import ParameterSpace
 
 
 def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) -> np.ndarray:

@@ -19,7 +19,8 @@ import numpy as np
 from fracid.data import ExperimentalData
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.methods.strategy import IdentificationResult, identify_data
+from fracid.inverse.methods.knn_kalman import IdentificationResult
+from fracid.inverse.methods.strategy import identify_data
 from fracid.models import ConvergenceError
 
 __all__ = ["Candidate", "ModelFit", "candidate_operator", "fit_model", "relative_rms", "run_to_end"]

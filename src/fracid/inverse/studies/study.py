@@ -27,7 +27,8 @@ import numpy as np
 
 from fracid.inverse.methods.knn_kalman import KnnKalman
 from fracid.inverse.core.method import check_problem, identification_bounds
-from fracid.inverse.methods.registry import StudyMethod, with_settings
+from fracid.inverse.core.method_settings import with_settings
+from fracid.inverse.methods.registry import StudyMethod
 from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.likelihood.terms import Problem, with_error_terms
