@@ -15,6 +15,7 @@ from fracid.inverse.core.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMe
 from fracid.inverse.methods.kalman_settings import KalmanSettings
 from fracid.inverse.methods.knn_kalman import IdentificationResult, KnnKalman
 from fracid.inverse.methods.knn_settings import KnnSettings
+from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS
 from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.study import StudySettings
 from fracid.inverse.studies.twin import synthetic_data
@@ -129,14 +130,18 @@ def test_failed_runs_and_status_of_a_stage_named_by_the_method():
 
 def test_study_settings_group_the_options_and_replace_by_name():
     settings = StudySettings().replace(n=16, k=3, groups="all", max_iterations=8, starts=0, prior="bounds")
-    assert settings.knn == KnnSettings(n=16, k=3) and settings.kalman == KalmanSettings(groups="all", max_iterations=8)
+    method = settings.method
+    assert method.knn == KnnSettings(n=16, k=3) and method.kalman == KalmanSettings(groups="all", max_iterations=8)
     assert (settings.starts, settings.replicates, settings.prior) == (0, 5, "bounds")
-    assert settings.identification == KnnKalman(settings.knn, settings.kalman)
-    assert StudySettings().replace(knn=KnnSettings(n=8), k=2).knn == KnnSettings(n=8, k=2)
+    assert settings.identification == KnnKalman(method.knn, method.kalman)
+    assert StudySettings().replace(knn=KnnSettings(n=8), k=2).method.knn == KnnSettings(n=8, k=2)
+    assert StudySettings().prior == "search" and isinstance(StudySettings().method, METHODS[DEFAULT_METHOD])
     with pytest.raises(TypeError, match="unknown setting.s. population .*or a study setting: error_terms, method, noise_seed"):
         StudySettings().replace(population=16)
-    with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
+    with pytest.raises(ValueError, match="choose 'search' or 'bounds'"):
         StudySettings(prior="flat")
+    with pytest.raises(ValueError, match="prior = 'knn' is now called 'search'"):
+        StudySettings(prior="knn")
 
 
 def _fit(y_fit, std=0.001, x=2.0):

@@ -171,7 +171,7 @@ class StudyResult:
         (directory / "study.json").write_text(json.dumps(self.to_dict(), indent=1))
         (directory / "verdict.txt").write_text(self.summary() + "\n")
         ident = self.identification
-        population = getattr(ident, "knn", None) or {}
+        population = ident.population()
         if population.get("points") is not None:
             points, f = np.asarray(population["points"], float), np.asarray(population["f"], float)
             status = population.get("status") or ["ok" if np.isfinite(v) else "failed" for v in f]
