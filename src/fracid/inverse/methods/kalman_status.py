@@ -241,7 +241,7 @@ def judge_last_pass(result, objective_at, objective, last, max_iterations, names
 
 def chi2_per_point(result, y_exp, C_exp) -> float:
     """(y_exp - y)^T C_exp^-1 (y_exp - y) / n_y at the result's estimate (inf when its run failed)."""
-    from fracid.inverse.methods.knn import objective
+    from fracid.inverse.core.misfit import objective
 
     if result.failed:
         return float("inf")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.methods.knn import objective
+from fracid.inverse.core.misfit import objective
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity
 from fracid.inverse.studies.verdict import DataDescription
 from fracid.store.tables import without_nan, write_csv_table
