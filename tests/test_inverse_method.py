@@ -185,3 +185,14 @@ def test_verdict_txt_carries_the_warnings_of_the_identification(tmp_path):
     lines = [f"Warning: {text}" for text in ident.warnings()]
     assert len(lines) == 2 and all(line in study.summary().splitlines() for line in lines)
     assert any("estimate at a bound" in line for line in lines) and any("misfit" in line for line in lines)
+
+
+def test_the_configurations_study_prior_reads_search_bounds_and_the_former_knn(tmp_path):
+    from fracid.config.checker import Checker
+    from fracid.config.sections import read_study
+
+    ck = Checker(tmp_path / "cfg.toml")
+    assert [read_study(ck, raw).prior for raw in (None, {"prior": "search"}, {"prior": "bounds"}, {"prior": "knn"})] == \
+        ["search", "search", "bounds", "search"]
+    with pytest.raises(Exception, match=r"study.prior = 'flat'.*'search', 'bounds'"):
+        read_study(ck, {"prior": "flat"})
