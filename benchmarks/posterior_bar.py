@@ -111,7 +111,7 @@ def emcee_reference(operator, y, C, steps, executor, start_at, seed=0):
 
 
 def moments(points, weights):
-    from fracid.inverse.sampling.posterior import weighted_quantile
+    from fracid.inverse.sampling.mixture import weighted_quantile
 
     mean = weights @ points
     std = np.sqrt(weights @ (points - mean) ** 2)

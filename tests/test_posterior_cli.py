@@ -14,7 +14,8 @@ import pytest
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli
 from fracid.runtime import exits
-from fracid.inverse.sampling.posterior import PosteriorSettings, weighted_quantile
+from fracid.inverse.sampling.mixture import weighted_quantile
+from fracid.inverse.sampling.posterior import PosteriorSettings
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

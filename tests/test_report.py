@@ -262,7 +262,7 @@ def test_images_load_in_a_browser(report, tmp_path):
 
 
 def test_posterior_page_renders_in_a_browser(tmp_path):
-    from fracid.inverse.sampling.posterior import PosteriorResult
+    from fracid.inverse.sampling.posterior_result import PosteriorResult
     from fracid.report.posterior import write_posterior_page
 
     x = np.random.default_rng(1).normal([2.0, 250.0], [0.1, 10.0], size=(50, 2))

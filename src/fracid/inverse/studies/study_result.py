@@ -82,7 +82,7 @@ def describe_data(operator) -> DataDescription:
 class StudyResult:
     """Everything a study computed; :meth:`save` writes it, :func:`fracid.report.study` reports it.
 
-    ``posterior`` is the sampled :class:`~fracid.inverse.sampling.posterior.PosteriorResult` when the study was
+    ``posterior`` is the sampled :class:`~fracid.inverse.sampling.posterior_result.PosteriorResult` when the study was
     asked for one and it could be sampled, None otherwise.
     """
 
