@@ -12,8 +12,8 @@ space):
    the importance weights, and the verdict per parameter on its credible intervals
    (:func:`fracid.inverse.studies.verdict.parameter_verdicts`; on the Gaussian when the sampling failed).
 
-Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the KNN prior's
-term, the objective the Kalman filter minimises), the chi^2, AIC and BIC. The models run side by side
+Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the term of the
+prior its search gave, the objective its local fit minimises), the chi^2, AIC and BIC. The models run side by side
 (:func:`fracid.runtime.executors.concurrently`: a thread per model submitting its forward runs to the shared executor)
 and every run goes through the run store (the identification's stages under their own labels, the posterior
 and the Laplace run under ``compare:<label>``; the keys hold the model, so models never share a run and a

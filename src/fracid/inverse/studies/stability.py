@@ -1,7 +1,7 @@
 """Stability of the estimate (docs/theory.md, section 4.7): identification repeated on data with noise added.
 
 Each replicate adds a draw of N(0, noise covariance) to the data (seeds fixed, so a study is
-reproducible) and runs the Kalman filter again from the same prior. The scatter of the estimates,
+reproducible) and runs the method's local fit again from the same prior. The scatter of the estimates,
 compared with the noise of the data, says how strongly measurement errors are amplified into the
 parameters: a stable identification has scatter of the order of the posterior standard deviation.
 """

@@ -54,9 +54,9 @@ class StudySettings:
         the prior, the objective maps and the starting points of the multi-start check; its refinement
         the identification; its local fit (``fit_from``) every multi-start fit and every noisy replicate.
     prior : {"search", "bounds"}
-        Covariance of the refinement's prior (mean: the search's estimate): the search's own (``"search"``: for
-        a KNN search the spread of the k nearest neighbours, the thesis's cascade, docs/theory.md, section 4.4), or
-        the bounds' uniform covariance. The search ranked its points with the same data, so "bounds" keeps the
+        Covariance of the refinement's prior (mean: the search's estimate): the search's own (``"search"``: the
+        spread of the points its prior is drawn from, the thesis's cascade, docs/theory.md, section 4.4), or the
+        bounds' uniform covariance. The search ranked its points with the same data, so "bounds" keeps the
         posterior to what the data say, which comparisons of data sets (twin matrices) need.
     starts : int
         Starting points of the multi-start check (0 or 1: skipped).

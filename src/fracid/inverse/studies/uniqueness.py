@@ -1,13 +1,13 @@
 """Uniqueness of the estimate (docs/theory.md, section 4.6): maps of the objective, its valley, multi-start.
 
-The population of a KNN search is an overview of the objective f over the parameter space. Its
+The population of the method's search is an overview of the objective f over the parameter space. Its
 *valley* is the set of parameter sets the data cannot tell from the estimate (the identification's, when
 given; else the best population point): f - f_estimate below the
 95 % quantile of chi^2 with p degrees of freedom (the likelihood-ratio confidence region of a
 Gaussian measurement error; p the number of identified parameters). A valley stretched along a line
 means correlated parameters; several separated pieces mean several minima.
 
-The multi-start check runs the Kalman filter from several distinct starting points of the
+The multi-start check runs the method's local fit from several distinct starting points of the
 population: ends that differ by more than their standard deviations expose a non-unique estimate.
 """
 
