@@ -129,3 +129,11 @@ def test_the_report_shows_a_section_per_stage_by_its_kind_of_record(identified):
     assert order == ["Final check", "Step refinement", "Grid scan population"]
     figures = {p.name for p in (identified / "figures").glob("*.png")}
     assert {"grid_objective.png", "grid_map.png", "steps.png"} <= figures and "check.png" not in figures
+
+
+def test_every_registered_method_declares_a_known_kind_of_record_for_each_stage():
+    from fracid.inverse.core.stage_records import RECORD_KINDS
+
+    for name, cls in {**METHODS, GridThenSteps.name: GridThenSteps}.items():
+        assert list(cls.stage_records) == list(cls.stages), name
+        assert set(cls.stage_records.values()) <= set(RECORD_KINDS), name
