@@ -30,7 +30,7 @@ from fracid.cli.dispatch import demo_config_path
 from fracid.config import build_data, build_method, build_parameters, build_space, build_specimen, load_config
 from fracid.inverse.studies.cross_model import compare_models, cross_calibration
 from fracid.inverse.studies.model_fit import Candidate
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.material.parameters import DamageParameters
 from fracid.models import CohesiveCrackModel, CrackBandModel, DamageModel

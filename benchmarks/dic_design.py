@@ -55,7 +55,7 @@ from fracid.data.dic_noise import DIAGONAL_FLOOR, dic_kernel
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.observations import FieldObservation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.studies.dic_twin import crack_distance, inside_mesh, speckle_grid
 from fracid.inverse.studies.uniqueness import bounds_covariance
 from fracid.specimens.beam import NotchedBeam

@@ -40,7 +40,7 @@ from fracid.data.dic import field_block, read_dic_frames
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.observations import field_observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.studies.dic_twin import synthetic_dic, write_dic
 from fracid.inverse.studies.study import StudySettings, run_study
 from fracid.specimens.beam import NotchedBeam

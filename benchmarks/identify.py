@@ -18,7 +18,8 @@ import numpy as np
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace, design, evaluate_population
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn import design, evaluate_population
 from fracid.inverse.methods.strategy import identify
 from fracid.runtime.executors import make_executor
 from fracid.specimens.beam import NotchedBeam

@@ -27,7 +27,7 @@ import numpy as np
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.methods.strategy import identify
@@ -111,7 +111,7 @@ def emcee_reference(operator, y, C, steps, executor, start_at, seed=0):
 
 
 def moments(points, weights):
-    from fracid.inverse.sampling.posterior import weighted_quantile
+    from fracid.inverse.sampling.mixture import weighted_quantile
 
     mean = weights @ points
     std = np.sqrt(weights @ (points - mean) ** 2)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import fracid
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.studies.twin import dogbone_cases, twin_matrix
 from fracid.runtime.executors import make_executor
 from fracid.report.figures import _new_figure, to_png

@@ -6,7 +6,8 @@ import numpy as np
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace, knn_search
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn import knn_search
 
 N_RUNS = 120
 SPACE = ParameterSpace(("c", "beta"), [0.5, 100.0], [4.0, 500.0])

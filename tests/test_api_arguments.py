@@ -7,8 +7,10 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation, RunRecord
-from fracid.inverse.methods.knn import ParameterSpace
-from fracid.inverse.methods.strategy import KnnGaussNewton, KnnKalman, identify, identify_data
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
+from fracid.inverse.methods.knn_kalman import KnnKalman
+from fracid.inverse.methods.strategy import identify, identify_data
 from fracid.models import DamageModel, implausible, usual_range_text
 
 BAR = fracid.BarWithWeakZone(n_elements=40)

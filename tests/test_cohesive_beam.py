@@ -60,7 +60,7 @@ def test_cohesive_beam_curve_peaks_then_softens(separated):
 @pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.core.forward_operator import Observation, ForwardOperator
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.methods.strategy import identify
     from fracid.inverse.studies.twin import synthetic_data
     from fracid.runtime.executors import make_executor

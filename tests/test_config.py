@@ -23,8 +23,8 @@ from fracid.config import (
     simulate_settings,
 )
 from fracid.inverse.core.forward_operator import ForwardOperator
-from fracid.inverse.methods.knn import ParameterSpace
-from fracid.inverse.methods.strategy import KnnSettings
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn_settings import KnnSettings
 from fracid.fem.material.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
@@ -418,7 +418,7 @@ BAD = [
     pytest.param(variant("vtk_steps = []", "vtk_steps = []\n[study]\nreplicates = 1"), "identify",
                  ["study.replicates", "1", ">= 2"], id="one-replicate"),
     pytest.param(variant("vtk_steps = []", "vtk_steps = []\n[study]\nprior = 'flat'"), "identify",
-                 ["study.prior", "'flat'", "'knn', 'bounds'"], id="unknown-prior"),
+                 ["study.prior", "'flat'", "'search', 'bounds'"], id="unknown-prior"),
     pytest.param(variant("n_points = 40", 'n_points = 40\nsampling = "measured-points"'), "identify",
                  ["experiments[0].sampling", "'measured-points'", "'equally-spaced', 'measured'"],
                  id="unknown-sampling"),

@@ -4,9 +4,9 @@ Kalman filter's information form against its gain form."""
 import numpy as np
 import pytest
 
-from fracid.data.covariance_matrix import DENSE_LIMIT, Block, Dense, Diagonal, as_covariance, block_diagonal
 from fracid.data.covariance_low_rank import LowRankPlusDiagonal
-from fracid.inverse.methods.kalman import assimilate, information_update, kalman_update
+from fracid.data.covariance_matrix import DENSE_LIMIT, Block, Dense, Diagonal, as_covariance, block_diagonal
+from fracid.inverse.methods.assimilation import assimilate, information_update, kalman_update
 
 
 def _spd(n, seed):

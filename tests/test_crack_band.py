@@ -148,7 +148,7 @@ def test_beam_curve_converges_with_the_mesh_and_matches_the_cohesive_crack():
 @pytest.mark.slow
 def test_twin_experiment_recovers_ft_and_gf_noise_free():
     from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.methods.strategy import identify
     from fracid.inverse.studies.twin import synthetic_data
     from fracid.runtime.executors import make_executor

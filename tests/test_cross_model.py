@@ -11,7 +11,7 @@ import pytest
 
 from fracid.inverse.studies.cross_model import compare_models, cross_calibration
 from fracid.inverse.studies.model_fit import Candidate, relative_rms
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.fem.material.cohesive import CohesiveParameters
 from fracid.fem.material.parameters import DamageParameters
 from fracid.fem.path.path_following import StepOptions

@@ -555,7 +555,7 @@ def test_the_old_bundled_data_names_raise_and_name_the_new_path():
 
 def test_block_weights_scale_the_objective_of_their_block():
     from fracid.data import ExperimentalData, DataError
-    from fracid.inverse.methods.knn import objective
+    from fracid.inverse.core.misfit import objective
 
     data = ExperimentalData([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], np.diag([0.1, 0.2, 0.3]),
                             (("global", 0, 2), ("local", 2, 3)))

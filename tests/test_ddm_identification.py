@@ -6,7 +6,7 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import (CentralDifferences, DirectDifferentiation, exact_sensitivity,
                                         sensitivity_label)

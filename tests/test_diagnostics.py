@@ -130,7 +130,7 @@ def test_a_twin_on_a_shorter_bar_gets_the_elastic_slope_warning():
     """Data from a 100 mm bar, identified (c, beta) with a 70 mm model of it: E fixed, the model is about
     100/70 times stiffer, which no (c, beta) mends; the result says so."""
     from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.methods.strategy import identify_data
     from fracid.inverse.studies.twin import synthetic_data
 

@@ -25,7 +25,7 @@ from fracid.fem.path.path_following import StepOptions
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.observations import FieldObservation
 from fracid.inverse.core.sensitivity import CentralDifferences
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.dic_twin import synthetic_dic
 from fracid.inverse.studies.uniqueness import bounds_covariance

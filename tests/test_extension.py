@@ -10,7 +10,7 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.twin import synthetic_data
 from fracid.fem.material.cohesive import CohesiveParameters

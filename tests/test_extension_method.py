@@ -19,7 +19,8 @@ import fracid
 from fracid import cli
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.settings import checks as settings
-from fracid.inverse.methods.knn_kalman import KnnSettings, population_search
+from fracid.inverse.methods.knn_settings import KnnSettings
+from fracid.inverse.methods.knn_started import population_search
 from fracid.inverse.methods.knn_settings import knn_from_table
 from fracid.inverse.core.method import MethodResult, identification_bounds, result_fields
 from fracid.inverse.methods.registry import METHODS, StudyMethod

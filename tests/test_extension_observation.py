@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.observations import ObservationKind
 from fracid.inverse.methods.strategy import identify
 from fracid.models import CohesiveCrackModel, StepOptions

@@ -8,7 +8,9 @@ import pytest
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.methods.kalman import kalman_filter
-from fracid.inverse.methods.knn import ParameterSpace, design, knn_from_population, knn_search, objective
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.core.misfit import objective
+from fracid.inverse.methods.knn import design, knn_from_population, knn_search
 from fracid.inverse.methods.strategy import identify
 
 BAR = fracid.BarWithWeakZone(n_elements=100)

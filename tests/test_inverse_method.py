@@ -10,9 +10,13 @@ import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
-from fracid.inverse.methods.strategy import IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, identify
+from fracid.inverse.methods.kalman_settings import KalmanSettings
+from fracid.inverse.methods.knn_kalman import IdentificationResult, KnnKalman
+from fracid.inverse.methods.knn_settings import KnnSettings
+from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS
+from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.study import StudySettings
 from fracid.inverse.studies.twin import synthetic_data
 
@@ -126,14 +130,18 @@ def test_failed_runs_and_status_of_a_stage_named_by_the_method():
 
 def test_study_settings_group_the_options_and_replace_by_name():
     settings = StudySettings().replace(n=16, k=3, groups="all", max_iterations=8, starts=0, prior="bounds")
-    assert settings.knn == KnnSettings(n=16, k=3) and settings.kalman == KalmanSettings(groups="all", max_iterations=8)
+    method = settings.method
+    assert method.knn == KnnSettings(n=16, k=3) and method.kalman == KalmanSettings(groups="all", max_iterations=8)
     assert (settings.starts, settings.replicates, settings.prior) == (0, 5, "bounds")
-    assert settings.identification == KnnKalman(settings.knn, settings.kalman)
-    assert StudySettings().replace(knn=KnnSettings(n=8), k=2).knn == KnnSettings(n=8, k=2)
+    assert settings.identification == KnnKalman(method.knn, method.kalman)
+    assert StudySettings().replace(knn=KnnSettings(n=8), k=2).method.knn == KnnSettings(n=8, k=2)
+    assert StudySettings().prior == "search" and isinstance(StudySettings().method, METHODS[DEFAULT_METHOD])
     with pytest.raises(TypeError, match="unknown setting.s. population .*or a study setting: error_terms, method, noise_seed"):
         StudySettings().replace(population=16)
-    with pytest.raises(ValueError, match="choose 'knn' or 'bounds'"):
+    with pytest.raises(ValueError, match="choose 'search' or 'bounds'"):
         StudySettings(prior="flat")
+    with pytest.raises(ValueError, match="prior = 'knn' is now called 'search'"):
+        StudySettings(prior="knn")
 
 
 def _fit(y_fit, std=0.001, x=2.0):
@@ -177,3 +185,14 @@ def test_verdict_txt_carries_the_warnings_of_the_identification(tmp_path):
     lines = [f"Warning: {text}" for text in ident.warnings()]
     assert len(lines) == 2 and all(line in study.summary().splitlines() for line in lines)
     assert any("estimate at a bound" in line for line in lines) and any("misfit" in line for line in lines)
+
+
+def test_the_configurations_study_prior_reads_search_bounds_and_the_former_knn(tmp_path):
+    from fracid.config.checker import Checker
+    from fracid.config.sections import read_study
+
+    ck = Checker(tmp_path / "cfg.toml")
+    assert [read_study(ck, raw).prior for raw in (None, {"prior": "search"}, {"prior": "bounds"}, {"prior": "knn"})] == \
+        ["search", "search", "bounds", "search"]
+    with pytest.raises(Exception, match=r"study.prior = 'flat'.*'search', 'bounds'"):
+        read_study(ck, {"prior": "flat"})

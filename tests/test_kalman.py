@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from fracid.inverse.methods.kalman import batch_kalman, kalman_filter, kalman_update
+from fracid.inverse.methods.assimilation import kalman_update
+from fracid.inverse.methods.kalman import batch_kalman, kalman_filter
 
 
 def linear_problem(seed=0, n=12, p=3):

@@ -11,7 +11,8 @@ from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.methods.kalman import kalman_filter
 from fracid.inverse.methods.kalman_status import (CONVERGED_STEP, POOR_CHI2_PER_POINT, chi2_per_point, oscillates,
                                           pass_change, restarted, valley_text)
-from fracid.inverse.methods.knn import ParameterSpace, design, knn_from_population
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.knn import design, knn_from_population
 
 T = np.array([0.5, 1.0, 1.5])
 

@@ -57,7 +57,6 @@ PENDING = {
     "fracid.fem.mesh.dofs": 1,
     "fracid.inverse.core.derived_observations": 1,
     "fracid.inverse.core.observations": 2,
-    "fracid.inverse.studies.model_comparison": 1,
     "fracid.report.field_figures": 5,
     "fracid.specimens.strip": 2,
     "fracid.specimens.wedge": 2,

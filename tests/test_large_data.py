@@ -9,7 +9,7 @@ import pytest
 
 from fracid.data import Diagonal, ExperimentalData
 from fracid.inverse.core.forward_operator import RunRecord
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import identify
 
 N = 100_000

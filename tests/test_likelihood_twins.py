@@ -13,7 +13,7 @@ from fracid.fem.material.parameters import DamageParameters
 from fracid.fem.path.path_following import StepOptions
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.likelihood import DiscretisationError
+from fracid.inverse.likelihood.settings import DiscretisationError
 from fracid.inverse.likelihood.discretisation import ORDER_RANGE
 from fracid.inverse.methods.strategy import identify
 from fracid.models import CohesiveCrackModel, DamageModel

@@ -11,7 +11,8 @@ from hostile import TRUTH, bar_config, check, run_fracid, synthetic_curve, write
 
 from fracid.config import ConfigError, build_method, load_config
 from fracid.inverse.methods.registry import METHODS
-from fracid.inverse.methods.strategy import KnnGaussNewton, KnnKalman
+from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
+from fracid.inverse.methods.knn_kalman import KnnKalman
 
 OUT = ("--out", "out", "--workers", "1", "--quiet")
 

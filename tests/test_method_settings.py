@@ -21,7 +21,9 @@ from fracid.settings import checks as settings
 from fracid.settings.checks import SettingError, SettingsContext
 from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table
 from fracid.inverse.methods.registry import METHODS, config_tables, known_tables, method_from_tables, table_readers
-from fracid.inverse.methods.strategy import KalmanSettings, KnnGaussNewton, KnnKalman
+from fracid.inverse.methods.kalman_settings import KalmanSettings
+from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
+from fracid.inverse.methods.knn_kalman import KnnKalman
 
 CONTEXT = SettingsContext(n_y=12, parameters=("c", "beta"))
 

@@ -184,7 +184,7 @@ def test_integral_model_is_mesh_objective_where_the_local_model_is_not():
 
 def test_twin_experiment_recovers_c_and_beta_noise_free():
     from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.methods.strategy import identify
     from fracid.inverse.studies.twin import synthetic_data
 

@@ -262,6 +262,7 @@ def test_filters_run_side_by_side_on_the_pool_and_share_the_store(tmp_path):
     import fracid
     from fracid.inverse.core.forward_operator import ForwardOperator, Observation
     from fracid.inverse.core.runs import StoredOperator
+    from fracid.inverse.methods.kalman import kalman_filter
     from fracid.inverse.studies.uniqueness import multi_start
     from fracid.runtime.executors import concurrently, executor_width
 
@@ -271,10 +272,10 @@ def test_filters_run_side_by_side_on_the_pool_and_share_the_store(tmp_path):
     C = np.eye(y.size) * (0.02 * np.abs(y).max()) ** 2
     starts = np.array([[1.5, 200.0], [3.0, 400.0], [2.5, 300.0]])
     C0, bounds = np.diag([1.0, 100.0**2]), (np.array([0.5, 100.0]), np.array([4.0, 500.0]))
-    serial = multi_start(op, y, C, starts, C0, bounds=bounds)
+    serial = multi_start(op, y, C, starts, C0, bounds=bounds, fit=kalman_filter)
     with RunStore(tmp_path / "runs.sqlite") as store, make_executor(2) as pool:
         assert executor_width(pool) == 2 and concurrently(abs, [-1, -2, 3], pool) == [1, 2, 3]
         evaluate = StoredOperator(op, store).differentiated()
-        parallel = multi_start(evaluate, y, C, starts, C0, bounds=bounds, executor=pool)
+        parallel = multi_start(evaluate, y, C, starts, C0, bounds=bounds, executor=pool, fit=kalman_filter)
         assert evaluate.computed == len(store) > 0 and evaluate.failed == 0
     np.testing.assert_allclose(parallel.ends, serial.ends, rtol=1e-9)

@@ -6,9 +6,10 @@ import json
 import numpy as np
 import pytest
 
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.forward_operator import RunRecord
-from fracid.inverse.sampling.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior, weighted_quantile
+from fracid.inverse.sampling.mixture import weighted_quantile
+from fracid.inverse.sampling.posterior import MIN_ESS, PosteriorSettings, ess_floor, posterior
 
 BANANA_Y = np.array([0.0, 0.5, 0.3])
 BANANA_C = np.diag([0.5, 0.1, 0.6]) ** 2

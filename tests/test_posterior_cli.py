@@ -14,7 +14,8 @@ import pytest
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli
 from fracid.runtime import exits
-from fracid.inverse.sampling.posterior import PosteriorSettings, weighted_quantile
+from fracid.inverse.sampling.mixture import weighted_quantile
+from fracid.inverse.sampling.posterior import PosteriorSettings
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -121,7 +122,7 @@ def test_all_runs_failed_is_a_computation_failure():
     from types import SimpleNamespace
 
     from fracid.inverse.core.forward_operator import RunRecord
-    from fracid.inverse.methods.knn import ParameterSpace
+    from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.core.sensitivity import ForwardRunError
     from fracid.inverse.sampling.posterior import sample_posterior
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.method import MethodResult
-from fracid.inverse.methods.strategy import IdentificationResult
+from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.store.provenance import collect, json_safe
 from fracid.store.runs import RunStore
 

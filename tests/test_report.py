@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from fracid.inverse.methods.strategy import IdentificationResult
+from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.report import fit_metrics, write_report
 
 figures = pytest.importorskip("fracid.report.figures")  # needs matplotlib
@@ -262,7 +262,7 @@ def test_images_load_in_a_browser(report, tmp_path):
 
 
 def test_posterior_page_renders_in_a_browser(tmp_path):
-    from fracid.inverse.sampling.posterior import PosteriorResult
+    from fracid.inverse.sampling.posterior_result import PosteriorResult
     from fracid.report.posterior import write_posterior_page
 
     x = np.random.default_rng(1).normal([2.0, 250.0], [0.1, 10.0], size=(50, 2))

@@ -13,7 +13,7 @@ import pytest
 
 from fracid.data.covariance_matrix import Diagonal
 from fracid.data.dic.rigid import rigid_modes, with_rigid_motion
-from fracid.inverse.methods.strategy import IdentificationResult
+from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.report import write_report
 
 ff = pytest.importorskip("fracid.report.field_figures")  # needs matplotlib

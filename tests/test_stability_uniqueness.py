@@ -1,11 +1,15 @@
 """Uniqueness, stability and the verdict: analytic checks, then the bar (fast) for the nonlinear ones."""
 
+from functools import partial
+
 import numpy as np
 import pytest
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.methods.knn import ParameterSpace, knn_from_population
+from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.kalman import kalman_filter
+from fracid.inverse.methods.knn import knn_from_population
 from fracid.inverse.studies.stability import noisy_replicates, stability
 from fracid.inverse.studies.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_level
 from fracid.inverse.studies.verdict import DataDescription, parameter_verdicts
@@ -83,8 +87,8 @@ def test_scatter_under_noise_shrinks_with_two_sizes(executor):
         y = op(TRUTH).y
         C = np.eye(y.size) * (0.01 * y.max()) ** 2
         prior = np.diag((0.5 * TRUTH) ** 2)
-        st = stability(op, y, C, TRUTH * [1.2, 1.1], prior, replicates=6, seed=5, groups=[np.arange(y.size)],
-                       max_iterations=6, executor=executor, bounds=fracid.DamageParameters.valid_bounds(("c", "beta")))
+        st = stability(op, y, C, TRUTH * [1.2, 1.1], prior, replicates=6, seed=5, executor=executor,
+                       fit=partial(kalman_filter, groups=[np.arange(y.size)], max_iterations=6), bounds=fracid.DamageParameters.valid_bounds(("c", "beta")))
         assert st.ok.all() and st.noise_level == pytest.approx(np.sqrt(np.mean((0.01 * y.max() / y) ** 2)), rel=1e-6)
         # the scatter is what the posterior covariance predicts (within sampling error of 6 replicates)
         assert np.all(st.scatter < 2.5 * st.posterior_std) and np.all(st.scatter > 0.25 * st.posterior_std)
@@ -97,8 +101,8 @@ def test_multi_start_ends_agree_when_the_data_identify(executor):
     y = op(TRUTH).y
     C = np.eye(y.size) * (0.005 * y.max()) ** 2
     starts = np.array([[1.0, 150.0], [4.0, 450.0]])
-    ms = multi_start(op, y, C, starts, bounds_covariance(SPACE), groups=[np.arange(y.size)], max_iterations=10,
-                     executor=executor, bounds=fracid.DamageParameters.valid_bounds(("c", "beta")))
+    ms = multi_start(op, y, C, starts, bounds_covariance(SPACE), executor=executor,
+                     fit=partial(kalman_filter, groups=[np.arange(y.size)], max_iterations=10), bounds=fracid.DamageParameters.valid_bounds(("c", "beta")))
     assert ms.unique(1.0).all() and not ms.failed
     # noise-free data: each end is the truth within its posterior uncertainty (the prior pulls it a little)
     assert np.all(np.abs(ms.ends - TRUTH) <= 2 * ms.stds)
@@ -124,7 +128,7 @@ def test_study_valley_is_centred_on_the_estimate():
     """A twin (bar, noisy data): the objective maps and the valley are measured from the identification's
     estimate and its objective, not from the best population point (which fits worse)."""
     from fracid.data import ExperimentalData
-    from fracid.inverse.methods.knn import objective
+    from fracid.inverse.core.misfit import objective
     from fracid.inverse.studies.study import StudySettings, run_study
 
     operator = _bar_operator([100.0])

@@ -11,7 +11,7 @@ import pytest
 from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli
 from fracid.runtime import exits
-from fracid.inverse.sampling.posterior import PosteriorResult
+from fracid.inverse.sampling.posterior_result import PosteriorResult
 from fracid.inverse.studies.verdict import GAUSSIAN_MEASURE, POSTERIOR_MEASURE, Z_90, DataDescription, parameter_verdicts
 
 STUDY = "\n[study]\nstarts = 2\nreplicates = 2\nposterior = true\n"

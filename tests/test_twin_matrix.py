@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import fracid
-from fracid.inverse.methods.knn import ParameterSpace
+from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.studies.twin import dogbone_cases, twin_matrix
 
 pytestmark = pytest.mark.slow  # the fast loop (-m "not slow") leaves this module out

@@ -195,7 +195,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     replicates = 5                      # identifications on data with noise added (0: none; else >= 2)
     seed = 0                            # seed of the replicates' noise, default 0
     tolerance = 0.1                     # largest relative std called "identified", default 0.1
-    prior = "knn"                       # Kalman prior covariance: "knn" (neighbours' spread, default)
+    prior = "search"                    # refinement's prior covariance: "search" (the search's, default)
                                         #   | "bounds" (uniform over the bounds: the data's information only)
     posterior = false                   # true: `fracid study` also samples the posterior with the
                                         #   [posterior] settings; the verdict then uses its 90 % credible
@@ -383,7 +383,7 @@ class StudyConfig:
     replicates: int = 5
     seed: int = 0
     tolerance: float = 0.1
-    prior: str = "knn"
+    prior: str = "search"
     posterior: bool = False
 
 

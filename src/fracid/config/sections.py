@@ -281,7 +281,9 @@ def read_study(ck: Checker, raw) -> StudyConfig:
         tolerance=ck.number("study.tolerance", raw.get("tolerance", 0.1),
                             "must be a number with 0 < t < 1 (largest relative std called identified)",
                             lambda v: 0 < v < 1),
-        prior=ck.choice("study.prior", raw.get("prior", "knn"), ("knn", "bounds")),
+        # "knn" is the former name of "search", still read
+        prior="search" if raw.get("prior") == "knn" else ck.choice("study.prior", raw.get("prior", "search"),
+                                                                   ("search", "bounds")),
         posterior=_flag(ck, "study.posterior", raw.get("posterior", False),
                         "must be true (fracid study also samples the posterior with the [posterior] settings, and "
                         "the verdict reads its credible intervals) or false (the default: the Gaussian std only)"),

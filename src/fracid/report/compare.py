@@ -30,8 +30,8 @@ DEFINITIONS = (
     "(adaptive importance sampling on the exact model), +- its Monte-Carlo standard error. Laplace: the Gaussian "
     "approximation at the estimate, log L + log prior + p/2 log(2 pi) + 1/2 log det Sigma with Sigma = (S^T C^-1 "
     "S)^-1. delta log Z: the log Bayes factor against the first. AIC = 2 p - 2 log L, BIC = p ln n - 2 log L at "
-    "the estimate (lower is better). MAP objective: chi2 plus the KNN prior's term, the objective the inverse method "
-    "minimised. RMS in % of the measured peak. A tie: log Z within "
+    "the estimate (lower is better). MAP objective: chi2 plus the term of the prior the search gave, the objective "
+    "the inverse method minimised. RMS in % of the measured peak. A tie: log Z within "
     f"{TIE_SIGMAS:g} combined Monte-Carlo errors of the first's.")
 
 

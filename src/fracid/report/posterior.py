@@ -75,7 +75,7 @@ def _usable(result):
 def _limits(values, weights, centre, std, lower, upper, log: bool) -> tuple[float, float]:
     """Axis range of one parameter: the weighted draws' 0.1 % to 99.9 % quantiles and the Gaussian's
     +- 3 std, within the bounds, with a margin."""
-    from fracid.inverse.sampling.posterior import weighted_quantile
+    from fracid.inverse.sampling.mixture import weighted_quantile
 
     lo, hi = weighted_quantile(values, weights, [0.001, 0.999])
     if math.isfinite(centre) and math.isfinite(std):

@@ -1,8 +1,10 @@
-"""Figures of the stages of an inverse method: the estimate along a refinement's history and the
-population of a search (objective against each parameter, map over the most correlated pair).
+"""Figures of the stages of an inverse method, one set per kind of record a stage leaves
+(:mod:`fracid.inverse.core.stage_records`): the estimate along a path of estimates, and a population
+(objective against each parameter, map over the most correlated pair).
 
 Each function returns a :class:`matplotlib.figure.Figure`, or ``None`` when the result holds nothing to
-draw; :func:`fracid.report.figures.to_png` renders it.
+draw; :func:`fracid.report.figures.to_png` renders it. A stage is named by the result (``result.stages``); the
+figures know no method and no stage by name.
 """
 
 from __future__ import annotations
@@ -13,28 +15,43 @@ import numpy as np
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
+from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.report.figures import (ESTIMATE, FAILED, MEASURED, NEIGHBOUR, covariance_ellipse, float_array, new_figure,
                                    parameter_axis,
                                    parameter_label)
 
 
-def population_arrays(result):
+def stage_of_kind(result, kind: str, stage: str | None = None) -> str | None:
+    """``stage``, or the first stage of the result that left a record of the kind ``kind`` (None without one)."""
+    if stage is not None:
+        return stage
+    return next(iter(result.stages_of_kind(kind)), None)
+
+
+def stage_label(result, stage: str | None) -> str:
+    """The label the result gives the stage ``stage`` (its name without one)."""
+    return dict(getattr(result, "stages", None) or {}).get(stage, stage or "")
+
+
+def population_arrays(result, stage: str | None = None):
     """Population ``points`` (N, p), objective ``f`` (inf where failed), boolean ``failed``,
-    ranking ``order`` and ``k`` of the result's KNN search; ``None`` without a population."""
-    knn = getattr(result, "knn", None) or {}
-    points = knn.get("points")
+    ranking ``order`` and ``k`` of the population record of ``stage`` (None: the first stage that left
+    one); ``None`` without a population."""
+    stage = stage_of_kind(result, POPULATION, stage)
+    record = (result.record(stage) if stage is not None else None) or {}
+    points = record.get("points")
     if points is None or np.size(points) == 0:
         return None
     p = len(result.names)
     points = float_array(points, np.nan).reshape(-1, p)
-    f = float_array(knn.get("f"), np.inf)
+    f = float_array(record.get("f"), np.inf)
     if f.size != len(points):
         f = np.full(len(points), np.inf)
-    status = list(knn.get("status") or ["ok"] * len(points))
+    status = list(record.get("status") or ["ok"] * len(points))
     failed = np.array([s != "ok" for s in status]) | ~np.isfinite(f)
-    order = knn.get("order")
+    order = record.get("order")
     order = np.argsort(np.where(failed, np.inf, f), kind="stable") if order is None else np.asarray(order, int)
-    k = int(knn.get("k") or 0)
+    k = int(record.get("k") or 0)
     return points, f, failed, order, k
 
 
@@ -66,14 +83,16 @@ def strongest_pair(result) -> tuple[int, int] | None:
 # ------------------------------------------------------------------------------------ figures
 
 
-def history_figure(result, label: str = "Kalman filter") -> Figure | None:
-    """Estimate of every parameter after every step of the stage ``label`` (the Kalman filter's steps, the
-    Gauss-Newton linearisations: ``result.history``) with its +/- 2 std band.
+def history_figure(result, stage: str | None = None) -> Figure | None:
+    """Estimate of every parameter after every step of the path of estimates of ``stage`` (None: the first
+    stage that left one) with its +/- 2 std band.
 
-    x axis: cumulative step index over the global iterations (0 = the prior from KNN when known);
+    x axis: cumulative step index over the global iterations (0 = the prior of the search when known);
     dotted vertical lines separate the global iterations; the horizontal line is the final value.
     """
-    history = list(getattr(result, "history", None) or [])
+    stage = stage_of_kind(result, PATH, stage)
+    history = list((result.record(stage) if stage is not None else None) or [])
+    label = stage_label(result, stage)
     if not history:
         return None
     names = list(result.names)
@@ -81,10 +100,10 @@ def history_figure(result, label: str = "Kalman filter") -> Figure | None:
     xs = np.array([float_array(h["x"], np.nan).reshape(p) for h in history])
     stds = np.array([np.sqrt(np.maximum(np.diag(float_array(h["C"], np.nan).reshape(p, p)), 0.0)) for h in history])
     index = np.arange(1, len(history) + 1)
-    knn = getattr(result, "knn", None) or {}
-    if knn.get("x0") is not None and knn.get("C0") is not None:
-        x0 = float_array(knn["x0"], np.nan).reshape(p)
-        s0 = np.sqrt(np.maximum(np.diag(float_array(knn["C0"], np.nan).reshape(p, p)), 0.0))
+    prior = result.search_prior()
+    if prior is not None:
+        x0 = float_array(prior[1], np.nan).reshape(p)
+        s0 = np.sqrt(np.maximum(np.diag(float_array(prior[2], np.nan).reshape(p, p)), 0.0))
         xs, stds, index = np.vstack([x0, xs]), np.vstack([s0, stds]), np.concatenate([[0], index])
     iterations = [h.get("iteration", 1) for h in history]
     boundaries = [i + 0.5 for i in range(1, len(history)) if iterations[i] != iterations[i - 1]]
@@ -104,18 +123,20 @@ def history_figure(result, label: str = "Kalman filter") -> Figure | None:
         ax.legend(fontsize="x-small", loc="best")
     n_iter = len(dict.fromkeys(iterations))
     axes[0].set_title(f"{label}: {len(history)} steps in {n_iter} global iteration(s)"
-                      + (" (step 0: KNN prior)" if index[0] == 0 else ""))
+                      + (f" (step 0: {stage_label(result, prior[0])} prior)" if index[0] == 0 else ""))
     axes[-1].set_xlabel("cumulative step [-] (dotted: new global iteration)")
     return fig
 
 
-def population_objective_figure(result) -> Figure | None:
-    """Objective f (log scale) of every population point against each parameter.
+def population_objective_figure(result, stage: str | None = None) -> Figure | None:
+    """Objective f (log scale) of every point of the population of ``stage`` (None: the first stage that left
+    one) against each parameter.
 
     Failed runs are drawn as grey crosses above the largest objective; the k nearest neighbours are
     highlighted and the final estimate is a vertical line.
     """
-    arrays = population_arrays(result)
+    stage = stage_of_kind(result, POPULATION, stage)
+    arrays = population_arrays(result, stage)
     if arrays is None:
         return None
     points, f, failed, order, k = arrays
@@ -147,16 +168,18 @@ def population_objective_figure(result) -> Figure | None:
     axes[0].legend(fontsize="x-small", loc="best")
     for ax in axes[p:]:
         ax.set_visible(False)
-    fig.suptitle(f"KNN population: {len(points)} runs, objective f = (y_exp - y)^T C_exp^-1 (y_exp - y)",
+    fig.suptitle(f"{stage_label(result, stage)} population: {len(points)} runs, objective f = (y_exp - y)^T C_exp^-1 (y_exp - y)",
                  fontsize="medium")
     return fig
 
 
-def population_map_figure(result) -> Figure | None:
-    """Population over the two most correlated parameters, coloured by log10 f, with the k nearest
-    and the estimate with its 2-std ellipse (and the KNN prior's, dashed). None for one parameter."""
+def population_map_figure(result, stage: str | None = None) -> Figure | None:
+    """The population of ``stage`` (None: the first stage that left one) over the two most correlated
+    parameters, coloured by log10 f, with the k nearest and the estimate with its 2-std ellipse (and the
+    search's prior's, dashed). None for one parameter."""
+    stage = stage_of_kind(result, POPULATION, stage)
     pair = strongest_pair(result)
-    arrays = population_arrays(result)
+    arrays = population_arrays(result, stage)
     if pair is None or arrays is None:
         return None
     i, j = pair
@@ -179,12 +202,12 @@ def population_map_figure(result) -> Figure | None:
     x = float_array(result.x, np.nan)
     C = float_array(result.C, np.nan).reshape(len(names), len(names))
     sub = np.ix_([i, j], [i, j])
-    knn = getattr(result, "knn", None) or {}
-    if knn.get("x0") is not None and knn.get("C0") is not None:
-        x0 = float_array(knn["x0"], np.nan)
-        C0 = float_array(knn["C0"], np.nan).reshape(len(names), len(names))
+    prior = result.search_prior()
+    if prior is not None:
+        x0 = float_array(prior[1], np.nan)
+        C0 = float_array(prior[2], np.nan).reshape(len(names), len(names))
         e0 = covariance_ellipse(x0[[i, j]], C0[sub])
-        ax.plot(e0[:, 0], e0[:, 1], "--", color=NEIGHBOUR, lw=1.0, label="KNN prior, 2 std")
+        ax.plot(e0[:, 0], e0[:, 1], "--", color=NEIGHBOUR, lw=1.0, label=f"{stage_label(result, prior[0])} prior, 2 std")
     ellipse = covariance_ellipse(x[[i, j]], C[sub])
     ax.plot(ellipse[:, 0], ellipse[:, 1], "-", color=ESTIMATE, lw=1.4, label="estimate, 2 std")
     ax.plot([x[i]], [x[j]], "*", color=ESTIMATE, ms=14, mec="k", mew=0.6, label="estimate")
@@ -199,30 +222,30 @@ def population_map_figure(result) -> Figure | None:
     return fig
 
 
+def _population_figures(result, stage: str) -> dict:
+    return {f"{stage}_objective": population_objective_figure(result, stage),
+            f"{stage}_map": population_map_figure(result, stage)}
 
 
-def _population_figures(result, stage: str, label: str) -> dict:
-    return {f"{stage}_objective": population_objective_figure(result), f"{stage}_map": population_map_figure(result)}
+def _path_figures(result, stage: str) -> dict:
+    return {stage: history_figure(result, stage)}
 
 
-def _history_figures(result, stage: str, label: str) -> dict:
-    return {stage: history_figure(result, label)}
-
-
-#: figures of the stages known by name: ``figures(result, stage, label) -> {file stem: Figure or None}``
-STAGE_FIGURES = {"knn": _population_figures, "kalman": _history_figures, "gauss_newton": _history_figures}
+#: the figures of a stage by the kind of record it left: ``figures(result, stage) -> {file stem: Figure or None}``
+RECORD_FIGURES = {POPULATION: _population_figures, PATH: _path_figures}
 
 
 def stage_figures(result) -> dict:
-    """The figures of every stage the result declares (``result.stages``) that :data:`STAGE_FIGURES`
-    knows, by file stem (``"kalman"``, ``"knn_objective"``, ``"knn_map"``, ...); None where there is
-    nothing to draw."""
+    """The figures of every stage the result declares (``result.stages``) whose kind of record has figures
+    (:data:`RECORD_FIGURES`), by file stem (``"<stage>"`` for a path, ``"<stage>_objective"`` and
+    ``"<stage>_map"`` for a population); None where there is nothing to draw."""
     out = {}
-    for stage, label in dict(getattr(result, "stages", None) or {}).items():
-        if stage in STAGE_FIGURES:
-            out.update(STAGE_FIGURES[stage](result, stage, label))
+    for stage in dict(getattr(result, "stages", None) or {}):
+        figures = RECORD_FIGURES.get(result.record_kind(stage))
+        if figures is not None:
+            out.update(figures(result, stage))
     return out
 
 
-__all__ = ["STAGE_FIGURES", "history_figure", "population_arrays", "population_map_figure",
-           "population_objective_figure", "stage_figures", "strongest_pair"]
+__all__ = ["RECORD_FIGURES", "history_figure", "population_arrays", "population_map_figure",
+           "population_objective_figure", "stage_figures", "stage_label", "stage_of_kind", "strongest_pair"]

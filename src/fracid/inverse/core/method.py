@@ -1,12 +1,12 @@
 """The inverse method as an argument: the interface a method meets and the result every method returns.
 
-:func:`fracid.inverse.methods.strategy.identify` takes any object that meets :class:`InverseMethod`; the
-default, :class:`fracid.inverse.methods.strategy.KnnKalman`, is the KNN population search followed by the
-Kalman filter. A method returns a :class:`MethodResult`: the estimate, its covariance and the fit,
-which every method has, and the stages it ran (``stages``), their forward runs (``runs``) and what
-they recorded (``records``), by stage name. Reports and warnings read those by the names the result
-declares, so another method (Gauss-Newton, sampling, ...) plugs in without changes to them.
-"""
+:func:`fracid.inverse.methods.strategy.identify` takes any object that meets :class:`InverseMethod`; without
+one, the registry's default (:data:`fracid.inverse.methods.registry.DEFAULT_METHOD`). A method returns a
+:class:`MethodResult`: the estimate, its covariance and the fit, which every method has, and the stages it
+ran (``stages``), the kind of record each left (``stage_records``: a population, a path of estimates or
+generic, :mod:`fracid.inverse.core.stage_records`), their forward runs (``runs``) and what they recorded
+(``records``), by stage name. Reports, studies and warnings read those by the names and kinds the result
+declares, so another method plugs in without changes to them."""
 
 from __future__ import annotations
 
@@ -19,9 +19,10 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from fracid.data.covariance_matrix import as_covariance
+from fracid.inverse.core.estimate import GaussianEstimate
 from fracid.inverse.core.diagnostics import diagnostic_warnings, diagnostics_lines, fit_diagnostics
-from fracid.inverse.methods.kalman import GaussianEstimate
 from fracid.inverse.core.problem_check import check_problem
+from fracid.inverse.core.stage_records import StageRecords
 
 #: RMS fit error [% of the measured peak] above which a fit is reported as poor
 POOR_FIT_PERCENT = 10.0
@@ -65,6 +66,9 @@ class InverseMethod(Protocol):
         Data blocks ``(name, start, stop)`` and notes of the data, to be kept in the result
         (:func:`result_fields` fills them).
 
+    A method may declare ``stages`` (stage name -> label) and ``stage_records`` (stage name -> kind of
+    record) as class attributes: the command's plan, the report and the studies read them.
+
     A failed forward run should be recorded (``runs[stage + "_failed"]``), not raised, whenever the
     method can still give an estimate.
     """
@@ -76,7 +80,7 @@ class InverseMethod(Protocol):
 
 
 @dataclass
-class MethodResult(GaussianEstimate):
+class MethodResult(GaussianEstimate, StageRecords):
     """Identified parameters with their uncertainty, the fit and how they were obtained: what every
     :class:`InverseMethod` returns.
 
@@ -111,8 +115,12 @@ class MethodResult(GaussianEstimate):
     stages : dict of str -> str
         The stages the method ran, in order: name (the key of their runs and records) -> label used
         in text (e.g. ``{"knn": "KNN", "kalman": "Kalman filter"}``). The last gave the estimate.
+    stage_records : dict of str -> str
+        The kind of record each stage left (:mod:`fracid.inverse.core.stage_records`: ``"population"``,
+        ``"path"``, ``"generic"``; a stage not named here is generic): the report shows it by its kind.
     records : dict of str -> object
-        What a stage recorded, by stage name (JSON-serialisable values; the report lists them).
+        What a stage recorded, by stage name (JSON-serialisable values, of the stage's kind;
+        :meth:`~fracid.inverse.core.stage_records.StageRecords.record` reads them).
     control : ndarray or None
         Control value of every entry of y [mm] (the observations' ``control_points``; None if unknown).
     control_names : list of str
@@ -145,6 +153,7 @@ class MethodResult(GaussianEstimate):
     bounds: tuple = ()
     method: str = ""
     stages: dict = field(default_factory=dict)
+    stage_records: dict = field(default_factory=dict)
     records: dict = field(default_factory=dict)
     control: object = None
     control_names: list = field(default_factory=list)

@@ -59,12 +59,4 @@ def runs_per_linearisation(operator, p: int) -> tuple[int, str]:
     return 2 * p + 1, "the run and 2 per parameter: central differences"
 
 
-def population_plan(knn, p: int, stage: str = "knn", label: str = "KNN") -> StagePlan:
-    """The population of a KNN search with the settings ``knn`` (a :class:`~fracid.inverse.methods.knn_settings.
-    KnnSettings`: n, method, k) for ``p`` parameters."""
-    runs = knn.population(p)
-    return StagePlan(stage, label, runs, True, float(runs), f"{runs} forward runs side by side ({knn.method}, k = {knn.k})",
-                     f"[identify.knn] n = {knn.n}")
-
-
-__all__ = ["StagePlan", "plural", "population_plan", "runs_per_linearisation"]
+__all__ = ["StagePlan", "plural", "runs_per_linearisation"]

@@ -14,9 +14,7 @@ The covariance objects are :mod:`fracid.data.covariance_update`'s.
 >>> result = identify_data(operator, data, space, discretisation_error="richardson",
 ...                        model_error="variance")                      # doctest: +SKIP
 >>> result.error_terms["blocks"]                                       # doctest: +SKIP
+
+May import :mod:`fracid.inverse.core` (and the data's covariance objects); never the methods, the sampling or the
+studies (the method it re-identifies with is given to it).
 """
-
-from fracid.inverse.likelihood.settings import DiscretisationError, ModelError
-from fracid.inverse.likelihood.terms import ErrorTerms
-
-__all__ = ["DiscretisationError", "ErrorTerms", "ModelError"]

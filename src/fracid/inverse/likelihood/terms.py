@@ -24,6 +24,7 @@ import numpy as np
 
 from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.core.method import observed_fields
+from fracid.inverse.core.method_settings import with_settings
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity
 from fracid.inverse.likelihood.discretisation import discretisation_error
@@ -193,8 +194,6 @@ def _sigma(problem, x, base, groups, settings, options) -> np.ndarray:
 
 def _by_blocks(method):
     """``method`` with a Kalman filter that assimilates one data block per step (when it has such a setting)."""
-    from fracid.inverse.methods.registry import with_settings
-
     try:
         return with_settings(method, groups="blocks")
     except TypeError:  # no observation groups: it sees the whole covariance at once

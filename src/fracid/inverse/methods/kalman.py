@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fracid.inverse.methods.assimilation import assimilate, information_update, kalman_update  # noqa: F401
-from fracid.inverse.methods.kalman_status import GaussianEstimate, KalmanResult, judge_last_pass, relaxed  # noqa: F401
+from fracid.inverse.methods.assimilation import assimilate
+from fracid.inverse.methods.kalman_status import KalmanResult, judge_last_pass, relaxed
 from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
 
@@ -119,7 +119,7 @@ def kalman_filter(evaluate, y_exp, C_exp, x0, C0, *, groups=None, max_iterations
                   max_backtracks: int = 4, names=None, damping: bool = True) -> KalmanResult:
     """Step-by-step Kalman filter with global iterations (docs/theory.md, section 4.3), bounded and failure tolerant.
 
-    For t = 1..n the observations of group t are assimilated with :func:`kalman_update`, using
+    For t = 1..n the observations of group t are assimilated with :func:`~fracid.inverse.methods.assimilation.kalman_update`, using
     S_t = d h_t / d x and h_t at a linearisation point (forward runs only up to the last
     observation of the group). h is nonlinear, so the sequence is repeated (global iterations) until
     no parameter moves by more than ``tol`` standard deviations. Two ways to repeat it:

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fracid.inverse.core.estimate import GaussianEstimate
+
 #: Converged: the last pass moved every parameter by less than this many standard deviations (of C) ...
 CONVERGED_STEP = 0.1
 #: ... and changed the objective by less than this fraction of it ...
@@ -38,19 +40,6 @@ POOR_CHI2_PER_POINT = 10.0
 #: Starts of the filter at most (the KNN prior, then the next-best population points) when it ends
 #: at a poor point.
 DEFAULT_MAX_STARTS = 3
-
-
-class GaussianEstimate:
-    """Mixin of the results that hold an estimate's covariance ``C``: its standard deviations and
-    correlation matrix."""
-
-    @property
-    def std(self) -> np.ndarray:
-        return np.sqrt(np.diag(self.C))
-
-    @property
-    def correlation(self) -> np.ndarray:
-        return self.C / np.outer(self.std, self.std)
 
 
 @dataclass
@@ -252,7 +241,7 @@ def judge_last_pass(result, objective_at, objective, last, max_iterations, names
 
 def chi2_per_point(result, y_exp, C_exp) -> float:
     """(y_exp - y)^T C_exp^-1 (y_exp - y) / n_y at the result's estimate (inf when its run failed)."""
-    from fracid.inverse.methods.knn import objective
+    from fracid.inverse.core.misfit import objective
 
     if result.failed:
         return float("inf")

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
-from fracid.data.covariance_matrix import as_covariance
-from fracid.inverse.core.space import ParameterSpace  # also importable from here, as before
+from fracid.inverse.core.misfit import objective
+from fracid.inverse.core.space import ParameterSpace
 
 
 def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) -> np.ndarray:
@@ -41,19 +41,6 @@ def design(space: ParameterSpace, n: int, method: str = "sobol", seed: int = 0) 
     else:
         raise ValueError(f"design method {method!r}; choose 'sobol', 'lhs' or 'grid'")
     return space.from_unit(unit)
-
-
-def objective(y_exp, C_exp, Y) -> np.ndarray:
-    """f_i = (y_exp - y_i)^T C_exp^-1 (y_exp - y_i) for every row of Y; inf for failed (NaN) rows.
-
-    ``C_exp`` is an (n, n) array or a :class:`~fracid.data.covariance_matrix.Covariance` (used through
-    its whitening: no n x n matrix for a diagonal one) [units of y squared]; f is dimensionless.
-    """
-    C_exp = as_covariance(C_exp, name="C_exp")
-    Y = np.atleast_2d(np.asarray(Y, float))
-    computed = np.all(np.isfinite(Y), axis=1)
-    residual = np.where(computed[:, None], np.asarray(y_exp, float) - Y, 0.0)
-    return np.where(computed, C_exp.quadratic(residual.T), np.inf)
 
 
 @dataclass
@@ -216,3 +203,6 @@ def _reason(error: str) -> str:
     """A failure message without the numbers that differ from run to run (so that equal causes count together)."""
     text = re.sub(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?", "#", str(error) or "unknown")
     return text[:300]
+
+
+__all__ = ["AllRunsFailed", "KnnResult", "design", "evaluate_population", "knn_from_population", "knn_search"]

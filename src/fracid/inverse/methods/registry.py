@@ -18,7 +18,6 @@ warns of one the chosen method does not read (:func:`table_readers`).
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Protocol, runtime_checkable
 
 from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
@@ -55,39 +54,6 @@ METHODS = {KnnKalman.name: KnnKalman, KnnGaussNewton.name: KnnGaussNewton}
 
 #: the default inverse method's name
 DEFAULT_METHOD = KnnKalman.name
-
-
-def with_settings(method, **changes):
-    """A copy of the inverse method ``method`` (a frozen dataclass) with ``changes`` to its fields or to the
-    fields of its settings dataclasses, by their own names: ``with_settings(KnnKalman(), n=16, groups="all")``
-    sets ``knn.n`` and ``kalman.groups``. A settings field named ``method`` (the population's design) is
-    given through its dataclass (``knn=KnnSettings(method="lhs")``).
-
-    Raises
-    ------
-    TypeError
-        For a name that is none of these (the message lists the known ones).
-    """
-    if not changes:
-        return method
-    if not dataclasses.is_dataclass(method) or isinstance(method, type):
-        raise TypeError(f"unknown setting(s) {', '.join(sorted(changes))}: the method "
-                        f"{getattr(method, 'name', method)!r} has no settings by name; give them to the method")
-    fields = {f.name: getattr(method, f.name) for f in dataclasses.fields(method)}
-    top = {name: changes.pop(name) for name in list(changes) if name in fields}
-    nested = {}
-    for part, value in {**fields, **top}.items():
-        if dataclasses.is_dataclass(value) and not isinstance(value, type):
-            names = {f.name for f in dataclasses.fields(value)} - {"method"}
-            own = {name: changes.pop(name) for name in list(changes) if name in names}
-            if own:
-                nested[part] = dataclasses.replace(value, **own)
-    if changes:
-        known = set(fields) | {f.name for v in fields.values() if dataclasses.is_dataclass(v)
-                               for f in dataclasses.fields(v)} - {"method"}
-        raise TypeError(f"unknown setting(s) {', '.join(sorted(changes))} of the method {method.name!r}; known: "
-                        f"{', '.join(sorted(known))}")
-    return dataclasses.replace(method, **{**top, **nested})
 
 
 def config_tables(cls) -> tuple:
@@ -142,5 +108,5 @@ def method_stages(name: str) -> dict:
     return dict(getattr(cls, "stages", None) or {})
 
 
-__all__ = ["DEFAULT_METHOD", "METHODS", "KnnGaussNewton", "KnnKalman", "StudyMethod", "config_tables", "known_tables",
-           "method_from_tables", "method_stages", "table_readers", "with_settings"]
+__all__ = ["DEFAULT_METHOD", "METHODS", "StudyMethod", "config_tables", "known_tables",
+           "method_from_tables", "method_stages", "table_readers"]

@@ -2,19 +2,16 @@
 
 The methods live in their own modules and are registered in :data:`fracid.inverse.methods.registry.METHODS`:
 :class:`~fracid.inverse.methods.knn_kalman.KnnKalman` (the default: KNN population search, then the Kalman
-filter, docs/theory.md, sections 4.2 to 4.4) and :class:`~fracid.inverse.methods.knn_gauss_newton.KnnGaussNewton`;
-they are importable from here too.
+filter, docs/theory.md, sections 4.2 to 4.4) and :class:`~fracid.inverse.methods.knn_gauss_newton.KnnGaussNewton`.
 """
 
 from __future__ import annotations
 
 import time
 
-from fracid.inverse.methods.knn_gauss_newton import GaussNewtonResult, KnnGaussNewton
-from fracid.inverse.methods.knn_kalman import (IdentificationResult, KalmanSettings, KnnKalman, KnnSettings, kalman_progress,
-                                       knn_output, knn_record, named_groups, refine)
 from fracid.inverse.core.method import InverseMethod, MethodResult, check_problem
-from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS, with_settings
+from fracid.inverse.core.method_settings import with_settings
+from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.likelihood.terms import ErrorTerms, Problem, identify_with_terms
 
@@ -50,20 +47,20 @@ def identify(operator, y_exp, C_exp, space: ParameterSpace, *, method: InverseMe
         with the parameters, to a fixed point. With either term the result's ``error_terms`` reports them
         (:mod:`fracid.inverse.likelihood.terms`); the re-identifications reuse the stored runs.
     **settings
-        Settings of the method by their own names (:func:`~fracid.inverse.methods.registry.with_settings`), e.g.
+        Settings of the method by their own names (:func:`~fracid.inverse.core.method_settings.with_settings`), e.g.
         ``n=16, k=3`` of its KNN population, ``groups="all", max_iterations=8`` of its Kalman filter.
 
     Returns
     -------
     MethodResult
-        The method's result (:class:`IdentificationResult` for the default); ``runs["wall_seconds"]`` is the
+        The method's result (:class:`~fracid.inverse.methods.knn_kalman.IdentificationResult` for the default); ``runs["wall_seconds"]`` is the
         wall time of the call [s].
 
     Raises
     ------
     AllRunsFailed
-        KNN-started methods: when fewer than k population runs succeeded. A failed run of the Kalman stage
-        never raises: see :func:`refine`.
+        KNN-started methods: when fewer than k population runs succeeded. A failed run of their local stage
+        never raises (:meth:`~fracid.inverse.methods.knn_started.KnnStarted.refine`).
     TypeError, ValueError
         Before any forward run, for arguments that do not fit together
         (:func:`~fracid.inverse.core.method.check_problem`: the shapes of ``y_exp`` and ``C_exp`` against the
@@ -117,5 +114,4 @@ def identify_data(operator, data, space: ParameterSpace, **settings) -> MethodRe
     return identify(operator, data.y, data.covariance, space, blocks=list(data.blocks), notes=list(data.notes), **settings)
 
 
-__all__ = ["GaussNewtonResult", "IdentificationResult", "KalmanSettings", "KnnGaussNewton", "KnnKalman", "KnnSettings",
-           "identify", "identify_data", "kalman_progress", "knn_output", "knn_record", "named_groups", "refine"]
+__all__ = ["identify", "identify_data"]

@@ -21,13 +21,15 @@ __all__ = ["ComparisonResult", "ModelScore", "map_objective"]
 
 def map_objective(result, chi2: float) -> float:
     """The inverse method's Bayesian objective at its estimate: chi^2 + (x - x0)^T C0^-1 (x - x0), with x0, C0
-    the prior of its KNN stage (``result.knn``); chi^2 alone for a result without one [-]."""
-    knn = getattr(result, "knn", None) or {}
-    if knn.get("x0") is None or knn.get("C0") is None:
+    the prior its search gave (:meth:`~fracid.inverse.core.stage_records.StageRecords.search_prior`); chi^2 alone
+    for a result without one [-]."""
+    prior = result.search_prior()
+    if prior is None:
         return float(chi2)
-    d = np.asarray(result.x, float) - np.asarray(knn["x0"], float)
+    _, x0, C0 = prior
+    d = np.asarray(result.x, float) - x0
     try:
-        return float(chi2 + d @ np.linalg.solve(np.asarray(knn["C0"], float), d))
+        return float(chi2 + d @ np.linalg.solve(C0, d))
     except np.linalg.LinAlgError:
         return float("nan")
 

@@ -8,8 +8,8 @@ cohesive crack, see :mod:`fracid.models`):
 * :func:`compare_models`: fitted to the same (measured) data, what parameters, fit error, peak
   force and dissipated energy does each model give?
 
-Both identify with :func:`fracid.inverse.methods.strategy.identify_data` (KNN population, then the Kalman
-filter) and then run each model once more at its estimate, to the last control value of the data,
+Both identify with :func:`fracid.inverse.methods.strategy.identify_data` (the inverse method's stages) and
+then run each model once more at its estimate, to the last control value of the data,
 to read the energy it dissipated (``observables["dissipated_energy"]``: external work minus elastic
 energy, [N mm]) and its peak force.
 
@@ -124,7 +124,7 @@ def compare_models(data: ExperimentalData, specimen, candidates, *, control="cmo
         One :class:`ModelFit` per candidate that could be fitted, in order; :meth:`ModelComparison.rows`
         gives the table: fitted parameters +- std, relative RMS fit error, peak force, dissipated
         energy to the last data control value [N mm], number of forward runs. A candidate whose fit
-        stops on a failed forward run (e.g. at the Kalman filter's estimate) is recorded in
+        stops on a failed forward run (e.g. at the local fit's estimate) is recorded in
         ``failures`` with the reason, and the comparison goes on.
     """
     fits, failures = [], {}
@@ -174,7 +174,7 @@ def cross_calibration(source_model, source_params, target_model, target_base, ta
     target_names : sequence of str
         Identified parameters of the target model.
     space : ParameterSpace
-        KNN population bounds over ``target_names``.
+        Bounds of the identification (and of its search) over ``target_names``.
     specimen : object
         The specimen (and mesh) of the source run; the target's too unless ``target_specimen``.
     cmod_points : array_like
@@ -183,7 +183,7 @@ def cross_calibration(source_model, source_params, target_model, target_base, ta
         The target model's specimen (e.g. another mesh).
     relative_std : float
         Standard deviation of the data as a fraction of the source's peak force [-]: the weight
-        of the data against the KNN prior in the Kalman filter. A mismatch of models is not noise,
+        of the data against the search's prior in the local fit. A mismatch of models is not noise,
         and a small std makes the filter's undamped steps overshoot: fitting gradient damage to
         the cohesive curve of the Gregoire beam (24 points, 4 mm mesh), 3 % left the bounds where
         6.5 % (the default; about the scatter of the measured curves of that beam past the peak)

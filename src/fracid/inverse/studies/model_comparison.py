@@ -12,8 +12,8 @@ space):
    the importance weights, and the verdict per parameter on its credible intervals
    (:func:`fracid.inverse.studies.verdict.parameter_verdicts`; on the Gaussian when the sampling failed).
 
-Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the KNN prior's
-term, the objective the Kalman filter minimises), the chi^2, AIC and BIC. The models run side by side
+Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the term of the
+prior its search gave, the objective its local fit minimises), the chi^2, AIC and BIC. The models run side by side
 (:func:`fracid.runtime.executors.concurrently`: a thread per model submitting its forward runs to the shared executor)
 and every run goes through the run store (the identification's stages under their own labels, the posterior
 and the Laplace run under ``compare:<label>``; the keys hold the model, so models never share a run and a
@@ -40,6 +40,7 @@ from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity
 from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.methods.registry import DEFAULT_METHOD
 from fracid.inverse.methods.strategy import identify_data
 from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.studies import evidence
@@ -94,7 +95,7 @@ def compare(data, contenders, *, method=None, posterior: PosteriorSettings = Pos
     contenders : sequence of Contender
         The models (labels unique).
     method : InverseMethod, str or None
-        The inverse method of every identification (None: the default, KNN then the Kalman filter).
+        The inverse method of every identification (None: the registry's default, :data:`~fracid.inverse.methods.registry.DEFAULT_METHOD`).
     posterior : PosteriorSettings
         The sampler's settings, the same for every model.
     executor, store
@@ -125,7 +126,7 @@ def compare(data, contenders, *, method=None, posterior: PosteriorSettings = Pos
     scores = [o for o in outcomes if isinstance(o, ModelScore)]
     failures = {c.label: o for c, o in zip(contenders, outcomes) if isinstance(o, str)}
     return ComparisonResult.ranked(data, scores, failures, {"posterior": asdict(posterior), "tolerance": tolerance,
-                                                           "method": getattr(method, "name", method) or "knn-kalman"})
+                                                           "method": getattr(method, "name", method) or DEFAULT_METHOD})
 
 
 def _attempt(data, contender: Contender, job) -> "ModelScore | str":

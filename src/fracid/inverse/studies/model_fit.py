@@ -1,7 +1,7 @@
 """One forward model fitted to one data set: the candidate, its identification and its run at the estimate.
 
 :func:`fit_model` identifies a :class:`Candidate` with :func:`fracid.inverse.methods.strategy.identify_data`
-(KNN population, then the Kalman filter) and then runs the model once more at its estimate, to the last
+(the inverse method's stages) and then runs the model once more at its estimate, to the last
 control value of the data (:func:`run_to_end`), to read the energy it dissipated
 (``observables["dissipated_energy"]``: external work minus elastic energy, [N mm]) and its peak force
 (:class:`ModelFit`). The studies that compare models are in :mod:`fracid.inverse.studies.cross_model`.
@@ -19,7 +19,8 @@ import numpy as np
 from fracid.data import ExperimentalData
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.methods.strategy import IdentificationResult, identify_data
+from fracid.inverse.core.method import MethodResult
+from fracid.inverse.methods.strategy import identify_data
 from fracid.models import ConvergenceError
 
 __all__ = ["Candidate", "ModelFit", "candidate_operator", "fit_model", "relative_rms", "run_to_end"]
@@ -40,7 +41,7 @@ class Candidate:
     names : sequence of str
         Identified parameters.
     space : ParameterSpace
-        Bounds (and log flags) of the KNN population over ``names``.
+        Bounds (and log flags) of the identification (and of its search) over ``names``.
     specimen : object, optional
         The specimen this model runs on (e.g. its own mesh); None: the one given to the caller.
     settings : dict, optional
@@ -71,7 +72,7 @@ class ModelFit:
     ----------
     label, model_key : str
         The candidate's label and the model's ``key``.
-    identification : IdentificationResult
+    identification : MethodResult
         Estimate ``x``, covariance ``C``, the fit ``y_fit`` at the data's points, runs, ...
     params : parameter object
         The full parameter set at the estimate.
@@ -85,15 +86,14 @@ class ModelFit:
         Energy dissipated by the run at the estimate up to the last data control value [N mm]
         (NaN if that run stopped before it).
     forward_runs : int
-        Forward runs of the identification: KNN population plus Kalman filter (the run at the
-        estimate is not counted).
+        Forward runs of the identification, all its stages (the run at the estimate is not counted).
     seconds : float
         Wall time of the identification and of the run at the estimate [s].
     """
 
     label: str
     model_key: str
-    identification: IdentificationResult
+    identification: MethodResult
     params: object
     control: np.ndarray
     force: np.ndarray
@@ -114,7 +114,7 @@ class ModelFit:
 
     @property
     def std(self) -> np.ndarray:
-        """Standard deviations of the estimate from the Kalman filter's covariance."""
+        """Standard deviations of the estimate from the identification's covariance."""
         return np.asarray(self.identification.std, float)
 
     @property
@@ -124,7 +124,7 @@ class ModelFit:
     def row(self) -> dict:
         """A plain dict for tables and JSON: ``label``, ``model``, ``parameters`` ({name: {value, std,
         unit}}), ``rms_percent``, ``peak_force_N``, ``dissipated_energy_Nmm``, ``forward_runs``,
-        ``converged``, ``status`` (of the Kalman filter), ``seconds``."""
+        ``converged``, ``status`` (of the stage that gave the estimate), ``seconds``."""
         units = self.units
         return {
             "label": self.label, "model": self.model_key,

@@ -1,21 +1,19 @@
 """Stability of the estimate (docs/theory.md, section 4.7): identification repeated on data with noise added.
 
 Each replicate adds a draw of N(0, noise covariance) to the data (seeds fixed, so a study is
-reproducible) and runs the Kalman filter again from the same prior. The scatter of the estimates,
+reproducible) and runs the method's local fit again from the same prior. The scatter of the estimates,
 compared with the noise of the data, says how strongly measurement errors are amplified into the
 parameters: a stable identification has scatter of the order of the posterior standard deviation.
 """
 
 from __future__ import annotations
 
-from functools import partial
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from fracid.data.covariance_matrix import as_covariance
-from fracid.inverse.methods.kalman import kalman_filter
 from fracid.runtime.executors import concurrently
 
 
@@ -84,7 +82,7 @@ def noisy_replicates(y, C_noise, n: int, seed: int = 0) -> np.ndarray:
 
 
 def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int = 0, C_noise=None, bounds=None,
-              executor=None, progress=None, fit=None, **kalman) -> Stability:
+              executor=None, progress=None, fit) -> Stability:
     """Identify again from ``replicates`` noisy copies of the data.
 
     Parameters
@@ -101,11 +99,9 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
         Seed of the noise draws.
     C_noise : ndarray or Covariance, optional
         Covariance of the added noise [units of y squared]; C_exp if None.
-    fit : callable, optional
+    fit : callable
         The local fit of the replicates, ``fit(evaluate, y, C_exp, x0, C0, bounds=, executor=)`` (an
-        inverse method's ``fit_from``); by default the Kalman filter with the settings ``kalman``.
-    kalman
-        Settings of :func:`~fracid.inverse.methods.kalman.kalman_filter` (without ``fit``).
+        inverse method's ``fit_from``) giving ``x``, ``std``, ``failed`` and ``status``.
     """
     if int(replicates) != replicates or replicates < 2:
         raise ValueError(f"replicates = {replicates!r}: the scatter needs at least 2 replicates")
@@ -114,10 +110,8 @@ def stability(evaluate, y_exp, C_exp, x0, C0, *, replicates: int = 10, seed: int
     data = noisy_replicates(y_exp, C_noise, int(replicates), seed)
     estimates, errors = np.full((len(data), np.size(x0)), np.nan), []
     stds = []
-    fit_once = fit or partial(kalman_filter, **kalman)
-
     def run(y):
-        return fit_once(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor)
+        return fit(evaluate, y, C_exp, x0, C0, bounds=bounds, executor=executor)
 
     for i, result in enumerate(concurrently(run, data, executor, progress)):  # the replicates side by side
         if result.failed:  # a replicate that fails is recorded; the study goes on

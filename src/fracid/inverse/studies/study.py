@@ -1,7 +1,7 @@
 """The identification strategy as one study (docs/theory.md, section 4.4), ending in a verdict per parameter.
 
 The study runs the stages of an inverse method (:class:`~fracid.inverse.methods.registry.StudyMethod`; by default
-:class:`~fracid.inverse.methods.knn_kalman.KnnKalman`): its global search over a population (overview, prior) ->
+the registry's :data:`~fracid.inverse.methods.registry.DEFAULT_METHOD`): its global search over a population (overview, prior) ->
 sensitivity along the load history at the search's estimate (which stage of the test informs which
 parameter) -> its local refinement -> uniqueness (valley of the objective over the population, measured
 from the estimate and its objective) -> multi-start check (the local fit from distinct population
@@ -21,13 +21,13 @@ from __future__ import annotations
 import dataclasses
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fracid.inverse.methods.knn_kalman import KnnKalman
 from fracid.inverse.core.method import check_problem, identification_bounds
-from fracid.inverse.methods.registry import StudyMethod, with_settings
+from fracid.inverse.core.method_settings import with_settings
+from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS, StudyMethod
 from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.likelihood.terms import Problem, with_error_terms
@@ -36,6 +36,10 @@ from fracid.inverse.studies.stability import stability as stability_check
 from fracid.inverse.studies.study_result import Prediction, StudyResult, describe_data, estimate_objective, predict
 from fracid.inverse.studies.uniqueness import bounds_covariance, multi_start, objective_maps, starting_points, valley_extent
 from fracid.inverse.studies.verdict import parameter_verdicts
+
+
+#: the values of ``StudySettings.prior``: the search's own prior covariance, or the bounds' uniform one
+PRIORS = ("search", "bounds")
 
 
 @dataclass(frozen=True)
@@ -49,11 +53,11 @@ class StudySettings:
         a key of :data:`~fracid.inverse.methods.registry.METHODS` is its class): its search gives the overview,
         the prior, the objective maps and the starting points of the multi-start check; its refinement
         the identification; its local fit (``fit_from``) every multi-start fit and every noisy replicate.
-    prior : {"knn", "bounds"}
-        Covariance of the refinement's prior (mean: the search's estimate): the spread of the k
-        nearest neighbours (the thesis's cascade, docs/theory.md, section 4.4), or the bounds' uniform covariance. The
-        neighbours were ranked with the same data, so "bounds" keeps the posterior to what the
-        data say, which comparisons of data sets (twin matrices) need.
+    prior : {"search", "bounds"}
+        Covariance of the refinement's prior (mean: the search's estimate): the search's own (``"search"``: the
+        spread of the points its prior is drawn from, the thesis's cascade, docs/theory.md, section 4.4), or the
+        bounds' uniform covariance. The search ranked its points with the same data, so "bounds" keeps the
+        posterior to what the data say, which comparisons of data sets (twin matrices) need.
     starts : int
         Starting points of the multi-start check (0 or 1: skipped).
     replicates : int
@@ -73,8 +77,8 @@ class StudySettings:
         and stability checks keep the measurement covariance. None (default): none.
     """
 
-    method: object = KnnKalman()
-    prior: str = "knn"
+    method: object = field(default_factory=lambda: METHODS[DEFAULT_METHOD]())
+    prior: str = "search"
     starts: int = 3
     replicates: int = 5
     noise_seed: int = 0
@@ -83,34 +87,27 @@ class StudySettings:
     error_terms: object = None
 
     def __post_init__(self):
-        if self.prior not in ("knn", "bounds"):
-            raise ValueError(f"prior = {self.prior!r}; choose 'knn' or 'bounds'")
+        if self.prior == "knn":
+            raise ValueError("prior = 'knn' is now called 'search' (the prior the method's search gives); choose "
+                             "'search' or 'bounds'")
+        if self.prior not in PRIORS:
+            raise ValueError(f"prior = {self.prior!r}; choose 'search' or 'bounds'")
         if self.posterior is not None and not isinstance(self.posterior, PosteriorSettings):
             raise TypeError(f"posterior = {self.posterior!r}: give PosteriorSettings(...) or None")
         if not isinstance(self.method, StudyMethod):
             raise TypeError(f"method = {self.method!r}: a study runs the stages of an inverse method with search, "
-                            "refine and fit_from (fracid.inverse.methods.registry.StudyMethod), e.g. KnnKalman() or "
-                            "KnnGaussNewton()")
+                            "refine and fit_from (fracid.inverse.methods.registry.StudyMethod), e.g. one of "
+                            f"{', '.join(f'{cls.__name__}()' for cls in METHODS.values())}")
 
     @property
     def identification(self):
         """The inverse method of the identification (``method``)."""
         return self.method
 
-    @property
-    def knn(self):
-        """The method's population settings (its ``knn``; None if it has none)."""
-        return getattr(self.method, "knn", None)
-
-    @property
-    def kalman(self):
-        """The method's Kalman filter settings (its ``kalman``; None if it has none)."""
-        return getattr(self.method, "kalman", None)
-
     def replace(self, **changes) -> StudySettings:
-        """A copy with ``changes``: fields of this class, fields of the method (``knn``, ``kalman``,
-        ``max_iterations``, ...) or fields of the method's settings (``n``, ``seed``, ``k`` of its
-        ``knn``; ``groups``, ``restart``, ... of its ``kalman``) by their own names.
+        """A copy with ``changes``: fields of this class, fields of the method or fields of the method's
+        settings by their own names (:func:`~fracid.inverse.core.method_settings.with_settings`: ``n``, ``k``,
+        ``groups``, ``max_iterations``, ... as the method has them).
 
         Raises
         ------
@@ -163,29 +160,14 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
     check_problem(operator, data.y, data.covariance, space)
     study = _Stages(log)
     y, C, method = data.y, data.covariance, settings.method
-    search_label, refine_label = _stage_labels(method)
+    search_label, _ = _stage_labels(method)
     C_bounds = bounds_covariance(space)
     # every run after the population carries its sensitivities where the model has them: one stored
     # operator (and its counters) for all stages
     evaluate, _ = exact_sensitivity(StoredOperator(operator, store, retry_failed=retry_failed))
-    study.log(f"{search_label}: population search")
-    overview = method.search(operator, y, C, space, executor=executor, store=store, progress=progress,
-                             retry_failed=retry_failed)
-    study.runs[search_label] = (len(overview.points), overview.n_failed)
-    study.stage("search")
-    C0 = overview.C0 if settings.prior == "knn" else C_bounds
-    history = _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_label, executor)
-    with study.counting(refine_label, evaluate, f"{refine_label} from the {search_label} prior"):
-        ident = method.refine(evaluate, y, C, overview, executor=executor, blocks=list(data.blocks),
-                              notes=list(data.notes), C0=C0, progress=progress)
-    if settings.error_terms is not None:
-        with study.counting("error terms", evaluate, "error terms: the refinement again with them"):
-            def fit(inverse, covariance):
-                return inverse.refine(evaluate, y, covariance, overview, executor=executor, blocks=list(data.blocks),
-                                      notes=list(data.notes), C0=C0, progress=progress)
-
-            ident = with_error_terms(method, fit, Problem.of(operator, y, C, space, data.blocks), settings.error_terms,
-                                     ident, store=store, executor=executor, retry_failed=retry_failed)
+    overview, C0, history, ident = _identification(study, operator, evaluate, data, space, settings, C_bounds,
+                                                   executor=executor, store=store, progress=progress,
+                                                   retry_failed=retry_failed)
     centre = estimate_objective(ident, y, C)
     maps, extent = objective_maps(overview, centre=centre), valley_extent(overview, centre=centre)
     fit = _local_fit(method, data.blocks)
@@ -212,6 +194,33 @@ def run_study(operator, data, space, settings: StudySettings = StudySettings(), 
                        study.notes, posterior=post)
 
 
+def _identification(study, operator, evaluate, data, space, settings, C_bounds, *, executor, store, progress,
+                    retry_failed):
+    """The method's search, the sensitivity at its estimate and the refinement from its prior (with the error
+    terms when asked): ``(overview, C0, sensitivity history, identification)``."""
+    y, C, method = data.y, data.covariance, settings.method
+    search_label, refine_label = _stage_labels(method)
+    study.log(f"{search_label}: population search")
+    overview = method.search(operator, y, C, space, executor=executor, store=store, progress=progress,
+                             retry_failed=retry_failed)
+    study.runs[search_label] = (len(overview.points), overview.n_failed)
+    study.stage("search")
+    C0 = overview.C0 if settings.prior == "search" else C_bounds
+    history = _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_label, executor)
+    with study.counting(refine_label, evaluate, f"{refine_label} from the {search_label} prior"):
+        ident = method.refine(evaluate, y, C, overview, executor=executor, blocks=list(data.blocks),
+                              notes=list(data.notes), C0=C0, progress=progress)
+    if settings.error_terms is not None:
+        with study.counting("error terms", evaluate, "error terms: the refinement again with them"):
+            def fit(inverse, covariance):
+                return inverse.refine(evaluate, y, covariance, overview, executor=executor, blocks=list(data.blocks),
+                                      notes=list(data.notes), C0=C0, progress=progress)
+
+            ident = with_error_terms(method, fit, Problem.of(operator, y, C, space, data.blocks), settings.error_terms,
+                                     ident, store=store, executor=executor, retry_failed=retry_failed)
+    return overview, C0, history, ident
+
+
 def _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_label, executor):
     """The sensitivity along the load history at the search's estimate (None, with a note, when a run fails)."""
     history = None
@@ -225,7 +234,7 @@ def _sensitivity_stage(study, evaluate, overview, data, C_bounds, space, search_
 
 
 def _stage_labels(method) -> tuple[str, str]:
-    """Labels of the method's first (search) and last (refinement) stages, e.g. ("KNN", "Kalman filter")."""
+    """Labels of the method's first (search) and last (refinement) stages (its ``stages``; its name without)."""
     labels = list(dict(method.stages).values()) or [method.name]
     return labels[0], labels[-1]
 
@@ -335,4 +344,4 @@ def stage_bar(progress, total, description):
         yield batch_progress(bar)
 
 
-__all__ = ["Prediction", "StudyResult", "StudySettings", "describe_data", "estimate_objective", "predict", "run_study"]
+__all__ = ["PRIORS", "Prediction", "StudyResult", "StudySettings", "describe_data", "estimate_objective", "predict", "run_study"]

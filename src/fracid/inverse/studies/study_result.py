@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.methods.knn import objective
+from fracid.inverse.core.misfit import objective
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity
 from fracid.inverse.studies.verdict import DataDescription
 from fracid.store.tables import without_nan, write_csv_table
@@ -82,7 +82,7 @@ def describe_data(operator) -> DataDescription:
 class StudyResult:
     """Everything a study computed; :meth:`save` writes it, :func:`fracid.report.study` reports it.
 
-    ``posterior`` is the sampled :class:`~fracid.inverse.sampling.posterior.PosteriorResult` when the study was
+    ``posterior`` is the sampled :class:`~fracid.inverse.sampling.posterior_result.PosteriorResult` when the study was
     asked for one and it could be sampled, None otherwise.
     """
 
@@ -171,7 +171,7 @@ class StudyResult:
         (directory / "study.json").write_text(json.dumps(self.to_dict(), indent=1))
         (directory / "verdict.txt").write_text(self.summary() + "\n")
         ident = self.identification
-        population = getattr(ident, "knn", None) or {}
+        population = ident.population()
         if population.get("points") is not None:
             points, f = np.asarray(population["points"], float), np.asarray(population["f"], float)
             status = population.get("status") or ["ok" if np.isfinite(v) else "failed" for v in f]

@@ -1,19 +1,18 @@
 """Uniqueness of the estimate (docs/theory.md, section 4.6): maps of the objective, its valley, multi-start.
 
-The population of a KNN search is an overview of the objective f over the parameter space. Its
+The population of the method's search is an overview of the objective f over the parameter space. Its
 *valley* is the set of parameter sets the data cannot tell from the estimate (the identification's, when
 given; else the best population point): f - f_estimate below the
 95 % quantile of chi^2 with p degrees of freedom (the likelihood-ratio confidence region of a
 Gaussian measurement error; p the number of identified parameters). A valley stretched along a line
 means correlated parameters; several separated pieces mean several minima.
 
-The multi-start check runs the Kalman filter from several distinct starting points of the
+The multi-start check runs the method's local fit from several distinct starting points of the
 population: ends that differ by more than their standard deviations expose a non-unique estimate.
 """
 
 from __future__ import annotations
 
-from functools import partial
 
 from dataclasses import dataclass, field
 from itertools import combinations
@@ -21,7 +20,7 @@ from itertools import combinations
 import numpy as np
 from scipy.stats import chi2
 
-from fracid.inverse.methods.kalman import kalman_filter
+from fracid.inverse.core.misfit import objective
 from fracid.runtime.executors import concurrently
 from fracid.inverse.core.sensitivity import ForwardRunError
 
@@ -156,9 +155,8 @@ class MultiStart:
         return self.distance <= tolerance
 
 
-def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=None, progress=None, fit=None,
-                **kalman) -> MultiStart:
-    """Run the Kalman filter from every starting point with the prior covariance C0.
+def multi_start(evaluate, y_exp, C_exp, starts, C0, *, fit, bounds=None, executor=None, progress=None) -> MultiStart:
+    """Run the local fit ``fit`` from every starting point with the prior covariance C0.
 
     Parameters
     ----------
@@ -168,20 +166,15 @@ def multi_start(evaluate, y_exp, C_exp, starts, C0, *, bounds=None, executor=Non
         Prior covariance of every start (wide, e.g. from the bounds: a tight prior would pin each
         end to its start).
     progress : callable(done, total), optional
-        Called after each filter.
-    fit : callable, optional
+        Called after each fit.
+    fit : callable
         The local fit from a start, ``fit(evaluate, y_exp, C_exp, x, C0, bounds=, executor=)`` (an inverse
-        method's ``fit_from``); by default the Kalman filter with the settings ``kalman``.
-    kalman
-        Settings of :func:`~fracid.inverse.methods.kalman.kalman_filter` (groups, max_iterations, ...; without ``fit``).
+        method's ``fit_from``) giving ``x``, ``std``, ``y``, ``failed`` and ``status``.
     """
-    from fracid.inverse.methods.knn import objective
-
     starts, results, failed = np.atleast_2d(starts), [], []
-    fit_once = fit or partial(kalman_filter, **kalman)
 
     def run(x):
-        return fit_once(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor)
+        return fit(evaluate, y_exp, C_exp, x, C0, bounds=bounds, executor=executor)
 
     for x, result in zip(starts, concurrently(run, starts, executor, progress)):  # the fits side by side
         if result.failed:  # recorded; the other starts still tell
