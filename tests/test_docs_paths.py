@@ -22,14 +22,7 @@ SOURCE_PATH = re.compile(r"src/fracid/[\w/.\-]*[\w/]")
 
 #: broken today (issue 37): the README's extension map names modules moved by the last tidy, and the demo's
 #: files moved to src/fracid/datasets/gregoire2013_beam4/ (one home of bundled data)
-PENDING = {
-    ("README.md", "fracid.fem.laws.TRACTION_SEPARATION_LAWS"),
-    ("README.md", "fracid.fem.probes.probe_matrix"),
-    ("README.md", "fracid.fem.ranges.compose"),
-    ("README.md", "fracid.fem.tsl.TractionSeparationLaw"),
-    ("README.md", "fracid.inverse.method.InverseMethod"),
-    ("README.md", "fracid.inverse.observations.ObservationKind"),
-}
+PENDING: set = set()
 
 
 def resolves(dotted: str) -> bool:
