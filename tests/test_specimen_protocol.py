@@ -204,6 +204,34 @@ def test_a_model_of_a_few_lines_gets_the_default_capabilities():
         declared(object())
 
 
+def test_simulate_reads_whether_a_model_needs_a_described_specimen():
+    """``needs_description`` is declared (ModelDefaults: False; the built-in models: True), not guessed from the
+    model's class: a model of a few lines takes any specimen object, one that declares it refuses a foreign one."""
+    from fracid.models.forward import simulate
+
+    @dataclass(frozen=True)
+    class Minimal:
+        key: ClassVar[str] = "minimal"
+        parameters: ClassVar[type] = dict
+
+        def simulate(self, specimen, params, **options):
+            return ("ran", specimen)
+
+    @dataclass(frozen=True)
+    class Describing(Minimal):
+        needs_description: ClassVar[bool] = True
+
+    foreign = object()  # neither describe() nor a Description
+    assert declared(Minimal()).needs_description is False and all(MODEL_TYPES[k]().needs_description
+                                                                   for k in MODEL_TYPES)
+    assert simulate(foreign, {}, model=Minimal()) == ("ran", foreign)
+    with pytest.raises(TypeError, match="specimen is a object; give a specimen object"):
+        simulate(foreign, {}, model=Describing())
+    assert simulate(BEAM, {}, model=Describing()) == ("ran", BEAM)
+    description = BarWithWeakZone(n_elements=10).describe()
+    assert simulate(description, {}, model=Describing()) == ("ran", description)
+
+
 # ---- no cap on the data size
 
 

@@ -35,6 +35,10 @@ damage_threshold, observables, sensitivities)``
     E and nu.
 ``specimen_starts`` : mapping
     Specimen class -> :class:`~fracid.models.protocol.SpecimenStart`, the fields ``fracid init`` writes.
+``needs_description`` : bool
+    Whether it builds its problem from the specimen's description (the built-in models), so that
+    :func:`~fracid.models.forward.simulate` refuses a specimen object without ``describe()``; False: the model
+    checks its specimens itself.
 
 A model of a few lines (``key``, ``parameters``, ``simulate``) inherits the rest from
 :class:`ModelDefaults`, or is completed by :func:`declared` (both of :mod:`fracid.models.protocol`,
