@@ -297,8 +297,3 @@ def refined(specimen, factor: float):
         return dataclasses.replace(specimen, **{resolution.field: resolution.value / factor})
     raise ValueError(f"{type(specimen).__name__}: no field sets its element size ({resolution.text}), so fracid cannot "
                      "make a refined mesh of it; give meshes of two sizes yourself")
-
-
-def field_names(cls) -> tuple:
-    """The dataclass fields of a specimen class (its ``[specimen]`` keys besides type and control)."""
-    return tuple(f.name for f in dataclasses.fields(cls)) if dataclasses.is_dataclass(cls) else ()
