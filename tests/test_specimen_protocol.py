@@ -232,6 +232,41 @@ def test_simulate_reads_whether_a_model_needs_a_described_specimen():
     assert simulate(description, {}, model=Describing()) == ("ran", description)
 
 
+def test_refined_is_the_specimens_declared_member():
+    """``refined(specimen, factor)`` asks the specimen (no probe): SpecimenDefaults' field rule, or its own."""
+    from fracid.specimens.protocol import refined
+
+    @dataclass(frozen=True)
+    class OwnRefinement(SpecimenDefaults):
+        h: float = 4.0
+
+        def refined(self, factor):
+            return dataclasses.replace(self, h=self.h / factor**2)  # not the field rule: its own
+
+    assert all(callable(kind.refined) for kind in SPECIMENS.values())
+    assert refined(OwnRefinement(), 2.0) == OwnRefinement(h=1.0)
+    assert refined(TensionStrip(n_elements=21), 3.0).n_elements == 63
+    with pytest.raises(ValueError, match="no field sets its element size"):
+        _NoField().refined(2.0)
+
+
+class _NoField(SpecimenDefaults):
+    """A specimen whose mesh no field sizes."""
+
+    def resolution(self, internal_length=None):
+        return Resolution(None, None, 1.0, "its smallest element side, 1 mm,", "")
+
+
+def test_usual_ranges_and_units_are_read_from_the_declared_parameter_class():
+    from fracid.fem.material.parameters import DamageParameters
+    from fracid.models import parameter_units, usual_ranges
+
+    assert usual_ranges(DamageParameters) == dict(DamageParameters.usual_ranges) and "kappa_i" in usual_ranges()
+    assert parameter_units(DamageModel("local"))["c"] == "mm^2"
+    with pytest.raises(TypeError, match="lacks key, parameters, simulate"):
+        parameter_units(object())
+
+
 # ---- no cap on the data size
 
 

@@ -6,8 +6,10 @@ A forward model declares
 ``key`` : str
     Names the model (and its variant, its law) in run-store keys: runs of different models never share a key.
 ``parameters`` : type
-    Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods and
-    ``replace(**changes)`` on instances, returning a validated copy (ValueError for bad values).
+    Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods, ``usual_ranges``
+    (name -> (lower, upper) of quasi-brittle materials; may be empty) and ``replace(**changes)`` on instances,
+    returning a validated copy (ValueError for bad values); :class:`~fracid.fem.material.ranges.ParameterSet`
+    gives them all.
 ``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints,
 damage_threshold, observables, sensitivities)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
