@@ -18,7 +18,7 @@ from fracid.inverse.likelihood.settings import (DiscretisationError, ModelError,
                                                 model_error_from_config)
 from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
 from fracid.specimens import NotchedBeam
-from fracid.specimens.protocol import refined
+from fracid.specimens.protocol import SpecimenDefaults, refined
 
 T = np.linspace(0.0, 1.0, 12)
 EXACT = np.sin(3 * T) + 2.0  # the mesh-converged values
@@ -64,7 +64,7 @@ def test_refined_meshes_of_every_kind_of_size_field():
         refined(fixed, 2.0)
 
 
-class FixedMesh:
+class FixedMesh(SpecimenDefaults):
     """A specimen whose mesh no field sizes (a mesh file's)."""
 
     def resolution(self, internal_length=None):

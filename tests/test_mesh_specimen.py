@@ -6,7 +6,8 @@ import pytest
 
 import fracid
 from fracid.models import DamageModel
-from fracid.specimens.mesh import MeshError, MeshSpecimen, plane_mesh, read_mesh
+from fracid.specimens.mesh import MeshSpecimen
+from fracid.specimens.mesh_reading import MeshError, plane_mesh, read_mesh
 
 meshio = pytest.importorskip("meshio")
 
@@ -151,7 +152,7 @@ def test_mesh_unknowns_and_the_size_limit(tmp_path, monkeypatch):
     """The count from the corners and elements is exact for one piece without holes; beyond
     MAX_UNKNOWNS the configuration refuses the mesh before it is built."""
     from fracid.specimens import protocol
-    from fracid.specimens.mesh import mesh_size, mesh_unknowns
+    from fracid.specimens.mesh_reading import mesh_size, mesh_unknowns
     from fracid.specimens.mesh_section import check_mesh_size
 
     for triangles in (True, False):

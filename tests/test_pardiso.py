@@ -11,8 +11,10 @@ import scipy.sparse.linalg as spla
 
 import fracid
 from fracid.fem.path import pardiso as pardiso_module
-from fracid.fem.path.linear_solvers import SingularMatrixError, SuperLUSolver
+from fracid.fem.path.linear_backend import SingularMatrixError
+from fracid.fem.path.linear_solvers import SuperLUSolver
 from fracid.fem.path.pardiso import PardisoSolver
+from fracid.models.damage import DamageModel
 
 pytest.importorskip("pypardiso")  # fracid.fem.path.pardiso itself imports it only when a solver is made
 
@@ -152,7 +154,7 @@ def test_snap_back_run_matches_superlu():
     """Local model of a long bar under weak-zone elongation control: the bordered system through snap-back."""
     bar = fracid.BarWithWeakZone(n_elements=200, profile="hat", length=400.0)
     params = fracid.DamageParameters(beta=100.0)
-    kwargs = {"regularization": "local", "control": "weak_zone_elongation", "target": 0.1, "stop_force_fraction": 0.05, "steps": STEPS}
+    kwargs = {"model": DamageModel("local"), "control": "weak_zone_elongation", "target": 0.1, "stop_force_fraction": 0.05, "steps": STEPS}
     reference = fracid.simulate(bar, params, linear_solver=SuperLUSolver(), **kwargs)
     solver = PardisoSolver()
     result = fracid.simulate(bar, params, linear_solver=solver, **kwargs)

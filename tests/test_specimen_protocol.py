@@ -204,6 +204,69 @@ def test_a_model_of_a_few_lines_gets_the_default_capabilities():
         declared(object())
 
 
+def test_simulate_reads_whether_a_model_needs_a_described_specimen():
+    """``needs_description`` is declared (ModelDefaults: False; the built-in models: True), not guessed from the
+    model's class: a model of a few lines takes any specimen object, one that declares it refuses a foreign one."""
+    from fracid.models.forward import simulate
+
+    @dataclass(frozen=True)
+    class Minimal:
+        key: ClassVar[str] = "minimal"
+        parameters: ClassVar[type] = dict
+
+        def simulate(self, specimen, params, **options):
+            return ("ran", specimen)
+
+    @dataclass(frozen=True)
+    class Describing(Minimal):
+        needs_description: ClassVar[bool] = True
+
+    foreign = object()  # neither describe() nor a Description
+    assert declared(Minimal()).needs_description is False and all(MODEL_TYPES[k]().needs_description
+                                                                   for k in MODEL_TYPES)
+    assert simulate(foreign, {}, model=Minimal()) == ("ran", foreign)
+    with pytest.raises(TypeError, match="specimen is a object; give a specimen object"):
+        simulate(foreign, {}, model=Describing())
+    assert simulate(BEAM, {}, model=Describing()) == ("ran", BEAM)
+    description = BarWithWeakZone(n_elements=10).describe()
+    assert simulate(description, {}, model=Describing()) == ("ran", description)
+
+
+def test_refined_is_the_specimens_declared_member():
+    """``refined(specimen, factor)`` asks the specimen (no probe): SpecimenDefaults' field rule, or its own."""
+    from fracid.specimens.protocol import refined
+
+    @dataclass(frozen=True)
+    class OwnRefinement(SpecimenDefaults):
+        h: float = 4.0
+
+        def refined(self, factor):
+            return dataclasses.replace(self, h=self.h / factor**2)  # not the field rule: its own
+
+    assert all(callable(kind.refined) for kind in SPECIMENS.values())
+    assert refined(OwnRefinement(), 2.0) == OwnRefinement(h=1.0)
+    assert refined(TensionStrip(n_elements=21), 3.0).n_elements == 63
+    with pytest.raises(ValueError, match="no field sets its element size"):
+        _NoField().refined(2.0)
+
+
+class _NoField(SpecimenDefaults):
+    """A specimen whose mesh no field sizes."""
+
+    def resolution(self, internal_length=None):
+        return Resolution(None, None, 1.0, "its smallest element side, 1 mm,", "")
+
+
+def test_usual_ranges_and_units_are_read_from_the_declared_parameter_class():
+    from fracid.fem.material.parameters import DamageParameters
+    from fracid.models import parameter_units, usual_ranges
+
+    assert usual_ranges(DamageParameters) == dict(DamageParameters.usual_ranges) and "kappa_i" in usual_ranges()
+    assert parameter_units(DamageModel("local"))["c"] == "mm^2"
+    with pytest.raises(TypeError, match="lacks key, parameters, simulate"):
+        parameter_units(object())
+
+
 # ---- no cap on the data size
 
 

@@ -6,8 +6,10 @@ A forward model declares
 ``key`` : str
     Names the model (and its variant, its law) in run-store keys: runs of different models never share a key.
 ``parameters`` : type
-    Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods and
-    ``replace(**changes)`` on instances, returning a validated copy (ValueError for bad values).
+    Its parameter class: ``names()``, ``units()``, ``valid_bounds(names)`` as class methods, ``usual_ranges``
+    (name -> (lower, upper) of quasi-brittle materials; may be empty) and ``replace(**changes)`` on instances,
+    returning a validated copy (ValueError for bad values); :class:`~fracid.fem.material.ranges.ParameterSet`
+    gives them all.
 ``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints,
 damage_threshold, observables, sensitivities)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
@@ -35,6 +37,10 @@ damage_threshold, observables, sensitivities)``
     E and nu.
 ``specimen_starts`` : mapping
     Specimen class -> :class:`~fracid.models.protocol.SpecimenStart`, the fields ``fracid init`` writes.
+``needs_description`` : bool
+    Whether it builds its problem from the specimen's description (the built-in models), so that
+    :func:`~fracid.models.forward.simulate` refuses a specimen object without ``describe()``; False: the model
+    checks its specimens itself.
 
 A model of a few lines (``key``, ``parameters``, ``simulate``) inherits the rest from
 :class:`ModelDefaults`, or is completed by :func:`declared` (both of :mod:`fracid.models.protocol`,

@@ -12,9 +12,9 @@ from fracid.fem.formulations.cohesive_problem import CohesiveCrackProblem, crack
 from fracid.fem.formulations.crack_band_problem import CrackBandProblem, element_extent
 from fracid.fem.material.laws import TRACTION_SEPARATION_LAWS, HordijkLaw
 from fracid.fem.material.tsl import differentiable as gives_derivatives
-from fracid.models.path_model import PathFollowingModel, described
+from fracid.models.path_model import PathFollowingModel
 from fracid.models.protocol import SpecimenStart
-from fracid.specimens.description import at_points, conditions, discretize
+from fracid.specimens.description import at_points, conditions, described, discretize
 from fracid.specimens.wedge import WedgeSplitting
 
 

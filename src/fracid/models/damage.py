@@ -9,9 +9,9 @@ from typing import ClassVar
 from fracid.fem.formulations.fpz import zone_width_observer
 from fracid.fem.formulations.problem import FORMULATIONS
 from fracid.fem.material.laws import DAMAGE_LAWS, DamageLaw
-from fracid.models.path_model import PathFollowingModel, described
+from fracid.models.path_model import PathFollowingModel
 from fracid.models.protocol import MeshLength
-from fracid.specimens.description import at_points, conditions, discretize, uniform
+from fracid.specimens.description import at_points, conditions, described, discretize, uniform
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from fracid.fem.path.path_following import PathResult
+from fracid.models.protocol import declared
+from fracid.specimens.description import Description
 
 
 def _specimen_names() -> str:
@@ -14,28 +16,27 @@ def _specimen_names() -> str:
 
 def check_specimen(specimen, model=None) -> None:
     """Raise a TypeError unless ``specimen`` is a specimen object: not a string (the message lists the
-    specimen types of a configuration and their classes), a class, None or a number; for the built-in
-    models (``model`` of :mod:`fracid.models`), one with ``describe`` or a description (``node_sets``).
-    Another model may take other specimen objects."""
-    from fracid.models import PathFollowingModel
-
+    specimen types of a configuration and their classes), a class, None or a number; for a model that
+    declares ``needs_description`` (the built-in models), one with ``describe`` or a description. Another
+    model may take other specimen objects."""
     if isinstance(specimen, str):
         raise TypeError(f"specimen = {specimen!r} is a name; give a specimen object, e.g. fracid.BarWithWeakZone() "
                         f"(the [specimen] types of a configuration and their classes: {_specimen_names()})")
     if isinstance(specimen, type):
         raise TypeError(f"specimen is the class {specimen.__name__}; give an instance, e.g. {specimen.__name__}()")
-    described = hasattr(specimen, "describe") or hasattr(specimen, "node_sets")
+    described = isinstance(specimen, Description) or hasattr(specimen, "describe")
     if (specimen is None or isinstance(specimen, (int, float))
-            or (isinstance(model, PathFollowingModel) and not described)):
+            or (model is not None and declared(model).needs_description and not described)):
         raise TypeError(f"specimen is a {type(specimen).__name__}; give a specimen object, e.g. "
                         f"fracid.BarWithWeakZone() (the specimen classes: {_specimen_names()})")
 
 
 def check_parameters(model, params) -> None:
     """Raise a TypeError unless ``params`` is an instance of ``model.parameters`` (for a dict, the message
-    says how to build one)."""
-    cls = getattr(model, "parameters", None)
-    if not isinstance(cls, type) or isinstance(params, cls):  # a model without a parameter class checks itself
+    says how to build one); a TypeError too when ``model`` is no forward model
+    (:func:`~fracid.models.protocol.declared`)."""
+    cls = declared(model).parameters
+    if not isinstance(cls, type) or isinstance(params, cls):  # a parameter factory that is no class checks itself
         return
     hint = f"{cls.__name__}(**params)" if isinstance(params, dict) else f"{cls.__name__}(c=2.0)"
     raise TypeError(f"params is a {type(params).__name__}; the model {model.key!r} takes a {cls.__name__} "

@@ -5,11 +5,7 @@ from __future__ import annotations
 
 from fracid.fem.path.path_following import StepOptions, follow_path
 from fracid.models.protocol import ModelDefaults
-
-
-def described(specimen):
-    """The specimen's :class:`~fracid.specimens.description.Description` (``specimen`` itself when it is one)."""
-    return specimen if hasattr(specimen, "node_sets") else specimen.describe()
+from fracid.specimens.description import Description, described
 
 
 def select_observers(observers: dict, names=None) -> dict:
@@ -25,6 +21,8 @@ class PathFollowingModel(ModelDefaults):
     path with the specimen's default control, target and steps, recording ``observers(description, params,
     damage_threshold)``. A subclass has a ``law`` (its ``scales`` are the law's)."""
 
+    needs_description = True
+
     def scales(self, params) -> dict:
         """Characteristic strain (and opening) a specimen sizes its default control with."""
         return self.law.scales(params)
@@ -38,7 +36,8 @@ class PathFollowingModel(ModelDefaults):
         problem = self.build(description, params)
         target = target if target is not None else self.default_target(specimen, params)
         if steps is None:
-            steps = specimen.default_steps(target) if hasattr(specimen, "default_steps") else StepOptions()
+            # a description has no steps of its own; a specimen declares them (Specimen.default_steps)
+            steps = StepOptions() if isinstance(specimen, Description) else specimen.default_steps(target)
         observers = self.observers(description, params, damage_threshold)
         return follow_path(problem, control or specimen.default_control, target, steps=steps,
                            stop_force_fraction=stop_force_fraction,

@@ -7,9 +7,9 @@ from typing import ClassVar
 
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
-from fracid.models.path_model import PathFollowingModel, described
+from fracid.models.path_model import PathFollowingModel
 from fracid.models.protocol import MeshLength, SpecimenStart
-from fracid.specimens.description import at_points, conditions, discretize
+from fracid.specimens.description import at_points, conditions, described, discretize
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 from fracid.specimens.strip import TensionStrip

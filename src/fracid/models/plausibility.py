@@ -19,10 +19,10 @@ def usual_ranges(parameters: type | None = None) -> dict:
     """name -> (lower, upper) usual range in the parameter's unit: of the parameter class ``parameters``, or
     (None) of every registered model's, the first model's where two share a name."""
     if parameters is not None:
-        return dict(getattr(parameters, "usual_ranges", {}))
+        return dict(parameters.usual_ranges)
     ranges = {}
     for cls in parameter_classes():
-        for name, usual in getattr(cls, "usual_ranges", {}).items():
+        for name, usual in cls.usual_ranges.items():
             ranges.setdefault(name, usual)
     return ranges
 

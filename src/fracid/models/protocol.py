@@ -76,6 +76,7 @@ class ForwardModel(Protocol):
     laws: Mapping
     first_identified: tuple | None
     specimen_starts: Mapping
+    needs_description: bool
 
     def simulate(self, specimen, params, **options): ...
 
@@ -92,8 +93,8 @@ class ModelDefaults:
     """The capabilities of a model that declares nothing more than ``key``, ``parameters`` and ``simulate``:
     it runs on every specimen, differentiates nothing, has no observers of its own, no regularisation, no
     length its mesh must resolve and no laws by name, takes the specimen's default target with no
-    characteristic scales, a first identification looks for the two parameters after E and nu, and
-    ``fracid init`` writes the specimens' defaults for it."""
+    characteristic scales, a first identification looks for the two parameters after E and nu,
+    ``fracid init`` writes the specimens' defaults for it, and it checks its specimen objects itself."""
 
     differentiable: ClassVar[tuple] = ()
     differentiates_observers: ClassVar[bool] = False
@@ -109,6 +110,10 @@ class ModelDefaults:
     #: the parameters a first identification looks for (``fracid init``, ``fracid compare``); None: the two
     #: after E and nu of its parameter class
     first_identified: ClassVar[tuple | None] = None
+
+    #: whether it builds its problem from the specimen's description, so that it takes only a specimen with
+    #: ``describe()`` or a :class:`~fracid.specimens.description.Description`; False: it checks its own specimens
+    needs_description: ClassVar[bool] = False
 
     def why_not(self, specimen) -> str | None:
         return None

@@ -63,7 +63,6 @@ def known_units() -> dict:
     return units
 
 
-def parameter_units(model_or_params) -> dict:
-    """Units of a model's parameters (from its parameter class or a parameter object)."""
-    cls = getattr(model_or_params, "parameters", None) or type(model_or_params)
-    return dict(cls.units())
+def parameter_units(model) -> dict:
+    """Units of a forward model's parameters (of its declared parameter class): name -> unit."""
+    return dict(declared(model).parameters.units())

@@ -4,7 +4,7 @@
 :data:`SPECIMENS` is the registry the configuration's ``[specimen] type`` reads; each class declares
 what :class:`~fracid.specimens.protocol.Specimen` asks (its control names, the first the default,
 the local ``observables`` its damage models record, its defaults, the field a size-effect series
-scales and the limits of its mesh); a size-effect specimen also has ``characteristic_size`` and
+scales, the limits of its mesh and its refined mesh, ``refined(factor)``); a size-effect specimen also has ``characteristic_size`` and
 ``nominal_section``. Every specimen is registered alike: the built-in geometries, the tension strip
 and the user's own mesh (``"mesh"``, read from a Gmsh file). A specimen declares the control that follows a
 snap-back (``snap_back_control``) and, when its ``[specimen]`` table is not its dataclass fields, the reader of

@@ -13,10 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def _description(specimen):
-    """The specimen's description (a description is its own)."""
-    return specimen if hasattr(specimen, "node_sets") else specimen.describe()
+from fracid.specimens.description import described
 
 
 @dataclass(frozen=True)
@@ -89,8 +86,8 @@ def crack_line(specimen) -> CrackLine:
     ValueError
         For a specimen without a straight crack path (node set) or not plane.
     """
-    d = _description(specimen)
-    crack = getattr(d, "crack", None)
+    d = described(specimen)
+    crack = d.crack
     if d.dim != 2 or crack is None or crack.nodes is None:
         raise ValueError(f"{type(specimen).__name__}: derived DIC data need a plane specimen with a straight crack "
                          "path (Description.crack with a node set); this one has none")

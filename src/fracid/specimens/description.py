@@ -195,6 +195,11 @@ class Description:
         return self.nodes, self.cells, self.cell_type or _PLANE_CELL_TYPES[self.cells.shape[1]]
 
 
+def described(specimen) -> Description:
+    """The specimen's :class:`Description` (``specimen.describe()``; a description is its own)."""
+    return specimen if isinstance(specimen, Description) else specimen.describe()
+
+
 def discretize(description: Description) -> MixedDiscretization:
     """The mixed discretisation of the description's mesh (built once per description)."""
     if "disc" not in description._cache:

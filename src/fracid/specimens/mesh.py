@@ -7,7 +7,7 @@ ebar on the corners, or Q8 with bilinear ebar) on straight edges. A group of lin
 the node set of its corners and of the mid-edge nodes of its lines. Lengths are in the mesh's unit
 times ``scale`` [mm].
 
-The file is read by :mod:`fracid.specimens.mesh_reading` (its names are importable from here too);
+The file is read by :mod:`fracid.specimens.mesh_reading` (import its names from there);
 this module checks the groups against the mesh and writes a description's mesh as a Gmsh file
 (:func:`write_gmsh`).
 """
@@ -24,12 +24,11 @@ import numpy as np
 
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.mesh_section import SECTION
-from fracid.specimens.mesh_reading import MeshError, PlaneMesh, mesh_size, mesh_unknowns, plane_mesh, read_mesh
+from fracid.specimens.mesh_reading import MeshError, PlaneMesh, mesh_size, mesh_unknowns, read_mesh
 from fracid.specimens.protocol import (BYTES_PER_UNKNOWN, MAX_UNKNOWNS, Resolution, SizeEstimate, SpecimenDefaults,
                                        SpecimenSection)
 
-__all__ = ["MeshError", "MeshSpecimen", "PlaneMesh", "mesh_size", "mesh_unknowns", "plane_mesh", "read_mesh",
-           "write_gmsh"]
+__all__ = ["MeshSpecimen", "write_gmsh"]
 
 _COMPONENTS = {"x": 0, "y": 1}
 

@@ -145,7 +145,9 @@ class Specimen(Protocol):
     ``config_section`` reads and checks its ``[specimen]`` section when that is not its dataclass fields
     (a :class:`SpecimenSection`; None: the fields are the keys). ``snap_back_control`` is the control that
     grows through a snap-back (an opening across the crack; None: none is known).
-    ``default_instance()`` is the specimen with its defaults (None when it needs the user's input).
+    ``refined(factor)`` is the same specimen with its element size where it localises divided by ``factor``
+    (the discretisation error's finer mesh). ``default_instance()`` is the specimen with its defaults (None when
+    it needs the user's input).
     """
 
     size_field: str | None
@@ -170,6 +172,8 @@ class Specimen(Protocol):
     def resolution(self, internal_length: float | None = None) -> Resolution: ...
 
     def size_estimate(self) -> SizeEstimate: ...
+
+    def refined(self, factor: float): ...
 
     def options_text(self, options: dict) -> str: ...
 
@@ -240,6 +244,29 @@ class SpecimenDefaults:
         """The options given in ``[specimen]`` in words: ``"depth = 100, h_fine = 2"``, or ``"defaults"``."""
         return ", ".join(f"{k} = {v}" for k, v in options.items()) or "defaults"
 
+    def refined(self, factor: float):
+        """The same specimen with its element size where it localises divided by ``factor`` (< 1: coarser).
+
+        Through the field :meth:`resolution` names: an element size (``h_fine``) divided by ``factor``, an element
+        count (``n_elements``) multiplied by it and rounded (the actual ratio is the two resolutions' ``h``).
+
+        Raises
+        ------
+        ValueError
+            When no field sets the element size (a mesh file, a fixed mesh), naming the specimen.
+        """
+        resolution = self.resolution()
+        if resolution.field == "n_elements":
+            count = max(3, int(round(self.n_elements * factor)))
+            try:
+                return dataclasses.replace(self, n_elements=count)
+            except ValueError:  # a count it refuses (the tension strip's is odd): the next one
+                return dataclasses.replace(self, n_elements=count + 1)
+        if resolution.field is not None and isinstance(resolution.value, (int, float)):
+            return dataclasses.replace(self, **{resolution.field: resolution.value / factor})
+        raise ValueError(f"{type(self).__name__}: no field sets its element size ({resolution.text}), so fracid "
+                         "cannot make a refined mesh of it; give meshes of two sizes yourself")
+
     @classmethod
     def default_instance(cls):
         """The specimen with its default fields (None for one that needs the user's input, e.g. a file)."""
@@ -274,31 +301,12 @@ def bar_resolution(length: float, n_elements: int, internal_length: float | None
 def refined(specimen, factor: float):
     """The same specimen with its element size where it localises divided by ``factor`` (< 1: coarser).
 
-    Its own ``refined(factor)`` when it has one (the notched beam, the dog-bone), else the field its
-    :meth:`~Specimen.resolution` names: an element size (``h_fine``) divided by ``factor``, an element count
-    (``n_elements``) multiplied by it and rounded (the actual ratio is the two resolutions' ``h``).
+    The specimen's declared :meth:`~Specimen.refined` (:meth:`SpecimenDefaults.refined`: through the field its
+    resolution names; the notched beam and the dog-bone have their own).
 
     Raises
     ------
     ValueError
         When no field sets the element size (a mesh file, a fixed mesh), naming the specimen.
     """
-    own = getattr(specimen, "refined", None)
-    if own is not None:
-        return own(factor)
-    resolution = specimen.resolution()
-    if resolution.field == "n_elements":
-        count = max(3, int(round(specimen.n_elements * factor)))
-        try:
-            return dataclasses.replace(specimen, n_elements=count)
-        except ValueError:  # a count it refuses (the tension strip's is odd): the next one
-            return dataclasses.replace(specimen, n_elements=count + 1)
-    if resolution.field is not None and isinstance(resolution.value, (int, float)):
-        return dataclasses.replace(specimen, **{resolution.field: resolution.value / factor})
-    raise ValueError(f"{type(specimen).__name__}: no field sets its element size ({resolution.text}), so fracid cannot "
-                     "make a refined mesh of it; give meshes of two sizes yourself")
-
-
-def field_names(cls) -> tuple:
-    """The dataclass fields of a specimen class (its ``[specimen]`` keys besides type and control)."""
-    return tuple(f.name for f in dataclasses.fields(cls)) if dataclasses.is_dataclass(cls) else ()
+    return specimen.refined(factor)

@@ -18,7 +18,8 @@ from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
 from fracid.specimens.protocol import FineSizeDefaults
 from fracid.specimens.description import Description
-from fracid.specimens.mesh import MeshSpecimen, plane_mesh
+from fracid.specimens.mesh import MeshSpecimen
+from fracid.specimens.mesh_reading import plane_mesh
 from fracid.specimens.meshing import graded_lines, structured_quad8
 
 COARSE_PER_SIZE = 0.125  # default h_coarse / min(width, height): 25 mm for the default 200 mm cube

@@ -31,8 +31,6 @@ from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 
 #: prior std of the rigid translations [mm] (and of the rotation's displacement at the farthest point)
 RIGID_STD = 1.0
-#: the modes' names, in the order of the columns of :func:`rigid_modes`
-MODES = ("tx", "ty", "theta")
 
 
 def rigid_modes(points, components) -> np.ndarray:
@@ -122,4 +120,4 @@ def fit_rigid_motion(points, components, residual, covariance: Covariance | None
     return motion, fitted
 
 
-__all__ = ["MODES", "RIGID_STD", "fit_rigid_motion", "rigid_modes", "with_rigid_motion"]
+__all__ = ["RIGID_STD", "fit_rigid_motion", "rigid_modes", "with_rigid_motion"]

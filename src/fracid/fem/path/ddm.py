@@ -34,7 +34,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from fracid.fem.mesh.assembly import dot
-from fracid.fem.path.linear_solvers import factorize, linear_solver
+from fracid.fem.path.linear_backend import factorize
+from fracid.fem.path.linear_solvers import linear_solver
 from fracid.fem.path.solver import SolverStatistics
 from fracid.fem.path.linear_backend import refine
 from fracid.fem.formulations.protocol import initial_history

@@ -13,9 +13,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from fracid.fem.path.linear_backend import LinearSolver, SingularMatrixError, factorize
+from fracid.fem.path.linear_backend import LinearSolver, SingularMatrixError
 
-__all__ = ["LinearSolver", "SingularMatrixError", "SuperLUSolver", "SymmetricOrdering", "factorize", "linear_solver"]
+__all__ = ["SuperLUSolver", "SymmetricOrdering", "linear_solver"]
 
 
 class SuperLUSolver:

@@ -13,7 +13,7 @@ from fracid.fem.path import ddm
 from fracid.fem.path.ddm import ConcurrentDerivatives, PathDerivatives
 from fracid.fem.path.recorder import ProbeSampler, Recorder, probed_at
 from fracid.fem.path import linear_solvers
-from fracid.fem.path.linear_solvers import SingularMatrixError
+from fracid.fem.path.linear_backend import SingularMatrixError
 from fracid.fem.formulations.protocol import initial_history
 from fracid.fem.path.solver import ControlledSystem, IncrementFailed, NewtonOptions, SolverStatistics, solve_increment
 from fracid.fem.path.step_sizes import StepSizes, check_steps

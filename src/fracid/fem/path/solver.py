@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fracid.fem.mesh.assembly import SparsePattern, dot, norm2
-from fracid.fem.path.linear_solvers import SingularMatrixError, factorize
+from fracid.fem.path.linear_backend import SingularMatrixError, factorize
 
 
 class IncrementFailed(RuntimeError):
