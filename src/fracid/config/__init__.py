@@ -66,7 +66,6 @@ from fracid.config.schema import (
     MAX_UNKNOWNS,
     Config,
     ConfigError,
-    ExperimentConfig,
     IdentifyConfig,
     ModelConfig,
     OutputConfig,
@@ -79,7 +78,6 @@ from fracid.config.schema import (
 __all__ = [
     "Config",
     "ConfigError",
-    "ExperimentConfig",
     "IdentifyConfig",
     "ModelConfig",
     "OutputConfig",
