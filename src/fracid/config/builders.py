@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import contextlib
 
+import numpy as np
+
 
 from fracid.config.checker import show
 from fracid.config.registry import model_of, model_parameters, specimen_class
@@ -182,6 +184,24 @@ def build_operator(cfg: Config, data):
     """
     _require(cfg, "experiments")
     return _operator(cfg, cfg.calibration, data)
+
+
+def build_view_coordinates(cfg: Config, operator, data) -> dict:
+    """The coordinates of every calibration block whose kind names a report view, by block name, for
+    :func:`fracid.report.views.block_views`: its observation's ``coordinates()`` (a field's frame, component,
+    point, x, y [mm], control [mm]), ``view`` (the kind's view name) and ``covariance`` (the block's data
+    covariance, the noise its residual is measured against).
+
+    ``operator`` and ``data`` are :func:`build_operator`'s and :func:`build_data`'s (their blocks line up with
+    the calibration ``[[experiments]]``).
+    """
+    coordinates = {}
+    for exp, observation, (name, start, stop) in zip(cfg.calibration, operator.observations, data.blocks):
+        view = experiment_kind(exp).view
+        if view is not None:
+            coordinates[name] = {**observation.coordinates(), "view": view,
+                                 "covariance": data.covariance.take(np.arange(start, stop))}
+    return coordinates
 
 
 def build_held_out(cfg: Config) -> list:

@@ -174,7 +174,7 @@ def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | No
     control_label : str, optional
         The x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
     skip : collection of str
-        Blocks not drawn: displacement fields (:func:`fracid.report.field_figures.field_block_names`), which
+        Blocks not drawn: those with a view of their own (:func:`fracid.report.views.view_block_names`), which
         are no curves against the control and have maps of their own. None is returned when no block is left.
     """
     y_exp = float_array(result.y_exp, np.nan)
