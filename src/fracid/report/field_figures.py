@@ -1,7 +1,7 @@
 """Maps of a displacement-field (DIC) block at the estimate: measured, computed and residual, frame by frame,
 and the field's report view (:func:`field_view`, the view ``"field"`` of :data:`fracid.report.views.VIEWS`).
 
-A field block (:class:`~fracid.inverse.core.observations.FieldObservation`) holds the displacement components at
+A field block (:class:`~fracid.inverse.core.field_observations.FieldObservation`) holds the displacement components at
 points of the specimen's face and at frames (control values); drawn against the control like a curve it is a
 cloud of thousands of points. Here every frame is a figure of maps over the face, and a summary figure follows
 the fit along the frames; the fit itself, each frame's rigid motion removed, is :mod:`fracid.report.field_fit`'s.

@@ -89,9 +89,8 @@ def parameter_label(name: str) -> str:
 def block_quantity(name: str) -> str:
     """Axis label of the measured quantity of a data block: a width [mm] if its name says so,
     else the force [N]."""
-    from fracid.inverse.core.diagnostics import is_force_block
-
-    return "force [N]" if is_force_block(name) else f"{name} [mm]"
+    lowered = str(name).lower()
+    return f"{name} [mm]" if "width" in lowered or "fpz" in lowered else "force [N]"
 
 
 #: how a control quantity is written on an axis (others: underscores as spaces)

@@ -12,7 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from fracid.data.sampling import SAMPLINGS
-from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE, FORCE_UNITS, LOCAL_UNITS, ROLES
+from fracid.inverse.core.observations import FORCE
+from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE_UNITS, LOCAL_UNITS, ROLES
 
 #: the keys of a curve block's table (the column keys of every curve kind among them: a block refuses another
 #: kind's with a message naming its own)

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.experiments.curve_table import CURVE_KEYS, read_curve_fields, required
-from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, FORCE, FORCE_UNITS, LOCAL_UNITS
+from fracid.inverse.core.observations import FORCE
+from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, FORCE_UNITS, LOCAL_UNITS
 from fracid.settings.checks import SettingError
 
 

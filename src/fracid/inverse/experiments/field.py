@@ -264,9 +264,9 @@ class FieldKind:
         return self.block(exp, context).data
 
     def observation(self, exp: FieldExperimentConfig, context, name: str, control):
-        """The :class:`~fracid.inverse.core.observations.FieldObservation` of the block, checked against its block
+        """The :class:`~fracid.inverse.core.field_observations.FieldObservation` of the block, checked against its block
         of the data (``control`` [mm])."""
-        from fracid.inverse.core.observations import field_observation
+        from fracid.inverse.core.field_observations import field_observation
 
         observation = field_observation(self.block(exp, context), context.specimen, control=context.control, name=name)
         check_matches(observation, control, exp.file)

@@ -15,9 +15,7 @@ DECIMALS = (".", ",")
 FORCE_UNITS = {"N": 1.0, "kN": 1e3, "MN": 1e6}
 #: ``force_unit`` of a local quantity (a length) -> multiplier to mm
 LOCAL_UNITS = dict(CONTROL_UNITS)
-#: the measured quantity of a force curve (``quantity``'s default; any other is a local observable)
-FORCE = "force"
 #: "source": read and checked, neither calibrated on nor predicted: the field a derived block comes from
 ROLES = ("calibration", "prediction", "source")
 
-__all__ = ["CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE", "FORCE_UNITS", "LOCAL_UNITS", "ROLES"]
+__all__ = ["CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE_UNITS", "LOCAL_UNITS", "ROLES"]

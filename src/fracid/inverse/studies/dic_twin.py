@@ -27,7 +27,7 @@ import numpy as np
 
 from fracid.data.dic.placement import CameraPlacement, rotation_matrix
 from fracid.data.dic_noise import dic_covariance
-from fracid.inverse.core.observations import mirrored_points
+from fracid.inverse.core.field_observations import mirrored_points
 from fracid.inverse.experiments.crack_region import crack_distance
 from fracid.specimens.description import Description
 
@@ -178,7 +178,7 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     both_halves : bool
         For a specimen modelled as a symmetric half about its crack line (``Description.crack.mirrored``): the
         camera sees both halves (the other half's displacements are the mirror image's, as
-        :class:`~fracid.inverse.core.observations.FieldObservation` computes them). Default: the modelled part.
+        :class:`~fracid.inverse.core.field_observations.FieldObservation` computes them). Default: the modelled part.
     seed : int
         Seeds the jitter and the noise.
     **options
