@@ -164,9 +164,10 @@ def table_keys() -> tuple:
 
 
 def read_experiments(ck, blocks: list, context: ReadContext) -> tuple:
-    """The validated blocks in order, each read by its kind (a block of an unknown kind by
-    :data:`FALLBACK_KIND`'s reader, which names the known kinds); the blocks of a derived kind are read last,
-    on the products of their source kind's blocks as read.
+    """The validated blocks in order, each read by its kind (a kind not registered is refused first, naming the
+    known ones; a block without ``kind`` is read by :data:`FALLBACK_KIND`'s reader, which names what is missing in
+    the order of its keys); the blocks of a derived kind are read last, on the products of their source kind's
+    blocks as read.
 
     Returns
     -------
@@ -177,7 +178,10 @@ def read_experiments(ck, blocks: list, context: ReadContext) -> tuple:
     read, products = {}, {}  # index -> config; kind -> name -> [(config, product), ...]
     for derived in (False, True):
         for i, raw in enumerate(blocks):
-            kind = EXPERIMENTS.get(raw.get("kind") if isinstance(raw, dict) else None, EXPERIMENTS[FALLBACK_KIND])
+            named = raw.get("kind") if isinstance(raw, dict) else None
+            if named is not None and named not in EXPERIMENTS:  # the kind decides which keys apply: named first
+                ck.choice(f"experiments[{i}].kind", named, kind_names())
+            kind = EXPERIMENTS.get(named, EXPERIMENTS[FALLBACK_KIND])
             if (kind.source is not None) != derived:
                 continue
             sources = products.get(kind.source, {}) if derived else {}
