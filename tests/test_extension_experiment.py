@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +21,8 @@ from fracid.data.curves import read_curve_csv
 from fracid.data.experimental import with_std
 from fracid.inverse.core.observations import Observation
 from fracid.inverse.experiments.registry import EXPERIMENTS
+from fracid.report.block_view import BlockView
+from fracid.report.views import VIEWS, View
 from fracid.settings.checks import SettingError
 
 #: N per unit of the recorded force column
@@ -152,3 +154,22 @@ def test_fracid_check_and_identify_take_the_new_kind_and_the_report_shows_it(tmp
     diagnostics = fit[fit.index("<h3>Fit diagnostics</h3>"):]
     assert '<td class="text">machine</td>' in diagnostics  # a force: its slope and peak diagnosed
     assert (out / "figures" / "fit.png").is_file()
+
+
+def readings_view(name, coordinates, measured, computed, std, control_label):
+    """A view of its own: a table of the block's values instead of a curve panel."""
+    rows = [[f"{c:.4g}", f"{m:.4g}", f"{f:.4g}"] for c, m, f in zip(coordinates["control"], measured, computed)]
+    return BlockView(name, f"Machine readings {name}", f"{len(rows)} readings, {control_label}",
+                     ["control [mm]", "measured [N]", "computed [N]"], rows)
+
+
+@pytest.mark.slow
+def test_a_kind_naming_a_view_of_its_own_gets_its_section_in_the_report(tmp_path, monkeypatch):
+    monkeypatch.setitem(EXPERIMENTS, KIND.name, replace(KIND, view="readings"))  # the kind names its view
+    monkeypatch.setitem(VIEWS, "readings", View(readings_view))  # the report's view of that name
+    out = tmp_path / "id"
+    assert cli.main(["identify", str(_configured(tmp_path, BLOCK)), "--out", str(out), "--workers", "1",
+                     "--quiet"]) == 0
+    report = (out / "report.html").read_text(encoding="utf-8")
+    assert "<h2>Machine readings machine</h2>" in report and "<th>computed [N]</th>" in report
+    assert report.count("<tr><td>") >= 12  # a row per reading

@@ -9,7 +9,8 @@ one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
 resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
-:func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`simulate_settings`,
+:func:`build_operator`, :func:`build_view_coordinates`, :func:`build_space`, :func:`build_method`,
+:func:`simulate_settings`,
 :func:`posterior_settings`, :func:`error_terms`)
 are pure functions of the validated :class:`Config`.
 
@@ -25,7 +26,8 @@ elements larger than the internal length l = sqrt(2 c)) are returned in ``Config
 The package's modules, each importing only those listed before it: :mod:`~fracid.config.vocabulary`
 (the keys and values of each section), :mod:`~fracid.config.registry` (the model and specimen types),
 :mod:`~fracid.config.schema` (the schema and the validated dataclasses), :mod:`~fracid.config.checker`
-(TOML reading and value checks), :mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments`,
+(TOML reading and value checks), :mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments` (each
+``[[experiments]]`` block read by its kind: :mod:`fracid.inverse.experiments.registry`),
 :mod:`~fracid.config.identify` and :mod:`~fracid.config.posterior` (one validator per section),
 :mod:`~fracid.config.loading` (:func:`load_config`) and :mod:`~fracid.config.builders`.
 

@@ -1,5 +1,5 @@
 """Maps of a displacement-field (DIC) block at the estimate: measured, computed and residual, frame by frame,
-and the field's report view (:func:`field_view`, the view ``"field"`` of :data:`fracid.report.views.VIEWS`).
+and the field's report view (:func:`field_view`, the view ``"displacement-field"`` of :data:`fracid.report.views.VIEWS`).
 
 A field block (:class:`~fracid.inverse.core.field_observations.FieldObservation`) holds the displacement components at
 points of the specimen's face and at frames (control values); drawn against the control like a curve it is a

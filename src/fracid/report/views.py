@@ -47,7 +47,7 @@ class View:
 
 
 #: view name -> :class:`View`; the first is the default of coordinates that name none
-VIEWS = {"field": View(field_view, quantities=("u",), heading="Displacement field {name}",
+VIEWS = {"displacement-field": View(field_view, quantities=("u",), heading="Displacement field {name}",
                        missing="Block {name!r} ({n} values) is a displacement field; its point coordinates are {held}, "
                                "so it is not drawn (a field is no curve against the control). fracid identify draws "
                                "its maps.")}

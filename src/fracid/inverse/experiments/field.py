@@ -250,7 +250,7 @@ class FieldKind:
     keys: tuple = FIELD_KEYS
     column_keys: tuple = ()
     source: str | None = None
-    view: str | None = "field"  # the report's maps and per-frame fit
+    view: str | None = "displacement-field"  # the report's maps and per-frame fit
 
     def read(self, ck, index: int, raw: dict, context) -> tuple:
         """(the validated :class:`FieldExperimentConfig`, its FieldBlock)."""
