@@ -12,7 +12,7 @@ from fracid.inverse.methods.registry import DEFAULT_METHOD
 
 # The kinds of [[experiments]] blocks, their keys and data columns, and the kinds derived from another's blocks
 # are the registry's, asked when a configuration is read (so that a kind registered later is known):
-# fracid.inverse.experiments.registry (kind_names, table_keys, column_keys, derived_kinds); the units and roles
+# fracid.inverse.experiments.registry (kind_names, column_keys, derived_kinds); the units and roles
 # of a block are the kinds' shared vocabulary (fracid.inverse.experiments.vocabulary).
 PURPOSES = ("identify", "simulate")
 

@@ -121,6 +121,9 @@ class ExperimentKind(Protocol):
     ``data(config, context) -> ExperimentalData``, ``observation(config, context, name, control)``
         The block's data and its observation kind at the data's ``control`` values [mm]; ``observation``
         raises :class:`~fracid.settings.checks.SettingError` (a key of the block) or ValueError.
+    ``block(config, context)``
+        Only of a kind another names as its ``source``: the product its derived blocks are computed from
+        (:func:`source_block`).
     """
 
     name: str
@@ -156,11 +159,6 @@ def column_keys() -> dict:
 def derived_kinds() -> tuple:
     """The names of the kinds derived from another kind's blocks."""
     return tuple(name for name, kind in EXPERIMENTS.items() if kind.source is not None)
-
-
-def table_keys() -> tuple:
-    """Every key some kind's table takes, each once."""
-    return tuple(dict.fromkeys(key for kind in EXPERIMENTS.values() for key in kind.keys))
 
 
 def read_experiments(ck, blocks: list, context: ReadContext) -> tuple:
@@ -202,5 +200,4 @@ def source_block(config, context: BuildContext):
 
 
 __all__ = ["EXPERIMENTS", "FALLBACK_KIND", "BuildContext", "ExperimentKind", "ReadContext", "TableChecker",
-           "column_keys", "derived_kinds", "experiment_kind", "kind_names", "read_experiments", "source_block",
-           "table_keys"]
+           "column_keys", "derived_kinds", "experiment_kind", "kind_names", "read_experiments", "source_block"]
