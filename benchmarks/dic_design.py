@@ -54,9 +54,10 @@ from fracid.data.dic.rigid import prior_scales, rigid_modes
 from fracid.data.dic_noise import DIAGONAL_FLOOR, dic_kernel
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.core.observations import FieldObservation
+from fracid.inverse.core.field_observations import FieldObservation
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.studies.dic_twin import crack_distance, inside_mesh, speckle_grid
+from fracid.inverse.experiments.crack_region import crack_distance
+from fracid.inverse.studies.dic_twin import inside_mesh, speckle_grid
 from fracid.inverse.studies.uniqueness import bounds_covariance
 from fracid.specimens.beam import NotchedBeam
 

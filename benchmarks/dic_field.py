@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 from fracid.config import build_data, build_operator
-from fracid.inverse.core.observations import FieldObservation
+from fracid.inverse.core.field_observations import FieldObservation
 from demo_setup import demo_config
 
 ESTIMATE = {"kappa_i": 4.798e-5, "beta": 1086.5, "c": 21.46}  # docs/demo/result.json (rounded)

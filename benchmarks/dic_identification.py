@@ -28,7 +28,7 @@ from fracid.data.covariance_matrix import block_diagonal
 from fracid.data.dic_noise import dic_frames_covariance
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.core.observations import FieldObservation
+from fracid.inverse.core.field_observations import FieldObservation
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import identify
 from fracid.inverse.studies.dic_twin import synthetic_dic

@@ -39,7 +39,7 @@ from fracid.data import Diagonal, ExperimentalData, stack
 from fracid.data.dic import field_block, read_dic_frames
 from fracid.fem.material.parameters import DamageParameters
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.core.observations import field_observation
+from fracid.inverse.core.field_observations import field_observation
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.studies.dic_twin import synthetic_dic, write_dic
 from fracid.inverse.studies.study import StudySettings, run_study

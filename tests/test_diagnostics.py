@@ -81,12 +81,14 @@ def test_width_blocks_have_no_slope_or_peak_and_the_index_replaces_a_missing_con
     y_fit = np.concatenate([curve(stiffness=125.0), [1.0, 2.0, 9.0]])
     std = np.concatenate([STD, [0.1] * 3])
     blocks = [("global", 0, 41), ("fpz_width", 41, 44)]
-    d = fit_diagnostics(None, y, std, y_fit, blocks)
+    d = fit_diagnostics(None, y, std, y_fit, blocks, quantities=["force", "fpz_width"])
     assert [b["block"] for b in d["blocks"]] == ["global"] and d["control"] == "index"
     assert d["worst"]["index"] == 43 and d["worst"]["block"] == "fpz_width"
     assert d["blocks"][0]["slope_ratio"] == pytest.approx(1.25)  # evenly spaced points: the same ratio
     d = fit_diagnostics(None, y, std, y_fit, blocks, quantities=["force", "force"])
-    assert len(d["blocks"]) == 2  # the quantities, when known, decide
+    assert len(d["blocks"]) == 2  # the quantities decide, not the names
+    d = fit_diagnostics(None, y, std, y_fit, blocks)
+    assert len(d["blocks"]) == 2  # none recorded: every block is taken for a force (its default quantity)
 
 
 def test_elastic_points_and_slopes_of_degenerate_blocks():

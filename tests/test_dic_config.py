@@ -120,7 +120,7 @@ def test_the_observation_matches_the_block(example):
     u = dic.u.copy()
     u[2, 4, 1] = np.nan
     block = field_block(dic._replace(u=u), frames=[2, 3, 5], name="dic")
-    from fracid.inverse.core.observations import field_observation
+    from fracid.inverse.core.field_observations import field_observation
 
     field = field_observation(block, beam)
     assert field.size == block.data.n_y and field.name == "dic"

@@ -21,7 +21,8 @@ from fracid.fem.path.path_following import StepOptions
 from fracid.models.forward import simulate
 from fracid.inverse.core.derived_observations import DerivedFieldObservation, derived_observation
 from fracid.inverse.core.forward_operator import ForwardOperator
-from fracid.inverse.core.observations import FieldObservation, ObservationKind, field_observation
+from fracid.inverse.core.field_observations import FieldObservation, field_observation
+from fracid.inverse.core.observations import ObservationKind
 from fracid.inverse.core.sensitivity import CentralDifferences
 from fracid.inverse.studies.dic_twin import rigid_motion, synthetic_dic
 from fracid.models import probe_matrix

@@ -1,5 +1,5 @@
 """[[experiments]] kind = "opening" | "fpz-width": local data derived from a field block of the configuration
-(fracid.config.derived_experiments), on examples/dic (a twin of the notched beam at [model.parameters])."""
+(fracid.inverse.experiments.derived), on examples/dic (a twin of the notched beam at [model.parameters])."""
 
 import re
 from pathlib import Path
@@ -67,7 +67,7 @@ def _chi2(data, name: str, residual) -> float:
 
 def test_the_derived_blocks_are_data_and_observations(twin):
     from fracid.config import build_specimen
-    from fracid.config.builders import _field_block
+    from fracid.inverse.experiments.field import field_block
     from fracid.data.dic.derived import opening_profile
     from fracid.inverse.core.derived_observations import DerivedFieldObservation
 
@@ -80,7 +80,7 @@ def test_the_derived_blocks_are_data_and_observations(twin):
     for observation, name in zip(operator.observations[1:], ("opening", "fpz_width")):
         assert isinstance(observation, DerivedFieldObservation) and observation.name == name
         np.testing.assert_array_equal(observation.controls, data.control[data.block(name)])
-    direct = opening_profile(_field_block(cfg, field), build_specimen(cfg), HEIGHTS, 6.0, radius=5.0)
+    direct = opening_profile(field_block(field, build_specimen(cfg)), build_specimen(cfg), HEIGHTS, 6.0, radius=5.0)
     np.testing.assert_array_equal(data.y[data.block("opening")], direct.data.y)
     np.testing.assert_allclose(data.std[data.block("opening")], direct.data.std)
 

@@ -23,7 +23,7 @@ from fracid.data.dic_noise import dic_frames_covariance
 from fracid.fem.material.parameters import DamageParameters
 from fracid.fem.path.path_following import StepOptions
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
-from fracid.inverse.core.observations import FieldObservation
+from fracid.inverse.core.field_observations import FieldObservation
 from fracid.inverse.core.sensitivity import CentralDifferences
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.strategy import identify

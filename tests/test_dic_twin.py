@@ -178,7 +178,7 @@ def test_the_readers_read_the_twins_files_back_in_the_specimen_frame(noisy, tmp_
 def test_a_camera_on_both_halves_sees_the_mirror_image():
     """both_halves: the grid covers the half beam and its mirror across the crack line x = 0; a point of the other
     half carries the mirror image's displacement (u_x negated), as the field observation computes it."""
-    from fracid.inverse.core.observations import FieldObservation
+    from fracid.inverse.core.field_observations import FieldObservation
 
     data = synthetic_dic(BEAM, PARAMS, frames=FRAMES[:2], spacing=5.0, std=0.0, subset_size=6.0, both_halves=True)
     left = data.points[:, 0] < 0

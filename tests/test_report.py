@@ -56,7 +56,7 @@ def make_result(n_population=20, failed=(7,)):
     return IdentificationResult(
         names=list(NAMES), x=X.copy(), C=C, y_exp=np.concatenate([Y_FORCE, Y_WIDTH]),
         y_fit=np.concatenate([FIT_FORCE, FIT_WIDTH]), std_exp=np.concatenate([np.full(8, 2.0), np.full(4, 0.5)]),
-        blocks=[("global", 0, 8), ("fpz_width", 8, 12)], history=history,
+        blocks=[("global", 0, 8), ("fpz_width", 8, 12)], quantities=["force", "fpz_width"], history=history,
         knn={"points": points, "f": f, "status": status, "errors": errors, "order": order, "k": k, "x0": x0,
              "C0": C0, "method": "sobol", "seed": 0},
         runs={"knn": n_population, "knn_failed": len(failed), "kalman": 43, "kalman_run_equivalents": 21.5,

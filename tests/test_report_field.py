@@ -1,4 +1,4 @@
-"""The report's displacement-field maps (fracid.report.field_figures): the rigid motion of every frame recovered
+"""The report's displacement-field maps (fracid.report.field_figures, fracid.report.views): the rigid motion of every frame recovered
 from a synthetic field, the residual at the noise level, the figures' panels and titles, the report's section
 per field block (and no curve panel for it), and ``fracid identify`` on a small copy of examples/dic."""
 
@@ -17,6 +17,8 @@ from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.report import write_report
 
 ff = pytest.importorskip("fracid.report.field_figures")  # needs matplotlib
+field_fit = pytest.importorskip("fracid.report.field_fit")
+block_view = pytest.importorskip("fracid.report.block_view")
 figures = pytest.importorskip("fracid.report.figures")
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dic"
@@ -73,7 +75,7 @@ def marginalised_covariance(field) -> object:
 
 
 def fit_of(field, **noise):
-    return ff.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"],
+    return field_fit.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"],
                         field["computed"], control=field["control"], **noise)
 
 
@@ -119,7 +121,7 @@ def test_the_points_are_told_apart_by_position_without_their_index(field):
 def test_a_missing_computed_frame_has_no_residual(field):
     computed = field["computed"].copy()
     computed[field["frame"] == 2] = np.nan  # the run did not reach the last frame
-    fit = ff.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"], computed,
+    fit = field_fit.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"], computed,
                        std=np.full(computed.size, NOISE))
     assert np.all(np.isnan(fit.motions[2])) and fit.values[2] == 0 and np.isfinite(fit.motions[:2]).all()
     assert np.all(np.isnan(fit.controls))  # no control given: the frames are numbered in the figures
@@ -128,9 +130,9 @@ def test_a_missing_computed_frame_has_no_residual(field):
 
 def test_bad_arguments_are_named(field):
     with pytest.raises(ValueError, match="std .* or covariance"):
-        ff.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"], field["computed"])
+        field_fit.fit_field(field["x"], field["y"], field["frame"], field["component"], field["measured"], field["computed"])
     with pytest.raises(ValueError, match="one value per entry"):
-        ff.fit_field(field["x"][:-1], field["y"], field["frame"], field["component"], field["measured"],
+        field_fit.fit_field(field["x"][:-1], field["y"], field["frame"], field["component"], field["measured"],
                      field["computed"], std=np.ones(field["x"].size))
 
 
@@ -154,7 +156,7 @@ def test_frame_figure_maps_measured_computed_and_residual_per_component(field):
 
 def test_one_component_gives_one_row_and_a_few_points_are_scattered():
     points = np.array([[0.0, 0.0], [10.0, 0.0]])  # two points: no triangle, coloured points instead
-    fit = ff.fit_field(points[:, 0], points[:, 1], [0, 0], [1, 1], [0.001, 0.002], [0.0, 0.001],
+    fit = field_fit.fit_field(points[:, 0], points[:, 1], [0, 0], [1, 1], [0.001, 0.002], [0.0, 0.001],
                        std=[NOISE, NOISE])
     fig = ff.frame_figure(fit, 0)
     assert len([ax for ax in fig.axes if ax.get_label() != "<colorbar>"]) == 3
@@ -284,7 +286,7 @@ def test_write_figures_writes_the_field_maps_as_png(field_report, tmp_path):
 
 
 def test_a_block_name_is_made_fit_for_a_file_name():
-    assert ff.file_stem("dic/left face 1") == "dic_left_face_1"
+    assert block_view.file_stem("dic/left face 1") == "dic_left_face_1"
 
 
 # ------------------------------------------------------------------------------------ fracid identify

@@ -66,7 +66,8 @@ def identification(args, job, store, executor):
 
 def write_identification(args, job, out, result) -> None:
     """What ``fracid identify`` writes and prints: result.json, fit.csv, report.html, figures, summary, warnings."""
-    from fracid.report.field_figures import block_views
+    from fracid.config import build_view_coordinates
+    from fracid.report.views import block_views
     from fracid.report.figures import rendered_once
     from fracid.report.html import write_report
     from fracid.store.tables import write_csv_table
@@ -78,7 +79,7 @@ def write_identification(args, job, out, result) -> None:
         block_of[a:b] = name
     write_csv_table(out / "fit.csv", ("control_mm", "measured", "std", "computed", "block"),
                     zip(data.control.tolist(), data.y.tolist(), data.std.tolist(), result.y_fit.tolist(), block_of))
-    views = block_views(result, field_coordinates(job))
+    views = block_views(result, build_view_coordinates(job.cfg, job.operator, job.data))
     with rendered_once():  # the report's figures are figures/'s
         write_report(out / "report.html", result, control=data.control,
                      title=f"fracid identification: {Path(job.cfg.path).name}", data_notes=data.notes, views=views)
@@ -116,28 +117,12 @@ def stage_plans(method, operator, n_y: int, p: int) -> list[str]:
     return [stage.line() for stage in plan(operator, n_y, p)]
 
 
-def field_coordinates(job) -> dict:
-    """The coordinates of every displacement-field block, by name, for the report's maps: the operator's field
-    observation kinds' ``coordinates()`` (frame, component, point, x, y [mm], control [mm]) with the block's data
-    covariance [mm^2] (the noise the residual is measured against)."""
-    from fracid.inverse.core.observations import FieldObservation
-
-    blocks = {name: (start, stop) for name, start, stop in job.data.blocks}
-    fields = {}
-    for kind in job.operator.observations:
-        if isinstance(kind, FieldObservation) and kind.name in blocks:
-            start, stop = blocks[kind.name]
-            fields[kind.name] = {**kind.coordinates(), "kind": "field",
-                                 "covariance": job.data.covariance.take(np.arange(start, stop))}
-    return fields
-
-
 def write_figures(directory: Path, result, control, fields=None, views=None) -> None:
-    """The report's figures as PNG files too; a displacement field's as ``field_<name>_summary.png`` and
-    ``field_<name>_frame<k>.png`` (``fields``: the coordinates of the field blocks, or ``views``: the views
-    built from them)."""
+    """The report's figures as PNG files too; a block view's under the stems of its figures (a displacement
+    field's ``field_<name>_summary.png`` and ``field_<name>_frame<k>.png``; ``fields``: the coordinates of the
+    blocks that have a view, or ``views``: the views built from them)."""
     from fracid.report import figures
-    from fracid.report.field_figures import block_views_and_skipped
+    from fracid.report.views import block_views_and_skipped
     from fracid.report.stage_figures import stage_figures
 
     directory.mkdir(parents=True, exist_ok=True)

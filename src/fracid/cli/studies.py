@@ -49,7 +49,7 @@ def _size_effect(cfg, params, executor, sizes=(), quiet=True):
 
     specimens, measured, calibrated = {}, {}, set()
     for exp in cfg.experiments:
-        if exp.quantity != "force":
+        if not exp.measures_force:
             continue
         specimen = build_specimen(cfg, exp)
         D = specimen_size(specimen)

@@ -9,7 +9,8 @@ one-paragraph message naming the file, the dotted key (``identify.bounds.c``,
 resolved against the directory of the configuration file.
 
 The builders (:func:`build_parameters`, :func:`build_specimen`, :func:`build_data`,
-:func:`build_operator`, :func:`build_space`, :func:`build_method`, :func:`simulate_settings`,
+:func:`build_operator`, :func:`build_view_coordinates`, :func:`build_space`, :func:`build_method`,
+:func:`simulate_settings`,
 :func:`posterior_settings`, :func:`error_terms`)
 are pure functions of the validated :class:`Config`.
 
@@ -25,7 +26,8 @@ elements larger than the internal length l = sqrt(2 c)) are returned in ``Config
 The package's modules, each importing only those listed before it: :mod:`~fracid.config.vocabulary`
 (the keys and values of each section), :mod:`~fracid.config.registry` (the model and specimen types),
 :mod:`~fracid.config.schema` (the schema and the validated dataclasses), :mod:`~fracid.config.checker`
-(TOML reading and value checks), :mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments`,
+(TOML reading and value checks), :mod:`~fracid.config.sections`, :mod:`~fracid.config.experiments` (each
+``[[experiments]]`` block read by its kind: :mod:`fracid.inverse.experiments.registry`),
 :mod:`~fracid.config.identify` and :mod:`~fracid.config.posterior` (one validator per section),
 :mod:`~fracid.config.loading` (:func:`load_config`) and :mod:`~fracid.config.builders`.
 
@@ -52,6 +54,7 @@ from fracid.config.builders import (
     build_parameters,
     build_space,
     build_specimen,
+    build_view_coordinates,
     error_terms,
     posterior_settings,
     simulate_settings,
@@ -66,7 +69,6 @@ from fracid.config.schema import (
     MAX_UNKNOWNS,
     Config,
     ConfigError,
-    ExperimentConfig,
     IdentifyConfig,
     ModelConfig,
     OutputConfig,
@@ -79,7 +81,6 @@ from fracid.config.schema import (
 __all__ = [
     "Config",
     "ConfigError",
-    "ExperimentConfig",
     "IdentifyConfig",
     "ModelConfig",
     "OutputConfig",
@@ -92,6 +93,7 @@ __all__ = [
     "build_space",
     "build_method",
     "build_specimen",
+    "build_view_coordinates",
     "load_config",
     "simulate_settings",
     "build_held_out",

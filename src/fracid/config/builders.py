@@ -8,14 +8,12 @@ import contextlib
 
 import numpy as np
 
+
 from fracid.config.checker import show
 from fracid.config.registry import model_of, model_parameters, specimen_class
-from fracid.config.schema import Config, ConfigError, ExperimentConfig
-from fracid.config.vocabulary import DERIVED_KINDS
+from fracid.config.schema import Config, ConfigError
+from fracid.inverse.experiments.registry import BuildContext, experiment_kind, source_block
 from fracid.settings.checks import SettingError
-
-#: the kinds whose data come from a DIC displacement field: the field and the blocks derived from it
-FIELD_KINDS = ("field", *DERIVED_KINDS)
 
 
 def _require(cfg: Config, section: str):
@@ -38,7 +36,7 @@ def build_parameters(cfg: Config):
     return model_parameters(cfg.model)
 
 
-def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
+def build_specimen(cfg: Config, experiment=None):
     """The specimen object of ``[specimen] type`` (a class of :data:`fracid.specimens.SPECIMENS`) with the
     fields given; with an experiment, its ``specimen`` overrides applied (e.g. the size of one specimen of
     a series)."""
@@ -48,43 +46,12 @@ def build_specimen(cfg: Config, experiment: ExperimentConfig | None = None):
     return specimen_class(cfg.specimen.type)(**options)
 
 
-def _field_block(cfg: Config, exp):
-    """The DIC block of a ``kind = "field"`` experiment (:mod:`fracid.config.field_experiments`: a FieldBlock)
-    or of one derived from a field (:mod:`fracid.config.derived_experiments`: a DerivedBlock, its field read)."""
-    from fracid.config.field_experiments import field_block
-
-    if exp.kind == "field":
-        return field_block(exp, build_specimen(cfg, exp))
-    from fracid.config.derived_experiments import derived_block
-
-    return derived_block(exp, _field_block(cfg, exp.source), build_specimen(cfg, exp))
-
-
-def _experiment_data(cfg: Config, exp: ExperimentConfig):
-    if exp.kind in FIELD_KINDS:
-        return _field_block(cfg, exp).data
-    from fracid.data import from_envelope, from_repeats, read_curve_csv, require_positive_force, with_std
-
-    if exp.kind == "envelope":
-        columns = [exp.mean_column, exp.lower_column, exp.upper_column]
-    else:
-        columns = list(exp.force_columns)
-    curves = read_curve_csv(exp.file, control_column=exp.control_column, force_columns=columns,
-                            control_unit_scale=exp.control_scale * exp.sign("control"),
-                            force_unit_scale=exp.force_scale * exp.sign("force"),
-                            delimiter=exp.delimiter, decimal=exp.decimal,
-                            backtrack_tolerance=exp.backtrack_tolerance_mm)
-    if exp.quantity == "force":
-        require_positive_force(curves)
-    _check_control_scale(cfg, exp, max(float(np.max(curve.control)) for curve in curves))
-    span, sampling = exp.control_range_mm, {"sampling": exp.sampling}
-    if exp.kind == "repeats":
-        return from_repeats(curves, exp.n_points, span, name=exp.name, **sampling)
-    if exp.kind == "envelope":
-        return from_envelope(*curves, exp.n_points, span, name=exp.name, **sampling)
-    if exp.std is not None:
-        return with_std(curves[0], exp.std * exp.force_scale, exp.n_points, span, name=exp.name, **sampling)
-    return with_std(curves[0], exp.relative_std, exp.n_points, span, name=exp.name, relative=True, **sampling)
+def _build_context(cfg: Config, exp) -> BuildContext:
+    """What the experiment's kind builds its data and observation with: its specimen, the runs' control, the
+    check of a curve's control reach, and the product of a source block (for a derived kind)."""
+    return BuildContext(specimen=build_specimen(cfg, exp), control=cfg.specimen.control,
+                        check_reach=lambda e, reach: _check_control_scale(cfg, e, reach),
+                        source_block=lambda source: source_block(source, _build_context(cfg, source)))
 
 
 def _stacked_data(cfg: Config, experiments):
@@ -93,7 +60,7 @@ def _stacked_data(cfg: Config, experiments):
     blocks = []
     for exp in experiments:
         try:
-            block = _experiment_data(cfg, exp)
+            block = experiment_kind(exp).data(exp, _build_context(cfg, exp))
             blocks.append(block.weighted({exp.name: exp.weight}) if exp.weight != 1.0 else block)
         except DataError as err:
             raise ConfigError(f"{cfg.path}: experiments[{exp.index}] (file {exp.file}): {err}") from None
@@ -108,7 +75,7 @@ def _stacked_data(cfg: Config, experiments):
 CONTROL_SCALE_LIMIT = 30.0
 
 
-def _check_control_scale(cfg: Config, exp: ExperimentConfig, reach: float) -> None:
+def _check_control_scale(cfg: Config, exp, reach: float) -> None:
     """Refuse data whose control reaches far beyond, or stops far short of, the control at which the
     specimen has long failed: blamed on ``control_unit`` unless a bound or a parameter value explains it."""
     specimen, model = build_specimen(cfg, exp), build_model(cfg)
@@ -148,7 +115,7 @@ def _unusual_values(cfg: Config, params) -> str:
     return "; or " + ", ".join(unusual) if unusual else ""
 
 
-def _blame_short_reach(cfg: Config, exp: ExperimentConfig, reach: float, targets: dict, params) -> None:
+def _blame_short_reach(cfg: Config, exp, reach: float, targets: dict, params) -> None:
     """When data stop deep in the elastic range of some parameters: a ConfigError naming the parameter value
     or the upper bound that puts failure so far out, if the data are plausible for the others."""
     from fracid.models import implausible, usual_range_text
@@ -169,7 +136,7 @@ def _blame_short_reach(cfg: Config, exp: ExperimentConfig, reach: float, targets
                       "Lower it, or check its unit")
 
 
-def build_experiment_data(cfg: Config, experiment: ExperimentConfig):
+def build_experiment_data(cfg: Config, experiment):
     """The data of one experiment (any role), weighted."""
     return _stacked_data(cfg, [experiment])
 
@@ -189,42 +156,25 @@ def build_data(cfg: Config):
 
 
 def _operator(cfg: Config, experiments, data):
-    from fracid.inverse.core.forward_operator import ForwardOperator, Observation
+    from fracid.inverse.core.forward_operator import ForwardOperator
 
     identify = _require(cfg, "identify")
     if len(data.blocks) != len(experiments):
         raise ConfigError(f"{cfg.path}: experiments: the data hold {len(data.blocks)} blocks but the configuration "
                           f"has {len(experiments)} such [[experiments]] entries; build the data with build_data(cfg)")
-    observations = []
-    for exp, (name, start, stop) in zip(experiments, data.blocks):
-        if exp.kind in FIELD_KINDS:
-            observations.append(_field_observation(cfg, exp, name, data.control[start:stop]))
-            continue
-        try:
-            observations.append(Observation(build_specimen(cfg, exp), data.control[start:stop], quantity=exp.quantity,
-                                            control=cfg.specimen.control, name=name,
-                                            damage_threshold=exp.damage_threshold))
-        except ValueError as err:
-            raise ConfigError(f"{cfg.path}: experiments[{exp.index}].control_range = "
-                              f"{show(exp.control_range and list(exp.control_range))}: {err}") from None
+    observations = [_observation(cfg, exp, name, data.control[start:stop])
+                    for exp, (name, start, stop) in zip(experiments, data.blocks)]
     return ForwardOperator(observations, build_parameters(cfg), identify.parameters, model=build_model(cfg))
 
 
-def _field_observation(cfg: Config, exp, name: str, control):
-    """The FieldObservation of a field experiment (the DerivedFieldObservation of one derived from a field),
-    checked against its block of the data (``control``)."""
-    block = _field_block(cfg, exp)
-    if exp.kind == "field":
-        from fracid.inverse.core.observations import field_observation as observation
-    else:
-        from fracid.inverse.core.derived_observations import derived_observation as observation
-
-    field = observation(block, build_specimen(cfg, exp), control=cfg.specimen.control, name=name)
-    if field.size != len(control) or not np.array_equal(field.controls, control):
-        raise ConfigError(f"{cfg.path}: experiments[{exp.index}]: the data's block {name!r} does not match the field "
-                          f"of {exp.file} ({len(control)} values, the field {field.size}); build the data with "
-                          "build_data(cfg)")
-    return field
+def _observation(cfg: Config, exp, name: str, control):
+    """The observation kind of an experiment (its kind's), at its block's control values [mm]."""
+    try:
+        return experiment_kind(exp).observation(exp, _build_context(cfg, exp), name, control)
+    except SettingError as err:
+        raise ConfigError(f"{cfg.path}: experiments[{exp.index}].{err.key} = {show(err.value)}: {err.allowed}") from None
+    except ValueError as err:
+        raise ConfigError(f"{cfg.path}: experiments[{exp.index}]: {err}") from None
 
 
 def build_operator(cfg: Config, data):
@@ -235,6 +185,24 @@ def build_operator(cfg: Config, data):
     """
     _require(cfg, "experiments")
     return _operator(cfg, cfg.calibration, data)
+
+
+def build_view_coordinates(cfg: Config, operator, data) -> dict:
+    """The coordinates of every calibration block whose kind names a report view, by block name, for
+    :func:`fracid.report.views.block_views`: its observation's ``coordinates()`` (a field's frame, component,
+    point, x, y [mm], control [mm]), ``view`` (the kind's view name) and ``covariance`` (the block's data
+    covariance, the noise its residual is measured against).
+
+    ``operator`` and ``data`` are :func:`build_operator`'s and :func:`build_data`'s (their blocks line up with
+    the calibration ``[[experiments]]``).
+    """
+    coordinates = {}
+    for exp, observation, (name, start, stop) in zip(cfg.calibration, operator.observations, data.blocks):
+        view = experiment_kind(exp).view
+        if view is not None:
+            coordinates[name] = {**observation.coordinates(), "view": view,
+                                 "covariance": data.covariance.take(np.arange(start, stop))}
+    return coordinates
 
 
 def build_held_out(cfg: Config) -> list:

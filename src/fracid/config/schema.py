@@ -95,7 +95,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     backtrack_tolerance = 0.002         # optional number >= 0 in control_unit: the largest backtrack of the
                                         #   control column dropped as noise (default 1 % of its range)
 
-    [[experiments]]                     # a DIC displacement field (fracid.config.field_experiments):
+    [[experiments]]                     # a DIC displacement field (fracid.inverse.experiments.field):
     kind = "field"                      #   its own keys, read while checking; examples/dic/identify.toml
     frames_file = "frames.csv"          # required: frame table (frame, file, load columns), relative here
     control_column = "cmod_mm"          # required: the table's control value of each frame [mm]
@@ -117,7 +117,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     # point_spacing = 3.0               # mm: thin a dense field to one point per square of this side
     # name = "field", weight = 1.0, role = "calibration"
 
-    [[experiments]]                     # local data derived from a field block (fracid.config.derived_experiments):
+    [[experiments]]                     # local data derived from a field block (fracid.inverse.experiments.derived):
     kind = "opening"                    #   "opening": the crack-opening profile by virtual extensometers across
                                         #   the crack | "fpz-width": the process-zone width by strain transects
     field = "field"                     # required: the name of a kind = "field" block of this file; give that
@@ -228,7 +228,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fracid.config.registry import model_of
-from fracid.config.vocabulary import CONTROL_UNITS, DEFAULT_INVERSE_METHOD, FORCE_UNITS, LOCAL_UNITS
+from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD
 from fracid.inverse.methods.knn_settings import MAX_POPULATION  # noqa: F401 (re-exported: a limit of the configuration)
 from fracid.inverse.sampling.posterior import PosteriorSettings
 from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
@@ -278,63 +278,6 @@ class SpecimenConfig:
     type: str
     control: str
     options: tuple = ()  # ((field, value), ...) as given, type-checked
-
-
-@dataclass(frozen=True)
-class ExperimentConfig:
-    """One ``[[experiments]]`` block (``index`` is its position, ``file`` an absolute path)."""
-
-    index: int
-    file: Path
-    control_column: str
-    control_unit: str
-    force_unit: str
-    kind: str
-    n_points: int
-    force_columns: tuple = ()
-    mean_column: str | None = None
-    lower_column: str | None = None
-    upper_column: str | None = None
-    std: float | None = None
-    relative_std: float | None = None
-    control_range: tuple | None = None  # in control_unit, as given
-    quantity: str = "force"
-    name: str = "global"
-    specimen: tuple = ()  # ((field, value), ...) overriding [specimen] for this test (e.g. its size)
-    weight: float = 1.0
-    damage_threshold: float = 0.0
-    role: str = "calibration"
-    delimiter: str = ","  # the cell separator itself ("tab" is stored as "\t"; " " is any whitespace)
-    decimal: str = "."
-    backtrack_tolerance: float | None = None  # in control_unit, as given; None: 1 % of the control range
-    negate: tuple = ()  # of "control", "force": columns the machine records with a negative sign
-    sampling: str = "equally-spaced"  # or "measured" (fracid.data.experimental.SAMPLINGS)
-
-    def sign(self, column: str) -> float:
-        """-1 if the ``column`` ("control" or "force") is to be negated, else 1."""
-        return -1.0 if column in self.negate else 1.0
-
-    @property
-    def control_scale(self) -> float:
-        """Multiplier from ``control_unit`` to mm."""
-        return CONTROL_UNITS[self.control_unit]
-
-    @property
-    def force_scale(self) -> float:
-        """Multiplier from ``force_unit`` to N (force) or to mm (local quantity)."""
-        return (FORCE_UNITS if self.quantity == "force" else LOCAL_UNITS)[self.force_unit]
-
-    @property
-    def control_range_mm(self) -> tuple | None:
-        """``control_range`` in mm."""
-        if self.control_range is None:
-            return None
-        return tuple(v * self.control_scale for v in self.control_range)
-
-    @property
-    def backtrack_tolerance_mm(self) -> float | None:
-        """``backtrack_tolerance`` in mm (None: the reader's default, 1 % of the control range)."""
-        return None if self.backtrack_tolerance is None else self.backtrack_tolerance * self.control_scale
 
 
 @dataclass(frozen=True)
@@ -400,7 +343,7 @@ class Config:
     purpose: str
     model: ModelConfig
     specimen: SpecimenConfig
-    experiments: tuple  # of ExperimentConfig; empty if none given
+    experiments: tuple  # of the kinds' validated blocks (fracid.inverse.experiments); empty if none given
     identify: IdentifyConfig | None
     output: OutputConfig
     simulate: SimulateConfig

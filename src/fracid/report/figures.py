@@ -89,9 +89,8 @@ def parameter_label(name: str) -> str:
 def block_quantity(name: str) -> str:
     """Axis label of the measured quantity of a data block: a width [mm] if its name says so,
     else the force [N]."""
-    from fracid.inverse.core.diagnostics import is_force_block
-
-    return "force [N]" if is_force_block(name) else f"{name} [mm]"
+    lowered = str(name).lower()
+    return f"{name} [mm]" if "width" in lowered or "fpz" in lowered else "force [N]"
 
 
 #: how a control quantity is written on an axis (others: underscores as spaces)
@@ -174,7 +173,7 @@ def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | No
     control_label : str, optional
         The x-axis label (e.g. ``"CMOD [mm]"``); by default from the result's ``control_names``.
     skip : collection of str
-        Blocks not drawn: displacement fields (:func:`fracid.report.field_figures.field_block_names`), which
+        Blocks not drawn: those with a view of their own (:func:`fracid.report.views.view_block_names`), which
         are no curves against the control and have maps of their own. None is returned when no block is left.
     """
     y_exp = float_array(result.y_exp, np.nan)

@@ -26,7 +26,7 @@ def fit_metrics(result, skip=()) -> list[dict]:
     result : IdentificationResult
     skip : collection of str
         Blocks left out: displacement fields (peaks and a diagonal objective share mean nothing for them; their
-        own section gives their fit, :mod:`fracid.report.field_figures`).
+        own section gives their fit, :mod:`fracid.report.views`).
 
     Returns
     -------
@@ -179,7 +179,7 @@ def notes_section(result, data_notes) -> str:
 
 
 def block_view_section(view) -> str:
-    """The section of a block that is not a curve (:class:`~fracid.report.field_figures.BlockView`: a
+    """The section of a block that is not a curve (:class:`~fracid.report.block_view.BlockView`: a
     displacement field's maps per frame): heading, text, table, figures."""
     table = html_table(view.header, view.rows) if view.rows else ""
     images = "\n".join(html_image(view.png(stem), stem.replace("_", " "), caption)
@@ -214,14 +214,15 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         How the result was obtained (:func:`fracid.store.provenance.collect`); the result's ``provenance``
         when omitted. Shown last, collapsed: "How this was run".
     fields : dict of str -> dict, optional
-        The coordinates of the displacement-field blocks, by block name: the observation kind's
-        ``coordinates()`` (``frame``, ``component``, ``point``, ``x``, ``y`` [mm], ``control`` [mm]), optionally
-        with ``covariance`` (the block's data covariance [mm^2]) and ``kind`` (a key of
-        :data:`fracid.report.field_figures.BLOCK_VIEWS`, ``"field"`` by default). Each such block gets a section
-        "Displacement field <name>" (maps per frame, a summary, a table per frame) instead of a curve panel; a
-        field block without coordinates (its quantity ``"u"``) is named but not drawn.
+        The coordinates of the blocks that have a view, by block name: the observation kind's ``coordinates()``
+        (for a displacement field ``frame``, ``component``, ``point``, ``x``, ``y`` [mm], ``control`` [mm]),
+        optionally with ``covariance`` (the block's data covariance [mm^2]) and ``view`` (a key of
+        :data:`fracid.report.views.VIEWS`; by default the view of the block's quantity). Each such block gets
+        the section of its view (a displacement field: "Displacement field <name>", maps per frame, a summary, a
+        table per frame) instead of a curve panel; a block without coordinates whose quantity a view shows
+        (a field's ``"u"``) is named but not drawn.
     views : list of BlockView, optional
-        The views already built by :func:`fracid.report.field_figures.block_views` (``fields`` is then not used):
+        The views already built by :func:`fracid.report.views.block_views` (``fields`` is then not used):
         ``fracid identify`` builds them once for the report and figures/.
 
     Returns
@@ -230,7 +231,7 @@ def write_report(path, result, *, control=None, title: str = "fracid identificat
         The file written.
     """
     from fracid.report import figures  # matplotlib is imported only when a report is written
-    from fracid.report.field_figures import block_views_and_skipped
+    from fracid.report.views import block_views_and_skipped
 
     views, skip = block_views_and_skipped(result, fields, views, control_label)
     date = generated_now()

@@ -1,6 +1,6 @@
 """Observation kinds of local data derived from a displacement field: the model side of :mod:`fracid.data.dic.derived`.
 
-:class:`DerivedFieldObservation` wraps a :class:`~fracid.inverse.core.observations.FieldObservation` of the
+:class:`DerivedFieldObservation` wraps a :class:`~fracid.inverse.core.field_observations.FieldObservation` of the
 crack's normal displacement u_n at the DIC points (its sparse probe matrix, applied by the run at the
 frames) and applies to the model's u_n the estimator the data went through (:class:`~fracid.data.dic.derived.
 Extensometers`: the crack-opening profile; :class:`~fracid.data.dic.derived.StrainTransects`: the
@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.inverse.core.observations import FieldObservation, check_points, check_control_points
+from fracid.inverse.core.field_observations import FieldObservation, check_points
+from fracid.inverse.core.observations import check_control_points
 
 
 def _present(present, shape: tuple) -> np.ndarray:
@@ -94,6 +95,7 @@ class DerivedFieldObservation:
         return self.field.probe_matrix()
 
     quantity = property(lambda self: self.name)  # what the block measures, as a curve kind's ``quantity``
+    measures_force = False  # lengths [mm]
 
     @property
     def run_key(self) -> tuple:

@@ -19,6 +19,8 @@ import math
 
 import numpy as np
 
+from fracid.inverse.core.observations import FORCE
+
 #: relative difference of the elastic slopes (computed / measured - 1) above which a warning is given [-]
 SLOPE_TOLERANCE = 0.10
 #: relative difference of the peak forces (computed / measured - 1) above which a warning is given [-]
@@ -34,13 +36,10 @@ SAMPLING_NOTE = ("the computed curve is known at the data's control values only:
                  "those at the data points")
 
 
-def is_force_block(name: str, quantity: str | None = None) -> bool:
-    """Whether a data block holds forces: its ``quantity`` is ``"force"`` when known, else its name
-    does not say width or FPZ (a local width [mm])."""
-    if quantity:
-        return quantity == "force"
-    lowered = str(name).lower()
-    return not ("width" in lowered or "fpz" in lowered)
+def measures_force(quantity: str | None) -> bool:
+    """Whether a data block of the observed ``quantity`` holds forces [N]: its quantity is the force, or unknown
+    (a result that records none: the force is a block's default quantity). The block's name is not read."""
+    return not quantity or quantity == FORCE
 
 
 def block_peak(y) -> int | None:
@@ -142,8 +141,8 @@ def fit_diagnostics(control, y, std, y_fit, blocks=(), quantities=()) -> dict:
     blocks : sequence of (name, start, stop)
         Data blocks of y (one block ``"data"`` when empty).
     quantities : sequence of str
-        Observed quantity of each block (``"force"``, ``"fpz_width"``, ...); when empty the block's
-        name decides (:func:`is_force_block`).
+        Observed quantity of each block (``"force"``, ``"fpz_width"``, ...: the observations' ``quantity``);
+        a block of unknown quantity is taken for a force (:func:`measures_force`).
 
     Returns
     -------
@@ -158,7 +157,7 @@ def fit_diagnostics(control, y, std, y_fit, blocks=(), quantities=()) -> dict:
     quantities = list(quantities or []) + [None] * len(blocks)
     out = []
     for (name, start, stop), quantity in zip(blocks, quantities):
-        if is_force_block(name, quantity) and stop > start:
+        if measures_force(quantity) and stop > start:
             part = slice(start, stop)
             out.append({"block": name, **block_diagnostics(x[part], y[part], std[part], y_fit[part])})
     return {"blocks": out, "worst": worst_residual(x, y, std, y_fit, blocks),
@@ -233,4 +232,4 @@ def _percent(ratio: float) -> str:
 
 __all__ = ["ELASTIC_FRACTION", "PEAK_TOLERANCE", "SAMPLING_NOTE", "SIGNIFICANCE", "SLOPE_TOLERANCE",
            "block_diagnostics", "block_peak", "diagnostic_warnings", "diagnostics_lines", "elastic_points",
-           "fit_diagnostics", "is_force_block", "line_slope", "worst_residual"]
+           "fit_diagnostics", "measures_force", "line_slope", "worst_residual"]

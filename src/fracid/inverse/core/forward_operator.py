@@ -17,7 +17,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
-from fracid.inverse.core.observations import FieldObservation, Observation, ObservationKind, check_control_points
+from fracid.inverse.core.field_observations import FieldObservation
+from fracid.inverse.core.observations import Observation, ObservationKind, check_control_points
 from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
 from fracid.models.forward import model_with_regularization
 from fracid.models import ConvergenceError, StepOptions, declared

@@ -27,7 +27,8 @@ import numpy as np
 
 from fracid.data.dic.placement import CameraPlacement, rotation_matrix
 from fracid.data.dic_noise import dic_covariance
-from fracid.inverse.core.observations import mirrored_points
+from fracid.inverse.core.field_observations import mirrored_points
+from fracid.inverse.experiments.crack_region import crack_distance
 from fracid.specimens.description import Description
 
 #: relative tolerance of the point-in-element test (the probe operator has the final word)
@@ -108,32 +109,6 @@ def inside_mesh(nodes, corners, points, *, chunk: int = 256) -> np.ndarray:
     return inside
 
 
-def crack_distance(description: Description, points, span=None) -> np.ndarray:
-    """Distance [mm] of each point to the segment of the specimen's crack line over ``span``.
-
-    Parameters
-    ----------
-    description : Description
-        The specimen's; its ``crack`` names the node set on the straight crack line.
-    points : array_like, shape (n, 2)
-        Specimen coordinates [mm].
-    span : (float, float), optional
-        Range of the crack line's along coordinate [mm]; by default from the mesh's edge (the notch's
-        mouth) to the middle of the crack path's node set (the notch and the lower half of the ligament).
-    """
-    crack = description.crack
-    if crack is None or crack.nodes is None:
-        raise ValueError("holes near the crack need a specimen with a crack path (Description.crack); "
-                         "this one has none: give holes=None")
-    line = description.nodes[description.nodes_of(crack.nodes)]
-    normal, along = crack.normal, 1 - crack.normal
-    if span is None:
-        span = (description.nodes[:, along].min(), 0.5 * (line[:, along].min() + line[:, along].max()))
-    lo, hi = sorted(float(s) for s in span)
-    points = np.asarray(points, float)
-    return np.hypot(points[:, normal] - line[:, normal].mean(), points[:, along] - np.clip(points[:, along], lo, hi))
-
-
 def _rigid_body(rigid_body, n_frames: int) -> np.ndarray:
     rb = np.asarray(rigid_body, float)
     if rb.shape == (3,):
@@ -203,7 +178,7 @@ def synthetic_dic(specimen, params, *, model=None, frames, spacing: float, std: 
     both_halves : bool
         For a specimen modelled as a symmetric half about its crack line (``Description.crack.mirrored``): the
         camera sees both halves (the other half's displacements are the mirror image's, as
-        :class:`~fracid.inverse.core.observations.FieldObservation` computes them). Default: the modelled part.
+        :class:`~fracid.inverse.core.field_observations.FieldObservation` computes them). Default: the modelled part.
     seed : int
         Seeds the jitter and the noise.
     **options
@@ -309,5 +284,5 @@ def write_dic(directory, data: SyntheticDic, *, digits: int = 10) -> list[Path]:
     return written + [directory / "frames.csv"]
 
 
-__all__ = ["SyntheticDic", "crack_distance", "inside_mesh", "rigid_motion", "speckle_grid", "synthetic_dic",
+__all__ = ["SyntheticDic", "inside_mesh", "rigid_motion", "speckle_grid", "synthetic_dic",
            "write_dic"]

@@ -73,7 +73,7 @@ def estimate_objective(ident, y, C):
 
 def describe_data(operator) -> DataDescription:
     """Number of specimens with a force curve and whether local data are present."""
-    force = [getattr(obs, "quantity", None) == "force" for obs in operator.observations]
+    force = [getattr(obs, "measures_force", False) for obs in operator.observations]  # a kind that does not say measures no force
     sizes = {obs.run_key[0] for obs, is_force in zip(operator.observations, force) if is_force}
     return DataDescription(sizes=max(len(sizes), 1), local=not all(force))
 

@@ -21,10 +21,10 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from fracid.config.checker import Checker
-from fracid.config.registry import specimen_class
-from fracid.config.schema import SpecimenConfig
-from fracid.config.vocabulary import ROLES
+import numpy as np
+
+from fracid.inverse.experiments.crack_region import away_from_crack
+from fracid.inverse.experiments.vocabulary import ROLES
 
 #: the keys of a field block
 FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "displacement",
@@ -63,6 +63,7 @@ class FieldExperimentConfig:
     quantity: str = "displacement"  # not a curve quantity: studies of force curves skip the block
     specimen: tuple = ()  # no per-experiment specimen overrides
     damage_threshold: float = 0.0
+    measures_force = False  # displacements [mm]
 
 
 def field_block(exp: FieldExperimentConfig, specimen):
@@ -75,30 +76,14 @@ def field_block(exp: FieldExperimentConfig, specimen):
                           placement=exp.placement)
     return block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
                     subset_size=exp.subset_size, rigid_std=exp.rigid_std,
-                    region=_away_from_crack(specimen, exp.exclude_near), point_spacing=exp.point_spacing, name=exp.name)
+                    region=away_from_crack(specimen, exp.exclude_near), point_spacing=exp.point_spacing, name=exp.name)
 
 
-def _away_from_crack(specimen, distance):
-    """None, or the region function keeping the points at least ``distance`` [mm] from the crack path (the
-    straight crack line of the specimen's description, from the mesh's edge to its end)."""
-    if distance is None:
-        return None
-    from fracid.inverse.studies.dic_twin import crack_distance
-
-    d = specimen.describe()
-    if d.crack is None or d.crack.nodes is None:
-        raise ValueError(f"the specimen {type(specimen).__name__} has no straight crack path (Description.crack)")
-    along = 1 - d.crack.normal
-    line = d.nodes[d.nodes_of(d.crack.nodes)]
-    span = (float(d.nodes[:, along].min()), float(line[:, along].max()))
-    return lambda points: crack_distance(d, points, span) >= distance
-
-
-def _optional_number(ck: Checker, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
+def _optional_number(ck, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
     return ck.number(key, raw[name], allowed, ok) if name in raw else None
 
 
-def _point_list(ck: Checker, key: str, value) -> list:
+def _point_list(ck, key: str, value) -> list:
     """A list of [x, y] pairs of numbers."""
     allowed = "must be a list of [x, y] points, e.g. [[0, 0], [100, 0], [0, 50]]"
     if not isinstance(value, list) or not value:
@@ -106,7 +91,7 @@ def _point_list(ck: Checker, key: str, value) -> list:
     return [ck.pair(key, point, allowed) for point in value]
 
 
-def _placement(ck: Checker, prefix: str, raw: dict, unit: str):
+def _placement(ck, prefix: str, raw: dict, unit: str):
     """The CameraPlacement of the keys (scale, rotation_deg, origins; or marked points fitted), or None."""
     from fracid.data import DataError
     from fracid.data.dic import CameraPlacement, fit_placement
@@ -144,7 +129,7 @@ def _placement(ck: Checker, prefix: str, raw: dict, unit: str):
     return CameraPlacement(scale, math.radians(rotation), tuple(origins[0]), tuple(origins[1]))
 
 
-def _rigid_std(ck: Checker, prefix: str, raw: dict) -> float | None:
+def _rigid_std(ck, prefix: str, raw: dict) -> float | None:
     """The prior std of the rigid motion [mm], or None when ``rigid_motion = false``."""
     from fracid.data.dic.rigid import RIGID_STD
 
@@ -161,7 +146,7 @@ def _rigid_std(ck: Checker, prefix: str, raw: dict) -> float | None:
                      "must be a number > 0 [mm], larger than the rigid motion (e.g. 1)", lambda v: v > 0)
 
 
-def _frames(ck: Checker, key: str, raw: dict) -> tuple | None:
+def _frames(ck, key: str, raw: dict) -> tuple | None:
     if "frames" not in raw:
         return None
     value = raw["frames"]
@@ -171,7 +156,7 @@ def _frames(ck: Checker, key: str, raw: dict) -> tuple | None:
     return tuple(value)
 
 
-def _components(ck: Checker, key: str, raw: dict) -> tuple:
+def _components(ck, key: str, raw: dict) -> tuple:
     value = raw.get("components", ["u", "v"])
     values = [value] if isinstance(value, str) else value
     if (not isinstance(values, list) or not values or len(set(map(str, values))) != len(values)
@@ -180,7 +165,7 @@ def _components(ck: Checker, key: str, raw: dict) -> tuple:
     return tuple(values)
 
 
-def _columns(ck: Checker, prefix: str, raw: dict) -> tuple:
+def _columns(ck, prefix: str, raw: dict) -> tuple:
     columns = tuple((k, ck.string(f"{prefix}.{k}", raw[k], "must be a column name (string)") if k in raw else d)
                     for k, d in COLUMN_KEYS.items())
     if "min_quality" in raw and "quality" not in raw:
@@ -207,9 +192,10 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
     return "exclude_near" if "no value left" in message and exp.exclude_near is not None else "frames_file"
 
 
-def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: SpecimenConfig) -> tuple:
+def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
     """The validated field block ``i`` of ``[[experiments]]`` and its :class:`~fracid.data.dic.FieldBlock`, read
-    while checking (the data's size is ``n_points``; the blocks derived from it reuse the FieldBlock)."""
+    while checking (the data's size is ``n_points``; the blocks derived from it reuse the FieldBlock);
+    ``context``: a :class:`~fracid.inverse.experiments.registry.ReadContext`."""
     from fracid.data import DataError
 
     prefix = f"experiments[{i}]"
@@ -217,7 +203,7 @@ def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: 
     if "frames_file" not in raw:
         ck.missing(f"{prefix}.frames_file", "the frame table (CSV with frame, file and load columns), relative to "
                    "the config file")
-    file = ck.file(f"{prefix}.frames_file", raw["frames_file"], base)
+    file = ck.file(f"{prefix}.frames_file", raw["frames_file"], context.base)
     if "control_column" not in raw:
         ck.missing(f"{prefix}.control_column", "the frame table's column of the control value [mm], e.g. 'cmod_mm'")
     control_column = ck.string(f"{prefix}.control_column", raw["control_column"], "must be a column name (string)")
@@ -239,10 +225,55 @@ def read_field_experiment(ck: Checker, i: int, raw: dict, base: Path, specimen: 
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
         role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))
     try:
-        block = field_block(exp, specimen_class(specimen.type)(**dict(specimen.options)))
+        block = field_block(exp, context.specimen())
     except DataError as err:
         key = _blamed_key(exp, str(err))
         ck.fail(f"{prefix}.{key}", raw.get(key, COLUMN_KEYS.get(key)), str(err))
     except ValueError as err:
         ck.fail(f"{prefix}.exclude_near", raw.get("exclude_near"), str(err))
     return replace(exp, n_points=block.data.n_y), block
+
+
+def check_matches(observation, control, file) -> None:
+    """Refuse an observation of a field (or of a block derived from one) whose values are not those of its
+    block of the data (``control`` [mm]): the data were not built from this configuration."""
+    if observation.size != len(control) or not np.array_equal(observation.controls, control):
+        raise ValueError(f"the data's block {observation.name!r} does not match the field of {file} ({len(control)} "
+                         f"values, the field {observation.size}); build the data with build_data(cfg)")
+
+
+@dataclass(frozen=True)
+class FieldKind:
+    """``kind = "field"``: a DIC displacement field; its blocks are sources of the derived kinds."""
+
+    name: str = "field"
+    keys: tuple = FIELD_KEYS
+    column_keys: tuple = ()
+    source: str | None = None
+    view: str | None = "displacement-field"  # the report's maps and per-frame fit
+
+    def read(self, ck, index: int, raw: dict, context) -> tuple:
+        """(the validated :class:`FieldExperimentConfig`, its FieldBlock)."""
+        return read_field_experiment(ck, index, raw, context)
+
+    def block(self, exp: FieldExperimentConfig, context):
+        """The :class:`~fracid.data.dic.FieldBlock` of the block on ``context.specimen``."""
+        return field_block(exp, context.specimen)
+
+    def data(self, exp: FieldExperimentConfig, context):
+        return self.block(exp, context).data
+
+    def observation(self, exp: FieldExperimentConfig, context, name: str, control):
+        """The :class:`~fracid.inverse.core.field_observations.FieldObservation` of the block, checked against its block
+        of the data (``control`` [mm])."""
+        from fracid.inverse.core.field_observations import field_observation
+
+        observation = field_observation(self.block(exp, context), context.specimen, control=context.control, name=name)
+        check_matches(observation, control, exp.file)
+        return observation
+
+
+FIELD = FieldKind()
+
+__all__ = ["COLUMN_KEYS", "FIELD", "FIELD_KEYS", "PLACEMENT_KEYS", "FieldExperimentConfig", "FieldKind",
+           "check_matches", "field_block", "read_field_experiment"]

@@ -31,11 +31,8 @@ import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from fracid.config.checker import Checker
-from fracid.config.field_experiments import FieldExperimentConfig
-from fracid.config.registry import specimen_class
-from fracid.config.schema import SpecimenConfig
-from fracid.config.vocabulary import ROLES
+from fracid.inverse.experiments.field import FieldExperimentConfig, check_matches
+from fracid.inverse.experiments.vocabulary import ROLES
 from fracid.settings.checks import is_number
 
 #: the keys of each derived kind
@@ -88,6 +85,8 @@ class DerivedExperimentConfig:
         """What the block measures (not "force": studies of force curves skip the block)."""
         return QUANTITIES[self.kind]
 
+    measures_force = False  # lengths [mm]
+
 
 def derived_block(exp: DerivedExperimentConfig, field, specimen):
     """The :class:`~fracid.data.dic.derived.DerivedBlock` of the block from the
@@ -107,13 +106,13 @@ def derived_block(exp: DerivedExperimentConfig, field, specimen):
                               name=exp.name)
 
 
-def _required(ck: Checker, prefix: str, raw: dict, name: str):
+def _required(ck, prefix: str, raw: dict, name: str):
     if name not in raw:
         ck.missing(f"{prefix}.{name}", _REQUIRED[name])
     return raw[name]
 
 
-def _positions(ck: Checker, prefix: str, raw: dict, name: str, minimum: int = 1) -> tuple:
+def _positions(ck, prefix: str, raw: dict, name: str, minimum: int = 1) -> tuple:
     """A required list of at least ``minimum`` strictly increasing numbers [mm]."""
     value = _required(ck, prefix, raw, name)
     if (not isinstance(value, list) or len(value) < minimum or not all(map(is_number, value))
@@ -122,12 +121,12 @@ def _positions(ck: Checker, prefix: str, raw: dict, name: str, minimum: int = 1)
     return tuple(float(v) for v in value)
 
 
-def _positive(ck: Checker, prefix: str, raw: dict, name: str) -> float:
+def _positive(ck, prefix: str, raw: dict, name: str) -> float:
     return ck.number(f"{prefix}.{name}", _required(ck, prefix, raw, name), "must be " + _REQUIRED[name],
                      lambda v: v > 0)
 
 
-def _estimator_keys(ck: Checker, prefix: str, raw: dict, kind: str) -> dict:
+def _estimator_keys(ck, prefix: str, raw: dict, kind: str) -> dict:
     """The keys of the kind's estimator besides ``heights`` and ``radius``."""
     if kind == "opening":
         pairs = raw.get("pairs")
@@ -139,7 +138,7 @@ def _estimator_keys(ck: Checker, prefix: str, raw: dict, kind: str) -> dict:
             "threshold": _positive(ck, prefix, raw, "threshold")}
 
 
-def _source(ck: Checker, prefix: str, raw: dict, fields: dict) -> tuple:
+def _source(ck, prefix: str, raw: dict, fields: dict) -> tuple:
     """(configuration, FieldBlock) of the field block that ``field`` names; ``fields``: name -> [(config, block)]."""
     key = f"{prefix}.field"
     name = ck.string(key, _required(ck, prefix, raw, "field"), "must be " + _REQUIRED["field"])
@@ -172,7 +171,7 @@ def _blamed(kind: str, error: Exception) -> tuple[str, str]:
     return "field", message
 
 
-def _check_twice(ck: Checker, prefix: str, exp: DerivedExperimentConfig) -> None:
+def _check_twice(ck, prefix: str, exp: DerivedExperimentConfig) -> None:
     """Warn when the block and its field are both calibration data: the same measurements counted twice."""
     source = exp.source
     if exp.role == "calibration" and source.role == "calibration":
@@ -182,12 +181,13 @@ def _check_twice(ck: Checker, prefix: str, exp: DerivedExperimentConfig) -> None
                 "(or in this block)")
 
 
-def read_derived_experiment(ck: Checker, i: int, raw: dict, fields: dict, specimen: SpecimenConfig):
+def read_derived_experiment(ck, i: int, raw: dict, context):
     """The validated derived block ``i`` of ``[[experiments]]``, its values estimated (their size is ``n_points``).
 
-    ``fields`` maps each field block's name to its ``[(FieldExperimentConfig, FieldBlock), ...]`` as read
-    while checking (:func:`~fracid.config.field_experiments.read_field_experiment`).
+    ``context.sources`` maps each field block's name to its ``[(FieldExperimentConfig, FieldBlock), ...]`` as
+    read while checking (:func:`~fracid.inverse.experiments.field.read_field_experiment`).
     """
+    fields = context.sources
     prefix = f"experiments[{i}]"
     kind = raw["kind"]
     ck.table(prefix, raw, DERIVED_KEYS[kind])
@@ -199,9 +199,48 @@ def read_derived_experiment(ck: Checker, i: int, raw: dict, fields: dict, specim
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
         role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))
     try:
-        block = derived_block(exp, field, specimen_class(specimen.type)(**dict(specimen.options)))
+        block = derived_block(exp, field, context.specimen())
     except ValueError as err:  # a DataError too
         key, reason = _blamed(kind, err)
         ck.fail(f"{prefix}.{key}", raw.get(key), reason)
     _check_twice(ck, prefix, exp)
     return replace(exp, n_points=block.data.n_y)
+
+
+@dataclass(frozen=True)
+class DerivedKind:
+    """A kind of local data derived from the blocks of the kind ``source``."""
+
+    name: str
+    keys: tuple
+    column_keys: tuple = ()
+    source: str | None = "field"
+    view: str | None = None  # drawn in the fit figure, against the control
+
+    def read(self, ck, index: int, raw: dict, context) -> tuple:
+        """(the validated :class:`DerivedExperimentConfig`, None)."""
+        return read_derived_experiment(ck, index, raw, context), None
+
+    def block(self, exp: DerivedExperimentConfig, context):
+        """The :class:`~fracid.data.dic.derived.DerivedBlock` of the block, from its source's block."""
+        return derived_block(exp, context.source_block(exp.source), context.specimen)
+
+    def data(self, exp: DerivedExperimentConfig, context):
+        return self.block(exp, context).data
+
+    def observation(self, exp: DerivedExperimentConfig, context, name: str, control):
+        """The :class:`~fracid.inverse.core.derived_observations.DerivedFieldObservation` of the block, checked
+        against its block of the data (``control`` [mm])."""
+        from fracid.inverse.core.derived_observations import derived_observation
+
+        observation = derived_observation(self.block(exp, context), context.specimen, control=context.control,
+                                          name=name)
+        check_matches(observation, control, exp.file)
+        return observation
+
+
+OPENING = DerivedKind("opening", DERIVED_KEYS["opening"])
+FPZ_WIDTH = DerivedKind("fpz-width", DERIVED_KEYS["fpz-width"])
+
+__all__ = ["DERIVED_KEYS", "FPZ_WIDTH", "OPENING", "QUANTITIES", "DerivedExperimentConfig", "DerivedKind",
+           "derived_block", "read_derived_experiment"]
