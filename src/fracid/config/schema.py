@@ -37,7 +37,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     [specimen]                          # required
     type = "notched-beam"               # required: a key of fracid.specimens.SPECIMENS: "notched-beam" |
                                         #   "dogbone" | "bar" | "wedge-splitting" | "strip" | "mesh" (its
-                                        #   own keys: fracid.config.mesh_section) | specimens added later
+                                        #   own keys: fracid.specimens.mesh_section) | specimens added later
     control = "cmod"                    # the specimen's default if omitted:
                                         #   notched-beam: "cmod" (default) | "deflection"
                                         #   dogbone:      "elongation" (default) | "platen_displacement"
@@ -150,7 +150,7 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     log = ["beta"]                      # optional: sampled uniformly in log(x); needs lower > 0
     # The tables below are the built-in methods' settings: the configuration allows every table a
     # registered method declares (its config_tables) and the method's from_config checks its own
-    # ([identify.knn]: fracid.inverse.methods.knn_settings; [identify.kalman]: knn_kalman.KnnKalman;
+    # ([identify.knn]: fracid.inverse.methods.knn_settings; [identify.kalman]: fracid.inverse.methods.kalman_settings;
     # [identify.gauss-newton]: knn_gauss_newton.KnnGaussNewton); a method's own table is [identify.<name>].
     [identify.knn]                      # optional
     n = 64                              # integer >= 2 (grid: points per parameter), default 64

@@ -4,7 +4,7 @@ A notched beam or a wedge-splitting specimen modelled as a symmetric half has it
 (``Description.crack``, ``mirrored``): a point of the other half behaves as its mirror image with the normal
 displacement's sign flipped. The derived DIC data (:mod:`fracid.data.dic.derived`: virtual extensometers and
 strain transects across the crack) and the field observation (points on both halves,
-:class:`fracid.inverse.core.observations.FieldObservation`) read the line from here.
+:class:`fracid.inverse.core.field_observations.FieldObservation`) read the line from here.
 """
 
 from __future__ import annotations

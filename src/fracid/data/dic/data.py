@@ -3,7 +3,7 @@
 A :class:`DicData` holds the reference points of the correlation (subset centres) and their displacements at
 every frame, NaN where the correlation gave none (a hole, a point of low quality), with the load of each frame.
 :meth:`DicData.values` flattens a selection in the order of
-:class:`fracid.inverse.core.observations.FieldObservation`: frame slowest, then component, point fastest.
+:class:`fracid.inverse.core.field_observations.FieldObservation`: frame slowest, then component, point fastest.
 """
 
 from __future__ import annotations
@@ -156,7 +156,7 @@ class DicData:
 
     def values(self, frame_indices=None, components=(0, 1)) -> tuple[np.ndarray, np.ndarray]:
         """Displacements flattened to 1-D, frame slowest, then component, point fastest (the order of
-        :class:`fracid.inverse.core.observations.FieldObservation`), and the matching missing mask.
+        :class:`fracid.inverse.core.field_observations.FieldObservation`), and the matching missing mask.
 
         Parameters
         ----------

@@ -2,7 +2,7 @@
 
 :func:`field_block` turns a :class:`~fracid.data.dic.data.DicData` (in the specimen frame, mm) into the
 :class:`~fracid.data.dataset.ExperimentalData` of one field block and what the matching
-:class:`~fracid.inverse.core.observations.FieldObservation` needs (its points, frames as control values,
+:class:`~fracid.inverse.core.field_observations.FieldObservation` needs (its points, frames as control values,
 components and ``keep`` mask). Entries are ordered frame slowest, then component, point fastest; the missing
 ones (NaN: holes, low quality) are dropped from y and from the covariance, and flagged False in ``keep``.
 """

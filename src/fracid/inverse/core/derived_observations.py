@@ -2,8 +2,8 @@
 
 :class:`DerivedFieldObservation` wraps a :class:`~fracid.inverse.core.field_observations.FieldObservation` of the
 crack's normal displacement u_n at the DIC points (its sparse probe matrix, applied by the run at the
-frames) and applies to the model's u_n the estimator the data went through (:class:`~fracid.data.dic.derived.
-Extensometers`: the crack-opening profile; :class:`~fracid.data.dic.derived.StrainTransects`: the
+frames) and applies to the model's u_n the estimator the data went through (:class:`~fracid.data.dic.estimators.
+Extensometers`: the crack-opening profile; :class:`~fracid.data.dic.estimators.StrainTransects`: the
 process-zone width), with the points present at each frame: data and model are processed identically.
 Sensitivities follow by the chain rule, S_k = J_k dU_k, from the run's exact derivatives of the probed
 displacements dU_k at frame k and the estimator's Jacobian J_k (the estimate's weights for the opening).
@@ -56,9 +56,9 @@ class DerivedFieldObservation:
         are sampled at their mirror image).
     frames : array_like
         Increasing control values of the frames [mm].
-    estimator : fracid.data.dic.derived.Extensometers or StrainTransects
+    estimator : fracid.data.dic.estimators.Extensometers or StrainTransects
         ``evaluate(points, present, u_n) -> (values (m,), d values / d u_n (m, n_points))``, ``size`` (m),
-        ``line`` (a :class:`~fracid.data.dic.derived.CrackLine`), ``coordinates()`` and ``key()``.
+        ``line`` (a :class:`~fracid.specimens.crack_line.CrackLine`), ``coordinates()`` and ``key()``.
     present : array_like of bool, shape (n_frames, n_points), optional
         The points the data had at each frame (the estimator uses these only); None: all.
     control : str or None

@@ -104,7 +104,7 @@ def compare_models(data: ExperimentalData, specimen, candidates, *, control="cmo
     Parameters
     ----------
     data : ExperimentalData
-        Force data [N] at control values [mm] (e.g. :func:`fracid.data.gregoire2013_beam4`).
+        Force data [N] at control values [mm] (e.g. ``fracid.datasets.load("gregoire2013-beam4")``).
     specimen : object
         The specimen of the data (candidates may carry their own, e.g. another mesh).
     candidates : sequence of Candidate or of tuples
