@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from hostile import bar_config, synthetic_curve, write_csv
 
-from fracid.config import MAX_POPULATION, ConfigError, build_method, load_config
+from fracid.config import ConfigError, build_method, load_config
+from fracid.inverse.methods.knn_settings import MAX_POPULATION
 from fracid.config.checker import Checker
 from fracid.settings import checks as settings
 from fracid.settings.checks import SettingError, SettingsContext

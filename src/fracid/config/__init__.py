@@ -17,8 +17,9 @@ are pure functions of the validated :class:`Config`.
 Units: N, mm, MPa; ``c`` in mm^2. Data files are scaled to mm and N by the units given.
 
 Limits: a configuration beyond what a workstation holds is refused with the estimate and the limit
-(:data:`MAX_POPULATION` KNN points, :data:`MAX_BAR_ELEMENTS` bar elements and :data:`MAX_UNKNOWNS`
-unknowns of a 2D mesh counted from the geometry).
+(the KNN method's :data:`~fracid.inverse.methods.knn_settings.MAX_POPULATION` points, the specimens'
+:data:`~fracid.specimens.protocol.MAX_BAR_ELEMENTS` bar elements and
+:data:`~fracid.specimens.protocol.MAX_UNKNOWNS` unknowns of a 2D mesh counted from the geometry).
 
 Warnings: valid settings that are probably not meant (``relative_std`` above 1, process-zone
 elements larger than the internal length l = sqrt(2 c)) are returned in ``Config.warnings``.
@@ -62,11 +63,6 @@ from fracid.config.builders import (
 )
 from fracid.config.loading import load_config
 from fracid.config.schema import (
-    BAR_BYTES_PER_ELEMENT,
-    BYTES_PER_UNKNOWN,
-    MAX_BAR_ELEMENTS,
-    MAX_POPULATION,
-    MAX_UNKNOWNS,
     Config,
     ConfigError,
     IdentifyConfig,
@@ -104,10 +100,5 @@ __all__ = [
     "error_terms",
     "PosteriorConfig",
     # the limits and constants of the docstring
-    "BAR_BYTES_PER_ELEMENT",
-    "BYTES_PER_UNKNOWN",
     "CONTROL_SCALE_LIMIT",
-    "MAX_BAR_ELEMENTS",
-    "MAX_POPULATION",
-    "MAX_UNKNOWNS",
 ]

@@ -229,14 +229,7 @@ from pathlib import Path
 
 from fracid.config.registry import model_of
 from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD
-from fracid.inverse.methods.knn_settings import MAX_POPULATION  # noqa: F401 (re-exported: a limit of the configuration)
 from fracid.inverse.sampling.posterior import PosteriorSettings
-from fracid.specimens.protocol import (  # noqa: F401 (re-exported: the limits of the configuration)
-    BAR_BYTES_PER_ELEMENT,
-    BYTES_PER_UNKNOWN,
-    MAX_BAR_ELEMENTS,
-    MAX_UNKNOWNS,
-)
 
 
 class ConfigError(ValueError):
@@ -248,9 +241,8 @@ class ConfigError(ValueError):
 # the estimate, instead of failing (or swapping for hours) in the middle of a study.
 
 # The largest KNN population (MAX_POPULATION) is the KNN settings' (fracid.inverse.methods.knn_settings), checked
-# by the methods that read [identify.knn]; imported above and re-exported.
-# The limits of a forward run's memory (MAX_BAR_ELEMENTS, BAR_BYTES_PER_ELEMENT, MAX_UNKNOWNS,
-# BYTES_PER_UNKNOWN) are the specimens' (fracid.specimens.protocol), imported above and re-exported.
+# by the methods that read [identify.knn]; the limits of a forward run's memory (MAX_BAR_ELEMENTS,
+# BAR_BYTES_PER_ELEMENT, MAX_UNKNOWNS, BYTES_PER_UNKNOWN) are the specimens' (fracid.specimens.protocol).
 
 
 # ------------------------------------------------------------------------------ validated config
