@@ -40,6 +40,9 @@ Example
 >>> data = build_data(cfg)                                            # doctest: +SKIP
 >>> result = identify_data(build_operator(cfg, data), data, build_space(cfg),
 ...                        method=build_method(cfg))                  # doctest: +SKIP
+
+The configuration reads registries only (specimens, models, laws, experiment kinds, methods): it names no
+kind. May import every package but the command.
 """
 
 from __future__ import annotations

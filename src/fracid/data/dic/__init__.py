@@ -4,6 +4,8 @@ point data, and the camera frame placed on the specimen.
 >>> from fracid.data.dic import CameraPlacement
 >>> CameraPlacement(scale=0.05).to_specimen([[100.0, 20.0]]).tolist()
 [[5.0, 1.0]]
+
+Part of :mod:`fracid.data`: may import what it may (settings, fem, specimens).
 """
 
 from fracid.data.dic.csv_frames import read_dic_frames
