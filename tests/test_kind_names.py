@@ -40,8 +40,6 @@ def registries() -> dict:
 #: registries); lowered as the kinds bring their own adapters
 PENDING = {
     "fracid.cli.init": 3,
-    "fracid.config.schema": 1,
-    "fracid.config.sections": 1,
     "fracid.data.dic.derived": 1,
     "fracid.data.dic.field": 1,
     "fracid.datasets": 4,

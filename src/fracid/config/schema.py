@@ -228,6 +228,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fracid.config.registry import model_of
+from fracid.models.registry import DEFAULT_MODEL_TYPE
 from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD
 from fracid.inverse.sampling.posterior import PosteriorSettings
 
@@ -252,7 +253,7 @@ class ConfigError(ValueError):
 class ModelConfig:
     """``[model]``: the model type, its law and the parameter values given (the rest are defaults)."""
 
-    type: str = "gradient-damage"
+    type: str = DEFAULT_MODEL_TYPE
     parameters: tuple = ()  # ((name, value), ...) as given
     law: str | None = None  # a law of the model by name (fracid.models.model_laws); None: its default
 

@@ -12,6 +12,7 @@ import dataclasses
 import re
 from pathlib import Path
 
+from fracid.models.registry import DEFAULT_MODEL_TYPE
 from fracid.config.checker import Checker, bytes_text, show
 from fracid.config.registry import (model_of, model_types, parameter_range, section_reader, specimen_class,
                                    specimen_types)
@@ -76,7 +77,7 @@ def read_model(ck: Checker, raw) -> ModelConfig:
     if raw is None:
         return ModelConfig()
     ck.table("model", raw, MODEL_KEYS)
-    kind = ck.choice("model.type", raw.get("type", "gradient-damage"), model_types())
+    kind = ck.choice("model.type", raw.get("type", DEFAULT_MODEL_TYPE), model_types())
     law = _model_law(ck, raw, kind)
     cls = model_of(kind, law).parameters
     names = cls.names()

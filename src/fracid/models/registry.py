@@ -23,6 +23,8 @@ MODEL_TYPES = {
     "crack-band": lambda: CrackBandModel(),
     "pf-czm": lambda: PhaseFieldModel(),
 }
+#: the ``[model] type`` of a configuration that gives none (the thesis's model)
+DEFAULT_MODEL_TYPE = "gradient-damage"
 
 
 def model_laws(model) -> dict:
