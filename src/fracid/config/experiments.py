@@ -9,7 +9,7 @@ import dataclasses
 from pathlib import Path
 
 from fracid.config.checker import Checker
-from fracid.config.registry import section_reader, specimen_class, specimen_observables
+from fracid.config.registry import specimen_class, specimen_observables
 from fracid.config.schema import SpecimenConfig
 from fracid.config.sections import check_specimen, check_specimen_size, specimen_options
 from fracid.inverse.experiments.registry import ReadContext, read_experiments as read_blocks
@@ -18,7 +18,7 @@ from fracid.inverse.experiments.registry import ReadContext, read_experiments as
 def _overrides(ck: Checker, prefix: str, raw: dict, specimen: SpecimenConfig) -> tuple:
     """The block's ``specimen`` overrides ((field, value), ...), checked with the rest of ``[specimen]``."""
     cls = specimen_class(specimen.type)
-    if "specimen" in raw and section_reader(cls) is not None:
+    if "specimen" in raw and cls.config_section is not None:
         ck.fail(f"{prefix}.specimen", raw["specimen"], f"a {specimen.type} specimen (read by its own [specimen] "
                 "section) takes no per-experiment overrides yet; run the experiments of different specimens from "
                 "configurations of their own")

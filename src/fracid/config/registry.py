@@ -10,7 +10,6 @@ reader (its ``config_section``), which :mod:`fracid.config.sections` calls.
 from __future__ import annotations
 
 from fracid.specimens import SPECIMENS
-from fracid.specimens.protocol import SpecimenSection
 
 
 def model_types() -> tuple:
@@ -44,12 +43,6 @@ def specimen_class(kind: str):
         return SPECIMENS[kind]
     except KeyError:
         raise ValueError(f"specimen type = {kind!r}; choose one of {', '.join(map(repr, SPECIMENS))}") from None
-
-
-def section_reader(cls) -> SpecimenSection | None:
-    """The reader of the ``[specimen]`` table of a specimen class that declares one (its ``config_section``),
-    or None when its dataclass fields are the table's keys."""
-    return cls.config_section
 
 
 def parameter_range(model, identify, name: str, unit: str) -> tuple:

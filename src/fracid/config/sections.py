@@ -14,7 +14,7 @@ from pathlib import Path
 
 from fracid.models.registry import DEFAULT_MODEL_TYPE
 from fracid.config.checker import Checker, bytes_text, show
-from fracid.config.registry import (model_of, model_types, parameter_range, section_reader, specimen_class,
+from fracid.config.registry import (model_of, model_types, parameter_range, specimen_class,
                                    specimen_types)
 from fracid.config.schema import (
     ConfigError,
@@ -211,7 +211,7 @@ def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
         ck.missing("specimen.type", "one of " + ", ".join(repr(t) for t in types))
     kind = ck.choice("specimen.type", raw["type"], types)
     cls = specimen_class(kind)
-    reader = section_reader(cls)
+    reader = cls.config_section
     if reader is not None:
         try:
             control, options = reader.read(ck, raw, base if base is not None else ck.path.parent, cls)
@@ -229,12 +229,12 @@ def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
 
 
 def check_specimen_section(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, identify) -> None:
-    """The check of a specimen's own ``[specimen]`` reader (:func:`~fracid.config.registry.section_reader`; e.g.
+    """The check of a specimen's own ``[specimen]`` reader (its ``config_section``; e.g.
     a mesh's units) against the length the model's mesh must resolve (its
     :class:`~fracid.models.protocol.MeshLength`; none: nothing to check) over the values of its parameter given
     and identified (:func:`~fracid.config.registry.parameter_range`)."""
     cls = specimen_class(specimen.type)
-    reader = section_reader(cls)
+    reader = cls.config_section
     mesh_length = declared(model_of(model.type, model.law)).mesh_length
     if reader is None or mesh_length is None:
         return

@@ -66,11 +66,12 @@ def implausible(name: str, value: float, units: dict | None = None, parameters: 
     if name not in ranges or not math.isfinite(value):
         return None
     lower, upper = ranges[name]
-    usual = usual_range_text(name, units, parameters)
     if value > upper * IMPLAUSIBLE_FACTOR:
-        return f"{name} = {value:g} is {value / upper:.3g} times the upper end of its usual range {usual}"
+        return (f"{name} = {value:g} is {value / upper:.3g} times the upper end of its usual range "
+                f"{usual_range_text(name, units, parameters)}")
     if 0 < value < lower / IMPLAUSIBLE_FACTOR:  # 0 itself is a bound, not a scale (e.g. beta >= 0)
-        return f"{name} = {value:g} is 1/{lower / value:.3g} of the lower end of its usual range {usual}"
+        return (f"{name} = {value:g} is 1/{lower / value:.3g} of the lower end of its usual range "
+                f"{usual_range_text(name, units, parameters)}")
     return None
 
 

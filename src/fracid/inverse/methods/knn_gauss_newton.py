@@ -26,14 +26,6 @@ GAUSS_NEWTON_TABLE = "gauss-newton"
 GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
 
 
-def _stages() -> dict:
-    return dict(KnnGaussNewton.stages)
-
-
-def _records() -> dict:
-    return dict(KnnGaussNewton.stage_records)
-
-
 @dataclass
 class GaussNewtonResult(KnnStartedResult):
     """The result of :class:`KnnGaussNewton`: a :class:`~fracid.inverse.methods.knn_started.KnnStartedResult`
@@ -45,8 +37,8 @@ class GaussNewtonResult(KnnStartedResult):
     """
 
     method: str = "knn-gauss-newton"
-    stages: dict = field(default_factory=_stages)
-    stage_records: dict = field(default_factory=_records)
+    stages: dict = field(default_factory=lambda: dict(KnnGaussNewton.stages))
+    stage_records: dict = field(default_factory=lambda: dict(KnnGaussNewton.stage_records))
 
 
 @dataclass(frozen=True)

@@ -28,14 +28,6 @@ from fracid.inverse.methods.knn_started import KnnStarted, KnnStartedResult, Loc
 from fracid.settings.checks import SettingsContext, toml_line
 
 
-def _knn_kalman_stages() -> dict:
-    return dict(KnnKalman.stages)
-
-
-def _knn_kalman_records() -> dict:
-    return dict(KnnKalman.stage_records)
-
-
 @dataclass
 class IdentificationResult(KnnStartedResult):
     """The result of :class:`KnnKalman`: a :class:`~fracid.inverse.methods.knn_started.KnnStartedResult`
@@ -47,8 +39,8 @@ class IdentificationResult(KnnStartedResult):
     """
 
     method: str = "knn-kalman"
-    stages: dict = field(default_factory=_knn_kalman_stages)
-    stage_records: dict = field(default_factory=_knn_kalman_records)
+    stages: dict = field(default_factory=lambda: dict(KnnKalman.stages))
+    stage_records: dict = field(default_factory=lambda: dict(KnnKalman.stage_records))
 
     def failed_runs_text(self) -> str:
         runs = self.runs or {}
