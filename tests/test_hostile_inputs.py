@@ -29,9 +29,16 @@ from pathlib import Path
 import pytest
 
 import hostile_checks
+import hostile_compare
 import hostile_data
+import hostile_dic
+import hostile_estimate
 import hostile_files
+import hostile_fit
 import hostile_mesh
+import hostile_paths
+import hostile_plausibility
+import hostile_status
 from fracid.runtime.locks import directory_lock
 from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, _cells, _clean, _config_bytes,
                      _corrupt_store, _estimate_near_truth, _out_dir, _out_is_file, _read_only_out, _scaled, _units_row,
@@ -144,7 +151,8 @@ CASES = {
 }
 
 #: the other cases, one module per class of defect (files and signals, data files, meshes, plausibility and API)
-for _module in (hostile_files, hostile_data, hostile_mesh, hostile_checks):
+for _module in (hostile_files, hostile_data, hostile_mesh, hostile_checks, hostile_plausibility, hostile_fit,
+                hostile_dic, hostile_paths, hostile_compare, hostile_estimate, hostile_status):
     assert not set(_module.CASES) & set(CASES), set(_module.CASES) & set(CASES)
     CASES.update(_module.CASES)
 
