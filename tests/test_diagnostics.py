@@ -9,7 +9,7 @@ import pytest
 
 import fracid
 from fracid.inverse.core.diagnostics import (PEAK_TOLERANCE, SLOPE_TOLERANCE, diagnostic_warnings, elastic_points,
-                                        fit_diagnostics, line_slope)
+                                             fit_diagnostics, origin_slope)
 from fracid.inverse.core.method import MethodResult, estimate_text
 
 CONTROL = np.linspace(0.0, 1.0, 41)  # [mm]
@@ -31,7 +31,8 @@ def test_a_model_25_percent_stiffer_gets_the_slope_warning_only():
     d = diagnose(curve(stiffness=125.0))
     block, = d["blocks"]
     assert block["slope_data"] == pytest.approx(100.0) and block["slope_ratio"] == pytest.approx(1.25)
-    assert block["elastic_points"] == 5  # 0 to 0.1 mm: up to 35 % of the 30 N peak
+    assert block["elastic_points"] == 4  # 0.025 to 0.1 mm: up to 35 % of the 30 N peak (control 0 tells nothing)
+    assert block["elastic_points_model"] == 3  # its own: up to 35 % of its own peak
     assert block["peak_ratio"] > 1 - PEAK_TOLERANCE
     warnings = diagnostic_warnings(d)
     assert len(warnings) == 1
@@ -69,9 +70,9 @@ def test_a_good_fit_gets_no_warning_and_the_worst_residual_is_located():
 
 
 def test_a_departure_within_the_scatter_of_few_points_is_no_warning():
-    """Two elastic points 2 N apart with a std of 2 N: a slope 20 % off is not significant."""
+    """One elastic point at 0.01 mm with a std of 2 N (slope std 200 N/mm): a slope 20 % off is not significant."""
     y = np.array([0.0, 10.0, 20.0, 30.0, 20.0, 10.0])
-    y_fit = y + np.array([1.0, -1.0, 1.0, -1.0, 1.0, -1.0])
+    y_fit = y + np.array([1.0, -2.0, 1.0, -1.0, 1.0, -1.0])
     d = fit_diagnostics(np.linspace(0, 0.05, 6), y, np.full(6, 2.0), y_fit, [("global", 0, 6)])
     assert d["blocks"][0]["slope_ratio"] == pytest.approx(0.8) and diagnostic_warnings(d) == []
 
@@ -92,11 +93,16 @@ def test_width_blocks_have_no_slope_or_peak_and_the_index_replaces_a_missing_con
 
 
 def test_elastic_points_and_slopes_of_degenerate_blocks():
-    assert elastic_points([5.0, 1.0, 0.5]).size == 0  # the peak is the first point: no rising branch
-    np.testing.assert_array_equal(elastic_points([0.0, 20.0, 30.0, 10.0]), [0, 1])  # at least two points
-    assert np.isnan(line_slope([1.0], [2.0])[0]) and np.isnan(line_slope([1.0, 1.0], [2.0, 3.0])[0])
-    slope, std = line_slope([0.0, 1.0, 2.0], [1.0, 3.0, 5.0], [1.0, 1.0, 1.0])
-    assert slope == pytest.approx(2.0) and std == pytest.approx(np.sqrt(1 / 2))
+    points, within = elastic_points([0.0, 1.0, 2.0], [5.0, 1.0, 0.5])
+    assert points.size == 0 and not within  # the peak at control 0: nothing rises
+    points, within = elastic_points([0.0, 1.0, 2.0, 3.0], [0.0, 20.0, 30.0, 10.0])
+    np.testing.assert_array_equal(points, [1])  # none below 35 %: the first rising point, a secant (a bound)
+    assert not within
+    points, within = elastic_points([0.0, 1.0, 2.0, 3.0, 4.0], [0.0, 5.0, 10.0, 40.0, 10.0])
+    np.testing.assert_array_equal(points, [1, 2]) and within
+    assert np.isnan(origin_slope([], [])[0]) and np.isnan(origin_slope([0.0], [2.0])[0])
+    slope, std = origin_slope([1.0, 2.0], [2.0, 4.0], [1.0, 1.0])
+    assert slope == pytest.approx(2.0) and std == pytest.approx(np.sqrt(1 / 5))
 
 
 def result_of(y_fit, control=CONTROL):
