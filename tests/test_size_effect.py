@@ -12,7 +12,8 @@ from fracid.inverse.studies.size_effect import nominal_strength, size_effect_ser
 from fracid.inverse.studies.size_effect_law import SizeEffectFit, bazant_law, fit_size_effect
 from fracid.fem.path.path_following import ConvergenceError, PathResult
 from fracid.runtime.executors import make_executor
-from fracid.report.figures import size_effect_figure, to_png
+from fracid.report.figures import to_png
+from fracid.report.size_effect_figure import size_effect_figure
 from fracid.specimens.beam import NotchedBeam
 from fracid.specimens.dogbone import DogBone
 

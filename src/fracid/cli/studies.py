@@ -174,7 +174,8 @@ def run_sensitivity_command(args) -> int:
 
 def run_size_effect_command(args) -> int:
     from fracid.config import build_parameters, build_specimen
-    from fracid.report.figures import size_effect_figure, to_png
+    from fracid.report.figures import to_png
+    from fracid.report.size_effect_figure import size_effect_figure
 
     cfg = load(args, args.config, "simulate")
     if not _has_size(cfg):

@@ -20,7 +20,6 @@ import math
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter
 
 
 #: resolution of the PNG images [dots per inch]
@@ -157,11 +156,46 @@ def covariance_ellipse(centre, cov, n_std=2.0, n=200) -> np.ndarray:
 
 
 
+#: the legend's words for a computed curve drawn through the data's points only (no run curve in the result)
+AT_DATA_POINTS = "through its values at the data points only: the run's curve is not in this result"
+
+
+def run_curves(result) -> list:
+    """The run's own curves at the estimate of a result (its ``curves``; empty for an older result)."""
+    return list(getattr(result, "curves", None) or [])
+
+
+def draw_computed(ax, x, fit, curve, label: str, colour=COMPUTED, style: str = "-", lw: float = 1.6) -> bool:
+    """The curve computed at the estimate in a block's panel: the run's own (``curve``: control [mm] and values
+    of every step, :func:`~fracid.inverse.core.diagnostics.block_curve`) with its values at the data's points
+    marked on it; without it, the line through the values at the data's points (``fit`` at ``x``), labelled so
+    (:data:`AT_DATA_POINTS`). Returns whether the run's curve was drawn."""
+    x, fit = np.asarray(x, float), np.asarray(fit, float)
+    order = np.argsort(x, kind="stable")
+    shown = order[np.isfinite(fit[order]) & np.isfinite(x[order])]
+    if curve is not None:
+        ax.plot(curve[0], curve[1], style, color=colour, lw=lw, label=label)
+        ax.plot(x[shown], fit[shown], ".", color=colour, ms=4)  # where the data sample it
+        return True
+    if shown.size:
+        ax.plot(x[shown], fit[shown], style, color=colour, lw=lw, label=f"{label} ({AT_DATA_POINTS})")
+    return False
+
+
+def block_run_curve(result, index: int, has_control: bool = True):
+    """The run's curve of block ``index`` of ``result`` as (control, values), or None (none kept, or the x axis
+    is the point index)."""
+    from fracid.inverse.core.diagnostics import block_curve
+
+    return block_curve(run_curves(result), index) if has_control else None
+
+
 def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | None:
     """Measured points with their +/- 2 std band and the curve computed at the estimate, per block.
 
-    The computed values are known at the data points only: the computed curve is the line through
-    them (its finite values), not a finer curve.
+    The computed curve is the forward run's own at the estimate (every step up to the data's last control
+    value, the result's ``curves``), its values at the data's points marked on it; a result without it (an
+    older one) gets the line through the values at the data's points, labelled so.
 
     Parameters
     ----------
@@ -182,20 +216,18 @@ def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | No
     control = getattr(result, "control", None) if control is None else control
     blocks = result_blocks(result)
     labels = block_control_labels(result, len(blocks), control_label)
-    drawn_blocks = [(block, label) for block, label in zip(blocks, labels) if block[0] not in set(skip)]
+    drawn_blocks = [(k, block, label) for k, (block, label) in enumerate(zip(blocks, labels)) if block[0] not in set(skip)]
     if not drawn_blocks:
         return None
-    blocks, labels = zip(*drawn_blocks)
+    indices, blocks, labels = zip(*drawn_blocks)
     fig, panels = block_panels(blocks, None if control is None else float_array(control, np.nan), y_exp.size)
-    for (ax, name, part, x), label in zip(panels, labels):
-        y, s, fit = y_exp[part], std[part], y_fit[part]
+    for (ax, name, part, x), label, k in zip(panels, labels, indices):
+        y, s = y_exp[part], std[part]
         sort = np.argsort(x, kind="stable")
         ax.fill_between(x[sort], (y - 2 * s)[sort], (y + 2 * s)[sort], color=MEASURED, alpha=0.2, lw=0,
                         label="measured +/- 2 std")
-        ax.plot(x, y, "o", color=MEASURED, ms=3.5, label="measured")
-        drawn = sort[np.isfinite(fit[sort])]
-        if drawn.size:
-            ax.plot(x[drawn], fit[drawn], "-", color=COMPUTED, lw=1.6, label="computed at the estimate")
+        draw_computed(ax, x, y_fit[part], block_run_curve(result, k, control is not None), "computed at the estimate")
+        ax.plot(x, y, "o", color=MEASURED, ms=3.5, label="measured", zorder=3)
         finish_block_panel(ax, name, control is not None, label)
     return fig
 
@@ -292,89 +324,3 @@ def sensitivity_figure(history, control=None) -> Figure:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     return fig
-
-
-# ------------------------------------------------------------------------------------ size effect
-
-
-def size_effect_figure(sizes, sigma_computed, fit=None, sigma_measured=None, measured_std=None,
-                       calibrated=None) -> Figure:
-    """Nominal strength against size on log-log axes, with Bazant's size effect law when fitted.
-
-    Parameters
-    ----------
-    sizes : array_like
-        Specimen sizes D [mm].
-    sigma_computed : array_like
-        Computed nominal strengths at ``sizes`` [MPa]; nan (a failed run) is left out.
-    fit : SizeEffectFit, optional
-        Drawn as the law over the sizes' range, with its asymptotes: the strength criterion
-        sigma_N = B f_t and LEFM sigma_N = B f_t sqrt(D0 / D) (slope -1/2), which cross at D0.
-    sigma_measured, measured_std : array_like, optional
-        Measured nominal strengths at ``sizes`` and their standard deviations [MPa] (error bars of
-        +/- 1 std); nan where a size was not tested.
-    calibrated : array_like of bool, optional
-        True for the sizes whose data calibrated the model: their computed points are filled,
-        those of the other (predicted) sizes hollow. None: no distinction.
-    """
-    D = float_array(sizes, np.nan)
-    computed = float_array(sigma_computed, np.nan)
-    if computed.shape != D.shape:
-        raise ValueError(f"sigma_computed has {computed.size} values but sizes has {D.size}")
-    fig = new_figure(6.4, 4.6)
-    ax = fig.subplots()
-    shown = [computed]
-    if fit is not None:
-        _size_effect_law(ax, fit, D)
-    if sigma_measured is not None:
-        measured = float_array(sigma_measured, np.nan)
-        std = None if measured_std is None else float_array(measured_std, np.nan)
-        shown.append(measured)
-        ax.errorbar(D, measured, yerr=std, fmt="s", color=MEASURED, mfc="none", ms=9, capsize=3,
-                    label="measured" + (" +/- 1 std" if std is not None else ""))
-    if calibrated is None:
-        ax.plot(D, computed, "o", color=COMPUTED, ms=7, label="computed")
-    else:
-        used = np.asarray(calibrated, dtype=bool)
-        if used.shape != D.shape:
-            raise ValueError(f"calibrated has {used.size} values but sizes has {D.size}; give one flag per size")
-        ax.plot(D[used], computed[used], "o", color=COMPUTED, ms=7, label="computed, calibration sizes")
-        ax.plot(D[~used], computed[~used], "o", mfc="white", mec=COMPUTED, mew=1.6, ms=7,
-                label="computed, predicted sizes")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    _plain_log_ticks(ax.xaxis)
-    _plain_log_ticks(ax.yaxis)
-    if fit is not None:
-        # the LEFM line grows without bound as D -> 0: cap the axis just above the law and the points
-        ax.set_ylim(top=1.6 * np.nanmax(np.concatenate([[fit.B_ft], *shown])))
-    ax.set_xlabel("size D [mm]")
-    ax.set_ylabel("nominal strength sigma_N [MPa]")
-    ax.grid(True, which="both", alpha=0.25)
-    ax.legend(fontsize="small", loc="best")
-    return fig
-
-
-def _plain_log_ticks(axis) -> None:
-    """Plain numbers (0.8, 2, 1000) on a log axis rather than powers of ten; the minor ticks are
-    labelled only when the axis spans less than a decade (a strength axis often does), as there
-    are then at most eight of them."""
-    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-
-    def minor(value, _):
-        low, high = axis.get_view_interval()
-        return f"{value:g}" if high < 10.0 * low else ""
-
-    axis.set_minor_formatter(FuncFormatter(minor))
-
-
-def _size_effect_law(ax, fit, D) -> None:
-    """The fitted law and its two asymptotes over a range wide enough to show where they meet."""
-    data = D[np.isfinite(D) & (D > 0)]
-    # show the transition at D0 when it is near the data, never decades of empty axis
-    span = np.concatenate([data, [np.clip(fit.D0, data.min() / 10.0, data.max() * 10.0)]])
-    grid = np.geomspace(span.min() / 2.0, span.max() * 2.0, 200)
-    ax.plot(grid, fit.predict(grid), "-", color=ESTIMATE, lw=1.6,
-            label=f"size effect law: B f_t = {fit.B_ft:.3g} MPa, D0 = {fit.D0:.3g} mm")
-    ax.axhline(fit.B_ft, color="k", lw=0.9, ls="--", label="strength criterion")
-    ax.plot(grid, fit.B_ft * np.sqrt(fit.D0 / grid), "k-.", lw=0.9, label="LEFM, slope -1/2")

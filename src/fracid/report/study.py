@@ -16,9 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from fracid.report.figures import (ESTIMATE, MEASURED, NEIGHBOUR, new_figure, parameter_axis, parameter_label,
-                                   parameter_units, sensitivity_figure, size_effect_figure, to_png)
+                                   parameter_units, sensitivity_figure, to_png)
 from fracid.report.html import write_report
 from fracid.report.markup import esc, html_image, html_table
+from fracid.report.size_effect_figure import size_effect_figure
 from fracid.report.posterior import (comparison_table, corner_figure, predictive_figure, statistics_table,
                                      write_posterior)
 

@@ -34,7 +34,9 @@ class RunRecord:
     ``y`` holds the computed values (NaN where not computed); ``status`` is ``"ok"`` or ``"failed"``;
     ``error`` the reason of a failure and ``reached`` the control value reached per observation.
     ``S`` is d y / d x (n_outputs x n_parameters) when the run computed it by direct differentiation
-    (an operator with ``sensitivities=True``), else None.
+    (an operator with ``sensitivities=True``), else None. ``curves`` holds, per observation, the run's own
+    curve (``{"control", "values"}`` at every step, from a kind's optional ``curve(run)``) when the run covered
+    the whole observation, else None (an empty list from a record stored without them).
     """
 
     x: np.ndarray
@@ -45,6 +47,7 @@ class RunRecord:
     seconds: float = 0.0
     retried: bool = False
     S: np.ndarray | None = None
+    curves: list = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -55,13 +58,16 @@ class RunRecord:
                "seconds": self.seconds, "retried": self.retried}
         if self.S is not None:
             out["S"] = self.S
+        if any(c is not None for c in self.curves):
+            out["curves"] = list(self.curves)
         return out
 
     @classmethod
     def from_dict(cls, d: dict) -> "RunRecord":
         S = d.get("S")
         return cls(np.asarray(d["x"], float), np.asarray(d["y"], float), d["status"], d["error"], list(d["reached"]),
-                   float(d["seconds"]), bool(d["retried"]), None if S is None else np.asarray(S, float))
+                   float(d["seconds"]), bool(d["retried"]), None if S is None else np.asarray(S, float),
+                   list(d.get("curves") or []))
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,7 +170,7 @@ class ForwardOperator:
         """Evaluate h(x); only the first ``needed`` outputs are guaranteed (runs stop early)."""
         start = time.perf_counter()
         x = np.asarray(x, dtype=float)
-        record = RunRecord(x=x, y=np.full(self.n_outputs, np.nan))
+        record = RunRecord(x=x, y=np.full(self.n_outputs, np.nan), curves=[None] * len(self.observations))
         try:
             params = self.parameters(x)
         except ValueError as err:
@@ -218,11 +224,17 @@ class ForwardOperator:
             y, S = obs.sample(run if whole else probe_rows(run, own))
             rows = slice(part.start, part.start + n)
             record.y[rows] = np.asarray(y, float)[:n]
+            if n == part.stop - part.start and callable(getattr(obs, "curve", None)):  # the whole block: its curve
+                record.curves[self._block_index(part)] = obs.curve(run if whole else probe_rows(run, own))
             if record.S is not None and S is None:  # a quantity the run did not differentiate: no S
                 record.S = None
             elif record.S is not None:  # the checkpoints are steps: the samples are the steps' values
                 record.S[rows] = np.asarray(S, float)[:n]
         return True
+
+    def _block_index(self, part: slice) -> int:
+        """Index of the observation whose block is ``part``."""
+        return int(np.searchsorted(self._offsets, part.start, side="right")) - 1
 
     def _run(self, obs, params, target, checkpoints, threshold, observables, probes, matrix=None):
         """Forward run to ``target`` (with the sparse probe ``matrix`` if not None); one retry with smaller

@@ -135,6 +135,11 @@ class MethodResult(GaussianEstimate, StageRecords):
         error: :func:`fracid.inverse.likelihood.record.terms_record`): per block the measurement,
         discretisation and model-error std; empty when none was added (``x`` and ``C`` are then the
         measurement's alone; with them, ``C`` holds them and ``std_exp`` stays the measurement std).
+    curves : list
+        The forward run's own curve at the estimate, per block: ``{"control": [mm], "values": [unit of the
+        block]}`` at every step of the run up to the block's last control value, or None (a block without a
+        curve, a displacement field); empty when unknown (an older result). The report draws it, and the fit
+        diagnostics judge the computed slope and peak on it (:func:`estimate_curves`).
     """
 
     names: list
@@ -160,6 +165,7 @@ class MethodResult(GaussianEstimate, StageRecords):
     quantities: list = field(default_factory=list)
     provenance: dict = field(default_factory=dict)
     error_terms: dict = field(default_factory=dict)
+    curves: list = field(default_factory=list)
 
     @property
     def rms_percent(self) -> float:
@@ -210,7 +216,7 @@ class MethodResult(GaussianEstimate, StageRecords):
         (:func:`~fracid.inverse.core.diagnostics.fit_diagnostics`), at ``control`` [mm] or the result's own."""
         control = self.control if control is None else control
         return fit_diagnostics(None if control is None else np.asarray(control, float), self.y_exp, self.std_exp,
-                               self.y_fit, self.blocks, self.quantities)
+                               self.y_fit, self.blocks, self.quantities, self.curves)
 
     def warnings(self, poor_fit_percent: float = POOR_FIT_PERCENT, poor_fit_std: float = POOR_FIT_STD, *,
                  control=None) -> list[str]:
@@ -356,6 +362,18 @@ def result_fields(operator, space, x, y_exp, C_exp, *, blocks=(), notes=()) -> d
             **observed_fields(operator, np.size(y_exp))}
 
 
+def estimate_curves(evaluate, x) -> list:
+    """The run's own curves at the estimate ``x`` (:attr:`MethodResult.curves`): ``evaluate(x)``'s
+    ``RunRecord.curves``. A method's last run is at its estimate: through a
+    :class:`~fracid.inverse.core.runs.StoredOperator` that run is remembered (or stored) and costs nothing
+    here; a plain operator runs once more. Empty when ``x`` is not finite or the run fails."""
+    x = np.asarray(x, float)
+    if not np.all(np.isfinite(x)):
+        return []
+    record = evaluate(x)
+    return list(getattr(record, "curves", None) or []) if record.ok else []
+
+
 def observed_fields(operator, n: int) -> dict:
     """``control`` [mm], ``control_names`` and ``quantities`` of a result, from the operator's
     observations (:class:`~fracid.inverse.core.forward_operator.Observation`); empty when it has none or
@@ -369,4 +387,4 @@ def observed_fields(operator, n: int) -> dict:
 
 
 __all__ = ["POOR_FIT_PERCENT", "POOR_FIT_STD", "InverseMethod", "MethodResult", "at_bounds", "check_problem",
-           "estimate_text", "identification_bounds", "observed_fields", "result_fields"]
+           "estimate_curves", "estimate_text", "identification_bounds", "observed_fields", "result_fields"]

@@ -110,6 +110,15 @@ def interpolate(run, name: str, points: np.ndarray) -> tuple[np.ndarray, np.ndar
     return y, np.column_stack([np.interp(points, run.control, d) for d in np.asarray(derivative).T])
 
 
+def run_curve(run, name: str, end: float) -> dict:
+    """``{"control": ndarray, "values": ndarray}``: the run's curve ``name`` (``"force"``, an observable or a
+    probe) at every step whose control is at most ``end`` [mm]."""
+    values = np.asarray(run.force if name == FORCE else run.observables[name], float)
+    control = np.asarray(run.control, float)
+    keep = control <= end * (1 + 1e-12) + 1e-15
+    return {"control": control[keep], "values": values[keep]}
+
+
 def check_control_points(values, what: str = "control_points") -> np.ndarray:
     """``values`` as a 1-D float array of finite, strictly increasing control values, or a ValueError."""
     try:
@@ -213,5 +222,11 @@ class Observation:
     def sample(self, run) -> tuple:
         return interpolate(run, self.quantity, self.control_points)
 
+    def curve(self, run) -> dict:
+        """The run's own curve of the quantity: ``{"control": [mm], "values": [N or mm]}`` at every step of
+        the run up to the last control point (an optional member of a kind: the report draws it, and the fit
+        diagnostics judge the computed slope and peak on it rather than on the data's points)."""
+        return run_curve(run, self.quantity, float(self.control_points[-1]))
 
-__all__ = ["FORCE", "Observation", "ObservationKind", "check_control_points", "interpolate"]
+
+__all__ = ["FORCE", "Observation", "ObservationKind", "check_control_points", "interpolate", "run_curve"]

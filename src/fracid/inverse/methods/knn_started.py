@@ -17,7 +17,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from fracid.inverse.core.method import MethodResult, check_problem, identification_bounds, result_fields
+from fracid.inverse.core.method import (MethodResult, check_problem, estimate_curves, identification_bounds,
+                                        result_fields)
 from fracid.inverse.core.plans import StagePlan
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.core.sensitivity import exact_sensitivity
@@ -133,6 +134,7 @@ class KnnStarted:
         search, local = self.stages
         runs = {search: len(knn.points), f"{search}_failed": knn.n_failed, local: fit.runs, f"{local}_failed": fit.failed,
                 **{f"{local}_{name}": value for name, value in fit.counters.items()}}
+        curves = estimate_curves(evaluate, fit.x)  # the estimate's run, already made: its own curve
         after = _counters(evaluate)
         if after is not None:
             runs.update({f"{local}_computed": after[0] - before[0], f"{local}_reused": after[1] - before[1]})
@@ -141,7 +143,7 @@ class KnnStarted:
         return self.result_class(
             x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history, knn=knn_record(knn, self.knn.method, self.knn.seed),
             runs=runs, converged=fit.converged, status=fit.status, method=self.name, stages=dict(self.stages),
-            stage_records=dict(self.stage_records),
+            stage_records=dict(self.stage_records), curves=curves,
             **result_fields(operator, knn.space, fit.x, y_exp, C_exp, blocks=blocks, notes=notes))
 
     def __call__(self, operator, y_exp, C_exp, space: ParameterSpace, *, executor=None, store=None, progress=None,

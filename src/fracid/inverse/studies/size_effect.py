@@ -207,7 +207,7 @@ class SizeEffectComparison:
     calibrated: np.ndarray
 
     def figure_arguments(self) -> dict:
-        """Keyword arguments of :func:`fracid.report.figures.size_effect_figure`."""
+        """Keyword arguments of :func:`fracid.report.size_effect_figure.size_effect_figure`."""
         have = np.isfinite(self.sigma_measured).any()
         return {"sizes": self.series.sizes, "sigma_computed": self.series.sigma_N, "fit": self.computed,
                 "sigma_measured": self.sigma_measured if have else None, "calibrated": self.calibrated}
