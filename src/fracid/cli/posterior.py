@@ -41,7 +41,7 @@ def run_posterior_command(args) -> int:
         evaluate = StoredOperator(job.operator, store, study="posterior", retry_failed=args.retry_failed)
         post = sample_posterior(evaluate, job.data, job.space, result, settings, executor=executor,
                                 progress=progress_choice(args), log=lambda text: say(args, text))
-    written = write_posterior(out, post, data=job.data, fit=result.y_fit, provenance=result.provenance,
+    written = write_posterior(out, post, data=job.data, fit=result, provenance=result.provenance,
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     say(args, post.summary())
     say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "

@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from fracid.inverse.studies.evidence import TIE_SIGMAS
-from fracid.report.figures import MEASURED, block_control_labels, block_panels, finish_block_panel, new_figure, to_png
+from fracid.report.figures import (MEASURED, block_control_labels, block_panels, block_run_curve, draw_computed,
+                                   finish_block_panel, new_figure, to_png)
 from fracid.report.html import parameter_section
 from fracid.report.markup import duration, esc, generated_now, html_image, html_table, provenance_section, write_document
 
@@ -42,21 +43,22 @@ def _colours(n: int) -> list:
 
 
 def fits_figure(result):
-    """The data (points, +- 2 std band) and every model's computed values at the estimate (lines through the
-    data's points), one panel per data block."""
+    """The data (points, +- 2 std band) and every model's curve computed at its estimate (the run's own,
+    :func:`~fracid.report.figures.draw_computed`; the line through the data's points for a model without it),
+    one panel per data block."""
     data = result.data
     y, std = np.asarray(data.y, float), np.asarray(data.std, float)
     fig, panels = block_panels(list(data.blocks), np.asarray(data.control, float), y.size)
     labels = block_control_labels(result.scores[0].identification, len(panels))
-    for (ax, name, part, x), label in zip(panels, labels):
+    for k, ((ax, name, part, x), label) in enumerate(zip(panels, labels)):
         order = np.argsort(x, kind="stable")
         ax.fill_between(x[order], (y[part] - 2 * std[part])[order], (y[part] + 2 * std[part])[order], color=MEASURED,
                         alpha=0.15, lw=0, label="data +/- 2 std")
-        ax.plot(x, y[part], "o", color="k", ms=3.5, label="data")
         for score, colour in zip(result.scores, _colours(len(result.scores))):
-            fit = np.asarray(score.identification.y_fit, float)[part][order]
-            ax.plot(x[order], fit, "-", color=colour, lw=1.5,
-                    label=f"{score.rank}. {score.label} (RMS {score.rms_percent:.2g} %)")
+            ident = score.identification
+            draw_computed(ax, x, np.asarray(ident.y_fit, float)[part], block_run_curve(ident, k), colour=colour,
+                          lw=1.5, label=f"{score.rank}. {score.label} (RMS {score.rms_percent:.2g} %)")
+        ax.plot(x, y[part], "o", color="k", ms=3.5, label="data", zorder=3)
         finish_block_panel(ax, name, True, label)
     return fig
 
@@ -114,7 +116,8 @@ def _page(result, pngs: dict, title: str, provenance) -> list:
             f"<p>{esc(DEFINITIONS)}</p>"]
     captions = {"compare_evidence": "Log evidence of every model with its Monte-Carlo error bars and the Laplace "
                                     "approximation at the estimate.",
-                "compare_fits": "The data and every model's computed values at its estimate."}
+                "compare_fits": "The data and every model's curve computed at its estimate (its forward run's own "
+                                "curve, dots where the data's points sample it)."}
     body += [html_image(png, name, captions[name]) for name, png in pngs.items()]
     body.append("<h2>Models</h2>")
     body += [_model_section(score) for score in result.scores]

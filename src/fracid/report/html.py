@@ -124,7 +124,9 @@ def fit_section(result, control, figures, control_label=None, skip=()) -> str:
     fig = figures.fit_figure(result, control, control_label, skip=skip)
     image = "" if fig is None else html_image(
         figures.to_png(fig, stem="fit"), "measured and computed curves", "Measured points with the +/- 2 std band of the data and "
-        "the curve computed at the estimate (a line through its values at the data points).")
+        + ("the curve computed at the estimate: the forward run's own curve (every step up to the data's last "
+           "control value), dots where the data's points sample it." if figures.run_curves(result) else
+           f"the curve computed at the estimate ({figures.AT_DATA_POINTS})."))
     unit_note = ("RMS error of the computed values over the measured range and peaks in the unit of the block "
                  "(N for forces, mm for widths); peaks are the values of largest magnitude; the objective share is "
                  "sum(((y_exp - y_fit) / std_exp)^2) over the block.")
@@ -144,7 +146,8 @@ def diagnostics_fragment(result, control) -> str:
     control = getattr(result, "control", None) if control is None else control
     d = fit_diagnostics(None if control is None else float_array(control, np.nan), float_array(result.y_exp, np.nan),
                         float_array(result.std_exp, np.nan), float_array(result.y_fit, np.nan),
-                        getattr(result, "blocks", None) or [], getattr(result, "quantities", None) or [])
+                        getattr(result, "blocks", None) or [], getattr(result, "quantities", None) or [],
+                        getattr(result, "curves", None) or [])
     where = "control [mm]" if d["control"] == "mm" else "point index"
     rows = [[b["block"], b["elastic_points"], num(b["slope_data"], 4), num(b["slope_model"], 4),
              num(100 * b["slope_ratio"], 3), num(b["peak_data"], 5), num(b["control_peak_data"], 4),
@@ -157,9 +160,10 @@ def diagnostics_fragment(result, control) -> str:
     text = (f"Worst residual: {worst['residual_std']:+.3g} std at point {worst['index']} (block {worst['block']}, "
             f"{where} {num(worst['control'], 4)}: computed {num(worst['computed'], 5)}, measured "
             f"{num(worst['measured'], 5)}). " if worst else "")
-    text += (f"Elastic slope: the least-squares line through the measured points of the rising branch up to "
-             f"{100 * ELASTIC_FRACTION:.0f} % of the block's peak, and through the computed values at the same points; "
-             f"slopes in the block's unit per {'mm' if d['control'] == 'mm' else 'point'}. Note: {d['note']}.")
+    text += (f"Elastic slope: the least-squares line through the origin and the points of each curve's own rising "
+             f"branch (before its own peak) up to {100 * ELASTIC_FRACTION:.0f} % of its own peak (elastic points: the "
+             "measured ones); when a curve has none that low, the secant to its first point, a lower bound of its "
+             f"slope; slopes in the block's unit per {'mm' if d['control'] == 'mm' else 'point'}. Note: {d['note']}.")
     return f"<h3>Fit diagnostics</h3>\n{table}\n<p>{esc(text)}</p>"
 
 

@@ -27,6 +27,8 @@ from fracid.report.figures import (
     covariance_ellipse,
     new_figure,
     block_panels,
+    block_run_curve,
+    draw_computed,
     finish_block_panel,
     parameter_units,
     to_png,
@@ -211,22 +213,26 @@ def predictive_figure(result, control=None, blocks=None, fit=None) -> Figure:
         Control value [mm] of every measured value; the point index without it.
     blocks : sequence of (name, start, stop), optional
         Data blocks of y (``ExperimentalData.blocks``); one block without them.
-    fit : array_like, optional
-        The values computed at the identification's estimate (``MethodResult.y_fit``).
+    fit : MethodResult or array_like, optional
+        The identification: its curve at the estimate is drawn (the run's own, ``curves``,
+        :func:`~fracid.report.figures.draw_computed`); or only its values at the data's points (``y_fit``), drawn
+        as the line through them.
     """
     y_exp = np.asarray(result.y_exp, float)
     std = np.asarray(result.std_exp, float)
     lower, median, upper = result.predictive_band(0.9)
-    fit = None if fit is None else np.asarray(fit, float)
+    identification = fit if hasattr(fit, "y_fit") else None
+    fit = None if fit is None else np.asarray(fit.y_fit if identification is not None else fit, float)
     blocks = [(str(b[0]), int(b[1]), int(b[2])) for b in (blocks or [])] or [("data", 0, y_exp.size)]
     fig, panels = block_panels(blocks, None if control is None else np.asarray(control, float), y_exp.size)
-    for ax, name, part, xs in panels:
+    for k, (ax, name, part, xs) in enumerate(panels):
         order = np.argsort(xs, kind="stable")
         ax.fill_between(xs[order], lower[part][order], upper[part][order], color=_POSTERIOR, alpha=0.25, lw=0,
                         label="posterior 90 % band of the computed curve")
         ax.plot(xs[order], median[part][order], "-", color=_POSTERIOR, lw=1.6, label="posterior median")
         if fit is not None and np.any(np.isfinite(fit[part])):
-            ax.plot(xs[order], fit[part][order], "--", color=_GAUSSIAN, lw=1.4, label="identification's fit")
+            curve = None if identification is None else block_run_curve(identification, k, control is not None)
+            draw_computed(ax, xs, fit[part], curve, "identification's fit", colour=_GAUSSIAN, style="--", lw=1.4)
         ax.errorbar(xs, y_exp[part], yerr=std[part], fmt="o", color=MEASURED, ms=3.5, capsize=2, lw=1,
                     label="measured +- std", zorder=3)
         finish_block_panel(ax, name, control is not None)
@@ -272,8 +278,9 @@ def write_posterior(out, result, *, data=None, fit=None, log_axes=None, title: s
     result : PosteriorResult
     data : ExperimentalData, optional
         Its ``control`` and ``blocks`` lay out the predictive figure.
-    fit : array_like, optional
-        The identification's fit, drawn in the predictive figure.
+    fit : MethodResult or array_like, optional
+        The identification (its run's curve at the estimate), or its values at the data's points, drawn in the
+        predictive figure (:func:`predictive_figure`).
     log_axes : sequence of bool, optional
         Log axes of the corner plot per parameter (``ParameterSpace.log``).
     title : str

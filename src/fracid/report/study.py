@@ -150,7 +150,8 @@ def _posterior_section(post, pngs: dict) -> str:
     if pngs.get("posterior_predictive") is not None:
         figures.append(html_image(pngs["posterior_predictive"], "posterior predictive",
                               "Measured points with +- 1 std, the posterior 90 % band of the computed curve (without "
-                              "measurement noise), its median, and the identification's fit (dashed)."))
+                              "measurement noise) and its median at the data's points, and the identification's fit "
+                              "(dashed: its run's own curve)."))
     return text + table + stats + "".join(figures)
 
 
@@ -162,7 +163,7 @@ def posterior_pngs(study, data=None) -> dict:
     control = None if data is None else data.control
     blocks = None if data is None else data.blocks
     return {"corner": to_png(corner_figure(post)),
-            "posterior_predictive": to_png(predictive_figure(post, control, blocks, study.identification.y_fit))}
+            "posterior_predictive": to_png(predictive_figure(post, control, blocks, study.identification))}
 
 
 def study_sections(study, figures: dict, posterior_figures: dict | None = None) -> list:
@@ -221,7 +222,7 @@ def write_study(directory, study, data, *, title="fracid study", truth=None, siz
     pngs, notes = None, []
     if getattr(study, "posterior", None) is not None:
         post = study.posterior
-        for item in write_posterior(directory, post, data=data, fit=study.identification.y_fit,
+        for item in write_posterior(directory, post, data=data, fit=study.identification,
                                     title=f"{title}: posterior", provenance=provenance):  # log axes: the posterior's own (its space's)
             if item.startswith("("):
                 notes.append(item)
