@@ -286,8 +286,10 @@ def test_warnings_head_the_report_poor_fit_bound_and_failed_runs(tmp_path):
     assert "fit is poor" in text and f"{poor.rms_percent:.3g} %" in text and "beta = " in text
     assert "not converged" in text and "2 in the Kalman stage" in text and "1 of 20 KNN" in text
     html = write_report(tmp_path / "r.html", poor, control=CONTROL).read_text(encoding="utf-8")
-    # poor fit, the peak 50 % below the measured one, the bound, not converged, failed runs
-    assert html.count('<span class="warn">warning</span>') == 5 and "beta (at a bound)" in html
+    # poor fit, the elastic slope 50 % softer (through the origin: one point at 5 std), the peak 50 % below the
+    # measured one, the bound, not converged, failed runs
+    assert html.count('<span class="warn">warning</span>') == 6 and "beta (at a bound)" in html
+    assert "the model is 50 % softer than the data in block &#x27;global&#x27;" in html
     assert "the model&#x27;s peak is 50 % below the measured one in block &#x27;global&#x27;" in html
     assert "report.html" not in html  # the warnings do not send the reader to the page they are in
     assert make_result().warnings() == ["failed forward runs: 1 of 20 KNN, 0 in the Kalman stage (each with its "
