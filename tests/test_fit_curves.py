@@ -90,3 +90,10 @@ def test_the_posterior_predictive_figure_draws_the_identifications_run_curve():
     _check_run_curve(line(predictive_figure(post, CONTROL, ident.blocks, ident), "identification's fit"))
     _check_fallback(line(predictive_figure(post, CONTROL, ident.blocks, result(curves=False)), "identification's fit"))
     _check_fallback(line(predictive_figure(post, CONTROL, ident.blocks, ident.y_fit), "identification's fit"))
+
+
+def test_the_reports_computed_peak_is_the_runs_own():
+    from fracid.report import fit_metrics
+
+    assert fit_metrics(result())[0]["peak_computed"] == pytest.approx(100.0)
+    assert fit_metrics(result(curves=False))[0]["peak_computed"] == pytest.approx(computed(CONTROL).max())

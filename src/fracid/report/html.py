@@ -34,18 +34,19 @@ def fit_metrics(result, skip=()) -> list[dict]:
         Per block: ``block``, ``n`` (points where both values are finite), ``rms`` (root mean square
         of y_fit - y_exp over the measured range, in the block's unit: N for forces),
         ``rms_percent`` (rms in % of |measured peak|), ``peak_measured`` and ``peak_computed`` (the
-        value of largest magnitude), ``peak_error_percent`` ((computed - measured) / |measured| in %),
+        value of largest magnitude; the computed one on the run's own curve when the result keeps it, so that a
+        peak between two data points counts), ``peak_error_percent`` ((computed - measured) / |measured| in %),
         ``index_peak_measured``/``index_peak_computed`` (positions in y) and ``f`` (the block's share
         of the objective sum(((y_exp - y_fit) / std_exp)^2)).
     """
-    from fracid.inverse.core.diagnostics import block_peak
-    from fracid.report.figures import float_array, result_blocks
+    from fracid.inverse.core.diagnostics import block_curve, block_peak
+    from fracid.report.figures import float_array, result_blocks, run_curves
 
     y_exp = float_array(result.y_exp, np.nan)
     y_fit = float_array(result.y_fit, np.nan) if result.y_fit is not None else np.full_like(y_exp, np.nan)
     std = float_array(result.std_exp, np.nan)
     metrics = []
-    for name, start, stop in result_blocks(result):
+    for k, (name, start, stop) in enumerate(result_blocks(result)):
         if name in set(skip):
             continue
         y, fit, s = y_exp[start:stop], y_fit[start:stop], std[start:stop]
@@ -55,8 +56,8 @@ def fit_metrics(result, skip=()) -> list[dict]:
         if both.any():
             residual = fit[both] - y[both]
             rms = float(np.sqrt(np.mean(residual**2)))
-            ic = block_peak(fit)
-            peak_c = float(fit[ic])
+            ic, curve = block_peak(fit), block_curve(run_curves(result), k)
+            peak_c = float(fit[ic]) if curve is None else float(curve[1][block_peak(curve[1])])
             f = float(np.sum((residual / s[both]) ** 2))
         else:
             rms, ic, peak_c, f = math.nan, None, math.nan, math.nan
