@@ -216,7 +216,8 @@ def fit_figure(result, control=None, control_label=None, skip=()) -> Figure | No
     control = getattr(result, "control", None) if control is None else control
     blocks = result_blocks(result)
     labels = block_control_labels(result, len(blocks), control_label)
-    drawn_blocks = [(k, block, label) for k, (block, label) in enumerate(zip(blocks, labels)) if block[0] not in set(skip)]
+    drawn_blocks = [(k, block, label) for k, (block, label) in enumerate(zip(blocks, labels))
+                    if block[0] not in set(skip)]
     if not drawn_blocks:
         return None
     indices, blocks, labels = zip(*drawn_blocks)

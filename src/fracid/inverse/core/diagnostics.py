@@ -251,8 +251,8 @@ def slope_warning(d: dict, tolerance: float = SLOPE_TOLERANCE) -> str | None:
         return None
     way, bound = slope_direction(d)
     spread = f" +- {d['slope_std']:.2g}" if math.isfinite(d["slope_std"]) else ""  # the data's scatter
-    slopes = (f"elastic slope {d['slope_model']:.4g} against {d['slope_data']:.4g}{spread} measured, through the origin over "
-              f"{d.get('elastic_points_model', '?')} computed and {d['elastic_points']} measured point(s) of each "
+    slopes = (f"elastic slope {d['slope_model']:.4g} against {d['slope_data']:.4g}{spread} measured, through the "
+              f"origin over {d.get('elastic_points_model', '?')} computed and {d['elastic_points']} measured point(s) of each "
               f"curve's rising branch below {100 * ELASTIC_FRACTION:.0f} % of its peak")
     causes = ("check the specimen's geometry (e.g. the notch depth, the ligament, the thickness, the span or length), "
               "E, and the units (force_unit, control_unit); a soft start of the test (seating, the machine's "
@@ -300,8 +300,8 @@ def diagnostics_lines(diagnostics: dict) -> list[str]:
     for d in diagnostics.get("blocks", []):
         bound = "" if d.get("slope_model_elastic", True) and d.get("slope_data_elastic", True) else \
             " (a secant above the elastic part: a bound only)"
-        lines.append(f"{d['block']}: elastic slope model/data {_percent(d['slope_ratio'])}{bound}, peak {d['peak_model']:.4g} "
-                     f"at {d['control_peak_model']:.4g} against {d['peak_data']:.4g} at {d['control_peak_data']:.4g} "
+        lines.append(f"{d['block']}: elastic slope model/data {_percent(d['slope_ratio'])}{bound}, peak "
+                     f"{d['peak_model']:.4g} at {d['control_peak_model']:.4g} against {d['peak_data']:.4g} at {d['control_peak_data']:.4g} "
                      f"{unit} measured (model/data {_percent(d['peak_ratio'])})")
     worst = diagnostics.get("worst")
     if worst:
