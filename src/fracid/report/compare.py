@@ -3,7 +3,7 @@
 
 :func:`write_compare` writes ``compare.json``, ``figures/compare_fits.png`` (the data with every model's fit
 overlaid, :func:`fits_figure`), ``figures/compare_evidence.png`` (the log evidences with their Monte-Carlo
-error bars and the Laplace approximations, :func:`evidence_figure`) and ``report.html``: the ranking table,
+error bars and the Laplace approximations, :func:`evidence_figure`) and ``compare.html`` (:data:`REPORT`): the ranking table,
 both figures, per model its parameters, its verdict and its posterior's status, the failures, the
 definitions and how it was run.
 
@@ -21,7 +21,10 @@ from fracid.report.figures import MEASURED, block_control_labels, block_panels, 
 from fracid.report.html import parameter_section
 from fracid.report.markup import duration, esc, generated_now, html_image, html_table, provenance_section, write_document
 
-__all__ = ["DEFINITIONS", "evidence_figure", "fits_figure", "write_compare"]
+__all__ = ["DEFINITIONS", "REPORT", "evidence_figure", "fits_figure", "write_compare"]
+
+#: the report's file name: its own, so that it never replaces identify's or study's report.html in a shared --out
+REPORT = "compare.html"
 
 #: what the table's numbers are (the report's and the docs' paragraph)
 DEFINITIONS = (
@@ -128,7 +131,7 @@ def _page(result, pngs: dict, title: str, provenance) -> list:
 
 def write_compare(out, result, *, title: str = "fracid compare", provenance=None) -> list[str]:
     """Write the comparison's files into ``out``: compare.json, figures/compare_fits.png,
-    figures/compare_evidence.png (when a model has a log evidence) and report.html; their names (relative)."""
+    figures/compare_evidence.png (when a model has a log evidence) and :data:`REPORT`; their names (relative)."""
     out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     result.save(out / "compare.json")
@@ -136,5 +139,5 @@ def write_compare(out, result, *, title: str = "fracid compare", provenance=None
     pngs = {name: to_png(fig) for name, fig in drawn.items() if fig is not None}
     for name, png in pngs.items():
         (out / "figures" / f"{name}.png").write_bytes(png)
-    write_document(out / "report.html", title, _page(result, pngs, title, provenance))
-    return ["compare.json", "report.html", *(f"figures/{name}.png" for name in pngs)]
+    write_document(out / REPORT, title, _page(result, pngs, title, provenance))
+    return ["compare.json", REPORT, *(f"figures/{name}.png" for name in pngs)]
