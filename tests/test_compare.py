@@ -167,16 +167,16 @@ kappa_i = [5e-5, 2e-4]
 beta = [100.0, 900.0]
 log = ["beta"]
 [identify.knn]
-n = 4
-k = 2
+n = 12
+k = 3
 [identify.kalman]
 groups = 2
-max_iterations = 1
+max_iterations = 3
 max_starts = 1
 [posterior]
-samples_per_round = 10
-max_rounds = 1
-target_ess = 5
+samples_per_round = 40
+max_rounds = 3
+target_ess = 20
 [output]
 directory = "out"
 """
@@ -215,7 +215,7 @@ def test_compare_command_end_to_end(bar_config):
     assert local["bounds"] == [[pytest.approx(3.33e-5), 100.0], [pytest.approx(3e-4), 900.0]]
     for model in saved["models"]:
         assert model["log_evidence"] is not None and model["log_evidence_error"] > 0
-    for name in ("report.html", "figures/compare_fits.png", "figures/compare_evidence.png", "runs.sqlite"):
+    for name in ("compare.html", "figures/compare_fits.png", "figures/compare_evidence.png", "runs.sqlite"):
         assert (out / name).is_file(), name
     assert "log Z (+- MC error)" in run.stdout and "best by evidence" in run.stdout
     again = _fracid("compare", bar_config, "--models", "gradient-damage", "local-damage", "--workers", "1", "--quiet",

@@ -35,7 +35,10 @@ DEFINITIONS = (
     "S)^-1. delta log Z: the log Bayes factor against the first. AIC = 2 p - 2 log L, BIC = p ln n - 2 log L at "
     "the estimate (lower is better). MAP objective: chi2 plus the term of the prior the search gave, the objective "
     "the inverse method minimised. RMS in % of the measured peak. A tie: log Z within "
-    f"{TIE_SIGMAS:g} combined Monte-Carlo errors of the first's.")
+    f"{TIE_SIGMAS:g} combined Monte-Carlo errors of the first's; the Monte-Carlo error is the larger of the delta "
+    "method's and a bootstrap over the draws. Not estimated, not ranked: a posterior whose effective sample size is "
+    "below the sampler's floor. log Z, bounds widened: log Z - log(volume ratio) with every prior span widened "
+    "(exact when the likelihood has no mass beyond the bounds; a lower bound when the posterior reaches them).")
 
 
 def _colours(n: int) -> list:
@@ -111,10 +114,16 @@ def _model_section(score) -> str:
 
 def _page(result, pngs: dict, title: str, provenance) -> list:
     header, rows = result.table()
-    body = [f"<h1>{esc(title)}</h1>", f'<p class="meta">Generated {esc(generated_now())} by fracid.</p>',
-            '<ul class="notes">' + "".join(f"<li>{esc(n)}</li>" for n in result.notes()) + "</ul>",
+    warnings = result.warnings()
+    body = [f"<h1>{esc(title)}</h1>", f'<p class="meta">Generated {esc(generated_now())} by fracid.</p>']
+    if warnings:  # first: what is missing from the ranking or doubtful in it
+        body += ['<h2 class="warning">Warnings</h2>',
+                 '<ul class="warnings">' + "".join(f"<li>{esc(w)}</li>" for w in warnings) + "</ul>"]
+    body += ['<ul class="notes">' + "".join(f"<li>{esc(n)}</li>" for n in result.notes()[len(warnings):]) + "</ul>",
             "<h2>Ranking by log evidence</h2>", html_table(header, rows, text_columns=(1, 11)),
             f"<p>{esc(DEFINITIONS)}</p>"]
+    if result.settings.get("prior"):
+        body.append(f"<p>Prior of every model: {esc(result.settings['prior'])}.</p>")
     captions = {"compare_evidence": "Log evidence of every model with its Monte-Carlo error bars and the Laplace "
                                     "approximation at the estimate.",
                 "compare_fits": "The data and every model's computed values at its estimate."}

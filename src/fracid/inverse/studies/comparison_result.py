@@ -16,7 +16,12 @@ import numpy as np
 
 from fracid.inverse.studies.evidence import BOUND_MARGIN, BOUND_SHARE, TIE_SIGMAS, rank_by_evidence
 
-__all__ = ["ComparisonResult", "ModelScore", "map_objective"]
+#: the gap [log units] between a sampled log evidence and its Laplace value that a comparison warns about beyond
+#: the Monte-Carlo error: a Gaussian approximation is off by a few tenths on a mildly skewed posterior, and a
+#: log Bayes factor below 1 is "barely worth mentioning" (Jeffreys' scale)
+LAPLACE_TOLERANCE = 1.0
+
+__all__ = ["LAPLACE_TOLERANCE", "ComparisonResult", "ModelScore", "map_objective"]
 
 
 def map_objective(result, chi2: float) -> float:
@@ -145,9 +150,11 @@ class ModelScore:
 
     def laplace_disagrees(self) -> bool:
         """Whether the sampled log evidence and the Laplace value differ by more than :data:`TIE_SIGMAS` times the
-        Monte-Carlo error (one of them is off: a bound, a curved valley, or too few draws)."""
+        Monte-Carlo error and :data:`LAPLACE_TOLERANCE` (one of them is off: a bound, a curved valley, too few
+        draws)."""
         gap = abs(self.log_evidence - self.log_evidence_laplace)
-        return self.estimated and math.isfinite(gap) and gap > TIE_SIGMAS * max(self.log_evidence_error, 0.1)
+        return (self.estimated and math.isfinite(gap)
+                and gap > max(TIE_SIGMAS * self.log_evidence_error, LAPLACE_TOLERANCE))
 
     def sampling_text(self) -> str:
         """The posterior's effective sample size and whether it reached the target (``ESS 212``, ``ESS 40 (below
@@ -203,13 +210,16 @@ class ComparisonResult:
     failures : dict
         label -> why the model could not be compared.
     settings : dict
-        The sampler's settings, the verdict's tolerance, the inverse method.
+        The sampler's settings, the verdict's tolerance, the inverse method, the prior sensitivity's ``widen``.
+    setup_warnings : list of str
+        What the set-up changed that the numbers depend on (e.g. bounds cut to the mesh): the first warnings.
     """
 
     data: object
     scores: list
     failures: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
+    setup_warnings: list = field(default_factory=list)
 
     @classmethod
     def ranked(cls, data, scores, failures, settings) -> "ComparisonResult":
@@ -246,7 +256,8 @@ class ComparisonResult:
         """What makes the ranking incomplete or a number doubtful: the models not compared, those whose log evidence
         is not estimated (not ranked), and sampled log evidences far from their Laplace value. ``fracid compare``
         prints them on stderr and its report opens with them."""
-        lines = [f"{label}: not compared, left out of the ranking ({why})" for label, why in self.failures.items()]
+        lines = list(self.setup_warnings)
+        lines += [f"{label}: not compared, left out of the ranking ({why})" for label, why in self.failures.items()]
         lines += [f"{s.label}: log evidence not estimated, not ranked: its posterior's effective sample size "
                   f"{s.posterior.ess:.2g} is below the sampler's floor, so log Z ({s.log_evidence:.3g}) and its "
                   "Monte-Carlo error are not credible (more draws: --samples, --rounds)"
@@ -301,7 +312,8 @@ class ComparisonResult:
         return _plain({"ranking": [s.label for s in self.scores if s.rank],
                        "not_ranked": [s.label for s in self.scores if not s.rank], "best": self.best.label if self.best else None,
                        "tie_sigmas": TIE_SIGMAS, "models": [s.to_dict() for s in self.scores],
-                       "failures": dict(self.failures), "settings": self.settings, "notes": self.notes(),
+                       "failures": dict(self.failures), "settings": self.settings,
+                       "warnings": self.warnings(), "notes": self.notes(),
                        "data": {"control": np.asarray(data.control, float), "y": np.asarray(data.y, float),
                                 "std": np.asarray(data.std, float), "blocks": [list(b) for b in data.blocks]}})
 

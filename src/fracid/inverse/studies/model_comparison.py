@@ -110,7 +110,8 @@ def compare(data, contenders, *, method=None, posterior: PosteriorSettings = Pos
     progress : bool or None
         Progress bars of the identifications and samplers (False: none; several models run at once).
     log : callable, optional
-        ``log(text)``: a line per model and stage.
+        ``log(text)``: a line per model and stage, ``"<label>: <stage>"``; the last ``"<label>: done: ..."`` or
+        ``"<label>: failed (...)"`` (:class:`fracid.runtime.progress.StageLines` reads them).
     retry_failed : bool
         Run again the runs stored as failed.
     tolerance : float
@@ -170,7 +171,7 @@ def _score(data, contender: Contender, job) -> ModelScore:
     score = _numbers(label, contender, data, result, (chi2, log_l, laplace), post, post_error, verdict)
     score.log_evidence_wider, score.at_bounds = _sensitivity(contender, post, job["widen"])
     score.seconds = time.perf_counter() - start
-    say(f"{label}: {score.line()}")
+    say(f"{label}: done: {score.line()}")
     return score
 
 
