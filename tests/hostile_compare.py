@@ -13,7 +13,8 @@ import os
 
 from hostile import _clean, case, check, fracid_wrote
 
-#: a posterior whose second round reaches ESS 15 on the bar (measured 19.5 with c at its lower bound), the floor min(15, 50) = 15
+#: a posterior whose second round reaches ESS 15 on the bar (measured 19.5 with c at its lower bound), the floor
+#: min(15, 50) = 15
 ESTIMATED = "[posterior]\nsamples_per_round = 40\nmax_rounds = 2\ntarget_ess = 15\n"
 #: 10 draws: ESS <= 10, below the floor of 20 whatever the weights
 BELOW_FLOOR = "[posterior]\nsamples_per_round = 10\nmax_rounds = 1\ntarget_ess = 20\n"
@@ -131,6 +132,7 @@ CASES = {
         None, config={"c": "2.0", "tail": BELOW_FLOOR}, slow=True, verify=_mesh_cut,
         args=("compare", "cfg.toml", "--models", "gradient-damage", *QUIET)),
     "compare-progress-lines-per-model": case(
-        None, config={**FINE, "tail": BELOW_FLOOR}, args=("compare", "cfg.toml", *TWO, "--out", "out", "--workers", "1"),
+        None, config={**FINE, "tail": BELOW_FLOOR}, args=("compare", "cfg.toml", *TWO, "--out", "out",
+                                                          "--workers", "1"),
         env={"FRACID_PROGRESS_SECONDS": "0.5"}, slow=True, verify=_progress_lines),
 }

@@ -10,9 +10,11 @@ writes for it, its other parameters the configuration's values where the names a
 beta, c ... between the damage models), its class's defaults elsewhere. The lower bound of the parameter that sets
 a model's mesh length is raised to what the mesh resolves, and a model the mesh resolves nowhere in its bounds is
 left out, both warned (:func:`fracid.config.mesh_bounds.fit_to_mesh`). A line per model every
-``FRACID_PROGRESS_SECONDS`` (30 s) says its stage while the models run side by side. Every model is identified with ``[identify] method`` and its settings, and sampled with
+``FRACID_PROGRESS_SECONDS`` (30 s) says its stage while the models run side by side. Every model is identified
+with ``[identify] method`` and its settings, and sampled with
 ``[posterior]`` (:data:`DEFAULT_POSTERIOR` when the configuration leaves it at its defaults; ``--samples``,
-``--rounds`` override). Writes compare.json, compare.html (its own name: identify's report.html in a shared ``--out`` stays) and
+``--rounds`` override). Writes compare.json, compare.html (its own name: identify's report.html in a shared
+``--out`` stays) and
 figures/compare_*.png
 (:func:`fracid.report.compare.write_compare`) beside the run store.
 """

@@ -98,7 +98,8 @@ def fit_to_mesh(cfg) -> MeshFit:
     cut = smallest_resolved(mesh_length.length, h, lower, upper)
     if cut is None:
         return MeshFit(None, f"{what} = {mesh_length.length(upper):.3g} mm even at the upper bound {name} = "
-                             f"{upper:g} {unit}, so {mesh_length.band} is not resolved anywhere in [{lower:g}, {upper:g}]")
+                             f"{upper:g} {unit}, so {mesh_length.band} is not resolved anywhere in "
+                             f"[{lower:g}, {upper:g}]")
     if cut == lower:
         return MeshFit(cfg, None)
     bounds = replace(identify, lower=tuple(cut if j == i else v for j, v in enumerate(identify.lower)))

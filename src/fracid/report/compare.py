@@ -3,9 +3,10 @@
 
 :func:`write_compare` writes ``compare.json``, ``figures/compare_fits.png`` (the data with every model's fit
 overlaid, :func:`fits_figure`), ``figures/compare_evidence.png`` (the log evidences with their Monte-Carlo
-error bars and the Laplace approximations, :func:`evidence_figure`) and ``compare.html`` (:data:`REPORT`): the ranking table,
-both figures, per model its parameters, its verdict and its posterior's status, the failures, the
-definitions and how it was run.
+error bars and the Laplace approximations, :func:`evidence_figure`) and ``compare.html`` (:data:`REPORT`): the
+warnings first (models not compared or not ranked, doubtful numbers), the ranking table, both figures, per model
+its parameters, its verdict and its posterior's status, the failures, the definitions, the prior rule and how it
+was run.
 
 Units: control [mm], force [N]; the log evidences are natural logarithms [-].
 """

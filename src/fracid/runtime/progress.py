@@ -215,7 +215,8 @@ class StageLines:
         """A line per job still running: its label, the time since the start, its last stage."""
         elapsed = clock(time.perf_counter() - self.started)
         with self._lock:
-            return [f"{label}: {elapsed} elapsed, {self.stages[label]}" for label in self.stages if label in self.running]
+            return [f"{label}: {elapsed} elapsed, {stage}" for label, stage in self.stages.items()
+                    if label in self.running]
 
     def _beat(self, interval: float) -> None:
         while not self._stop.wait(interval):

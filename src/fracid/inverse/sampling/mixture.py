@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import gammaln, logsumexp
 
-__all__ = ["GaussianMixture", "amis_log_evidence", "amis_weights", "bootstrap_log_mean_std", "fit_mixture", "weighted_covariance", "weighted_quantile"]
+__all__ = ["GaussianMixture", "amis_log_evidence", "amis_weights", "bootstrap_log_mean_std", "fit_mixture",
+           "weighted_covariance", "weighted_quantile"]
 
 #: draws used to measure a mixture's mass inside the unit cube
 _MASS_DRAWS = 20_000

@@ -185,7 +185,8 @@ class ModelScore:
             "log_evidence_sampled": self.log_evidence, "log_evidence_estimated": self.estimated,
             "log_evidence_error": self.log_evidence_error, "log_evidence_wider": self.log_evidence_wider,
             "posterior_at_bounds": self.at_bounds,
-            "log_evidence_laplace": self.log_evidence_laplace, "delta_log_evidence": self.delta if self.estimated else None,
+            "log_evidence_laplace": self.log_evidence_laplace,
+            "delta_log_evidence": self.delta if self.estimated else None,
             "tied_with_best": self.tied, "posterior_status": self.posterior_status,
             "posterior": post.to_dict() if post is not None else None, "verdict": self.verdict.as_dict(),
             "y_fit": np.asarray(ident.y_fit, float), "forward_runs": ident.forward_runs,
@@ -291,7 +292,8 @@ class ComparisonResult:
         moved = (best.log_evidence_wider - second.log_evidence_wider) - (best.log_evidence - second.log_evidence)
         bounded = [s.label for s in (best, second) if s.at_bounds > BOUND_SHARE]
         return (f"prior sensitivity: with every prior span x {factor:g} (in x, or ln x for a log parameter; clipped to "
-                f"the valid ranges) the log Bayes factor of {best.label} against {second.label} moves by {moved:+.3g} to "
+                f"the valid ranges) the log Bayes factor of {best.label} against {second.label} moves by "
+                f"{moved:+.3g} to "
                 f"{best.log_evidence_wider - second.log_evidence_wider:.3g} (log Z moves by -log of the volume ratio "
                 "where the likelihood has no mass beyond the bounds)" + (
                     f"; {', '.join(bounded)}: over {BOUND_SHARE:.0%} of the posterior weight within "
@@ -310,7 +312,8 @@ class ComparisonResult:
         and the data (control [mm], values, std)."""
         data = self.data
         return _plain({"ranking": [s.label for s in self.scores if s.rank],
-                       "not_ranked": [s.label for s in self.scores if not s.rank], "best": self.best.label if self.best else None,
+                       "not_ranked": [s.label for s in self.scores if not s.rank],
+                       "best": self.best.label if self.best else None,
                        "tie_sigmas": TIE_SIGMAS, "models": [s.to_dict() for s in self.scores],
                        "failures": dict(self.failures), "settings": self.settings,
                        "warnings": self.warnings(), "notes": self.notes(),
