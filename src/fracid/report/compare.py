@@ -77,7 +77,7 @@ def evidence_figure(result):
     """The log evidence of every model with +- :data:`TIE_SIGMAS` Monte-Carlo standard errors (bars) and the
     Laplace approximation (open marker), best at the top, and beside it the models within :data:`ZOOM` of the
     best when some lie further; None when no model has a log evidence."""
-    scores = [s for s in result.scores if np.isfinite(s.log_evidence)]
+    scores = [s for s in result.scores if s.estimated]  # not the log evidences below the ESS floor
     if not scores:
         return None
     near = [s for s in scores if scores[0].log_evidence - s.log_evidence <= ZOOM]
@@ -106,7 +106,8 @@ def _evidence_panel(ax, scores) -> None:
 def _model_section(score) -> str:
     ident = score.identification
     verdict = score.verdict.text({name: unit for name, unit in (ident.units or {}).items() if unit != "-"})
-    return (f"<details><summary>{esc(score.rank)}. {esc(score.label)} ({esc(score.model)}): parameters, verdict, "
+    rank = f"{score.rank}." if score.rank else "not ranked:"
+    return (f"<details><summary>{esc(rank)} {esc(score.label)} ({esc(score.model)}): parameters, verdict, "
             f"posterior</summary>\n{parameter_section(ident)}\n<h3>Verdict</h3>\n<pre>{esc(verdict)}</pre>\n"
             f"<p>Posterior: {esc(score.posterior_status)}; {ident.forward_runs} identification runs"
             + (f", {len(score.posterior.x)} posterior draws, ESS {score.posterior.ess:.0f}" if score.posterior else "")
