@@ -87,18 +87,15 @@ def model_config(cfg, kind: str):
     """``cfg`` for model type ``kind`` with the bounds of the one prior rule (module docstring): the configuration's
     own model keeps its ``[model]`` and its ``[identify]`` parameters; another gets ``[model]`` of that type with the
     shared parameter values and ``fracid init``'s parameters. Every identified parameter's bounds are
-    :func:`fracid.cli.init.default_identification`'s around its value (log scale for beta)."""
-    from fracid.cli.init import default_identification
+    :func:`fracid.cli.init.first_prior`'s around its value."""
+    from fracid.cli.init import default_identification, first_prior
     from fracid.config import build_parameters
     from fracid.config.schema import ModelConfig
     from fracid.models import model_from_type
-    from fracid.models.plausibility import first_bounds
 
     if kind == cfg.model.type:
-        params, model = build_parameters(cfg), cfg.model
-        names = list(cfg.identify.parameters)
-        bounds = {name: first_bounds(type(params), name, getattr(params, name)) for name in names}
-        log = [name for name in names if name == "beta"]
+        names, model = list(cfg.identify.parameters), cfg.model
+        bounds, log = first_prior(build_parameters(cfg), names)
     else:
         given = build_parameters(cfg)
         cls = model_from_type(kind).parameters

@@ -183,7 +183,8 @@ class StageLines:
 
     Use :meth:`log` as the jobs' ``log(text)``: a line ``"<label>: <text>"`` is written at once and sets the label's
     stage; a text starting with one of ``ends`` (``"done"``, ``"failed"``) ends the label's job. Within ``with``, a
-    thread writes ``"<label>: 1:30 elapsed, <stage>"`` for every job still running each interval.
+    thread writes ``"<label>: 1:30 elapsed, <stage>"`` for every job still running each interval (the time since
+    the job's first line; since the start while it waits for a worker).
 
     Parameters
     ----------
@@ -198,6 +199,7 @@ class StageLines:
     def __init__(self, labels, write, ends=("done", "failed")):
         self.write, self.ends, self.started = write, tuple(ends), time.perf_counter()
         self.stages = {label: "waiting for a worker" for label in labels}
+        self.since = dict.fromkeys(self.stages, self.started)  # a job's first line, or the start while it waits
         self.running = set(self.stages)
         self._stop, self._thread, self._lock = threading.Event(), None, threading.Lock()
 
@@ -206,17 +208,20 @@ class StageLines:
         label, _, rest = str(text).partition(": ")
         with self._lock:
             if label in self.stages:
+                if self.stages[label] == "waiting for a worker":
+                    self.since[label] = time.perf_counter()
                 self.stages[label] = rest
                 if rest.startswith(self.ends):
                     self.running.discard(label)
         self.write(text)
 
     def status(self) -> list[str]:
-        """A line per job still running: its label, the time since the start, its last stage."""
-        elapsed = clock(time.perf_counter() - self.started)
+        """A line per job still running: its label, the time since its first line (since the start while it
+        waits), its last stage."""
+        now = time.perf_counter()
         with self._lock:
-            return [f"{label}: {elapsed} elapsed, {stage}" for label, stage in self.stages.items()
-                    if label in self.running]
+            return [f"{label}: {clock(now - self.since[label])} elapsed, {stage}"
+                    for label, stage in self.stages.items() if label in self.running]
 
     def _beat(self, interval: float) -> None:
         while not self._stop.wait(interval):
