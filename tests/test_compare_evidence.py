@@ -141,6 +141,11 @@ def test_laplace_disagreement_and_bounds_are_warned_both_ways():
     assert not close.laplace_disagrees() and far.laplace_disagrees()
     assert [w.split(":")[0] for w in result.warnings()] == ["far"]
     assert "far: over 5% of the posterior weight" in next(n for n in result.notes() if n.startswith("prior"))
+    unsampled = _score("unsampled", float("nan"), float("nan"), ess=0.0)
+    unsampled.posterior, unsampled.posterior_status = None, "not sampled: ForwardRunError: all 8 runs failed"
     alone = ComparisonResult.ranked(SimpleNamespace(), [_score("only", 1.0, 0.1, ess=100.0),
-                                                        _score("rough", 2.0, 0.1, ess=3.0)], {}, {"widen": 2.0})
+                                                        _score("rough", 2.0, 0.1, ess=3.0), unsampled], {}, {"widen": 2.0})
     assert alone.best.label == "only" and any("the only model with an estimated" in n for n in alone.notes())
+    assert [s.rank for s in alone.scores] == [1, 0, 0]
+    assert alone.warnings()[-1] == ("unsampled: log evidence not estimated, not ranked: posterior not sampled: "
+                                    "ForwardRunError: all 8 runs failed")

@@ -259,10 +259,11 @@ class ComparisonResult:
         prints them on stderr and its report opens with them."""
         lines = list(self.setup_warnings)
         lines += [f"{label}: not compared, left out of the ranking ({why})" for label, why in self.failures.items()]
-        lines += [f"{s.label}: log evidence not estimated, not ranked: its posterior's effective sample size "
-                  f"{s.posterior.ess:.2g} is below the sampler's floor, so log Z ({s.log_evidence:.3g}) and its "
-                  "Monte-Carlo error are not credible (more draws: --samples, --rounds)"
-                  for s in self.scores if s.posterior is not None and s.posterior.sampling_failed]
+        lines += [f"{s.label}: log evidence not estimated, not ranked: " + (
+            f"its posterior's effective sample size {s.posterior.ess:.2g} is below the sampler's floor, so log Z "
+            f"({s.log_evidence:.3g}) and its Monte-Carlo error are not credible (more draws: --samples, --rounds)"
+            if s.posterior is not None and s.posterior.sampling_failed else f"posterior {s.posterior_status}")
+                  for s in self.scores if not s.estimated]
         lines += [f"{s.label}: log Z {s.evidence_text()} and its Laplace value {s.log_evidence_laplace:.3g} differ by "
                   f"{abs(s.log_evidence - s.log_evidence_laplace):.3g}, more than {TIE_SIGMAS:g} Monte-Carlo errors: "
                   "one of them is off (the Laplace value at a bound or in a curved valley, the sampled one with few "
