@@ -167,16 +167,16 @@ kappa_i = [5e-5, 2e-4]
 beta = [100.0, 900.0]
 log = ["beta"]
 [identify.knn]
-n = 4
-k = 2
+n = 12
+k = 3
 [identify.kalman]
 groups = 2
-max_iterations = 1
+max_iterations = 3
 max_starts = 1
 [posterior]
-samples_per_round = 10
-max_rounds = 1
-target_ess = 5
+samples_per_round = 40
+max_rounds = 3
+target_ess = 20
 [output]
 directory = "out"
 """
@@ -213,11 +213,17 @@ def test_compare_command_end_to_end(bar_config):
     local = next(m for m in saved["models"] if m["label"] == "local-damage")
     assert list(local["parameters"]) == ["kappa_i", "beta"]  # fracid init's: bounds a factor 3 around the values
     assert local["bounds"] == [[pytest.approx(3.33e-5), 100.0], [pytest.approx(3e-4), 900.0]]
+    own = next(m for m in saved["models"] if m["label"] == "gradient-damage")  # one prior rule: not [identify.bounds]
+    assert list(own["parameters"]) == ["kappa_i", "beta"] and own["bounds"] == local["bounds"]
+    assert own["log"] == [False, True]
     for model in saved["models"]:
         assert model["log_evidence"] is not None and model["log_evidence_error"] > 0
-    for name in ("report.html", "figures/compare_fits.png", "figures/compare_evidence.png", "runs.sqlite"):
+    for name in ("compare.html", "figures/compare_fits.png", "figures/compare_evidence.png", "runs.sqlite"):
         assert (out / name).is_file(), name
     assert "log Z (+- MC error)" in run.stdout and "best by evidence" in run.stdout
+    assert "prior sensitivity" in run.stdout
+    assert "prior of every model: uniform between bounds a factor 3" in run.stdout
+    assert not (out / "report.html").exists()  # its own compare.html
     again = _fracid("compare", bar_config, "--models", "gradient-damage", "local-damage", "--workers", "1", "--quiet",
                     cwd=bar_config.parent)  # the runs come from the store
     assert again.returncode == 0 and json.loads((out / "compare.json").read_text())["ranking"] == saved["ranking"]
@@ -248,8 +254,8 @@ def test_a_failing_model_is_recorded_and_the_others_go_on(bar_config):
     operator, space = build_operator(cfg, data), build_space(cfg)
     wrong = ParameterSpace(("kappa_i", "c"), space.lower, space.upper)
     result = compare(data, [Contender("bar", operator, space), Contender("broken", operator, wrong)],
-                     posterior=PosteriorSettings(samples_per_round=8, max_rounds=1, target_ess=4.0), n=4, k=2,
-                     max_iterations=1, max_starts=1)
+                     posterior=PosteriorSettings(samples_per_round=40, max_rounds=2, target_ess=15.0), n=12, k=3,
+                     groups=np.array_split(np.arange(data.y.size), 2), max_iterations=3, max_starts=1)
     assert [s.label for s in result.scores] == ["bar"] and result.best.label == "bar"
     assert "broken" in result.failures and "ValueError" in result.failures["broken"]
     assert any("broken: not compared" in line for line in result.notes())

@@ -66,3 +66,29 @@ def test_identify_prints_progress_lines_into_a_pipe(tmp_path):
     quiet = run_fracid(["identify", "cfg.toml", "--workers", "1", "--quiet", "--out", "again"], tmp_path,
                        env={progress.INTERVAL_VARIABLE: "0"})
     assert quiet.returncode == 0 and "fracid: forward runs" not in quiet.stderr
+
+
+def test_stage_lines_beat_for_the_jobs_still_running(monkeypatch):
+    """fracid compare's models side by side: a line per model still running every interval, its last stage in it;
+    none for a model done or failed, none at all after the block."""
+    import time
+
+    monkeypatch.setenv(progress.INTERVAL_VARIABLE, "0.05")
+    written = []
+    with progress.StageLines(["a", "b", "c"], written.append) as stages:
+        stages.log("a: identifying x, y")
+        stages.log("b: failed (ArithmeticError: no run)")
+        stages.log("unrelated line")
+        time.sleep(0.3)
+        stages.log("a: done: x = 1")
+        assert stages.status()[0].startswith("c: 0:00 elapsed, waiting for a worker")
+        time.sleep(0.15)
+    count = len(written)
+    time.sleep(0.15)
+    assert len(written) == count  # the thread has stopped
+    beats_a = [w for w in written if re.fullmatch(r"a: 0:00 elapsed, identifying x, y", w)]
+    assert len(beats_a) >= 2 and not any(re.match(r"b: 0:\d\d elapsed", w) for w in written)
+    assert "unrelated line" in written and "a: done: x = 1" in written
+    last_a = max(i for i, w in enumerate(written) if w.startswith("a: 0:"))
+    assert last_a < written.index("a: done: x = 1")  # no beat of a after its end
+    assert sum(w.startswith("c: 0:00 elapsed, waiting") for w in written) >= 3

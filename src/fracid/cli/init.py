@@ -202,11 +202,18 @@ def default_identification(model_type: str, params) -> tuple:
         its range spans decades).
     """
     from fracid.models import declared, model_from_type
-    from fracid.models.plausibility import first_bounds
 
     names = list(declared(model_from_type(model_type)).first_identified or params.names()[2:4])
+    return (names, *first_prior(params, names))
+
+
+def first_prior(params, names) -> tuple:
+    """The bounds of :func:`default_identification` for ``names`` of ``params``: ``{name: [lower, upper]}`` a factor
+    3 around each value (:func:`fracid.models.plausibility.first_bounds`), and the names sampled in log scale."""
+    from fracid.models.plausibility import first_bounds
+
     bounds = {name: first_bounds(type(params), name, getattr(params, name)) for name in names}
-    return names, bounds, [name for name in names if name == "beta"]
+    return bounds, [name for name in names if name == "beta"]
 
 
 def _identify_lines(model_type: str, demo: dict | None, params) -> list:

@@ -3,9 +3,10 @@
 
 :func:`write_compare` writes ``compare.json``, ``figures/compare_fits.png`` (the data with every model's fit
 overlaid, :func:`fits_figure`), ``figures/compare_evidence.png`` (the log evidences with their Monte-Carlo
-error bars and the Laplace approximations, :func:`evidence_figure`) and ``report.html``: the ranking table,
-both figures, per model its parameters, its verdict and its posterior's status, the failures, the
-definitions and how it was run.
+error bars and the Laplace approximations, :func:`evidence_figure`) and ``compare.html`` (:data:`REPORT`): the
+warnings first (models not compared or not ranked, doubtful numbers), the ranking table, both figures, per model
+its parameters, its verdict and its posterior's status, the failures, the definitions, the prior rule and how it
+was run.
 
 Units: control [mm], force [N]; the log evidences are natural logarithms [-].
 """
@@ -22,7 +23,10 @@ from fracid.report.figures import (MEASURED, block_control_labels, block_panels,
 from fracid.report.html import parameter_section
 from fracid.report.markup import duration, esc, generated_now, html_image, html_table, provenance_section, write_document
 
-__all__ = ["DEFINITIONS", "evidence_figure", "fits_figure", "write_compare"]
+__all__ = ["DEFINITIONS", "REPORT", "evidence_figure", "fits_figure", "write_compare"]
+
+#: the report's file name: its own, so that it never replaces identify's or study's report.html in a shared --out
+REPORT = "compare.html"
 
 #: what the table's numbers are (the report's and the docs' paragraph)
 DEFINITIONS = (
@@ -33,7 +37,10 @@ DEFINITIONS = (
     "S)^-1. delta log Z: the log Bayes factor against the first. AIC = 2 p - 2 log L, BIC = p ln n - 2 log L at "
     "the estimate (lower is better). MAP objective: chi2 plus the term of the prior the search gave, the objective "
     "the inverse method minimised. RMS in % of the measured peak. A tie: log Z within "
-    f"{TIE_SIGMAS:g} combined Monte-Carlo errors of the first's.")
+    f"{TIE_SIGMAS:g} combined Monte-Carlo errors of the first's; the Monte-Carlo error is the larger of the delta "
+    "method's and a bootstrap over the draws. Not estimated, not ranked: a posterior whose effective sample size is "
+    "below the sampler's floor. log Z, bounds widened: log Z - log(volume ratio) with every prior span widened "
+    "(exact when the likelihood has no mass beyond the bounds; a lower bound when the posterior reaches them).")
 
 
 def _colours(n: int) -> list:
@@ -72,7 +79,7 @@ def evidence_figure(result):
     """The log evidence of every model with +- :data:`TIE_SIGMAS` Monte-Carlo standard errors (bars) and the
     Laplace approximation (open marker), best at the top, and beside it the models within :data:`ZOOM` of the
     best when some lie further; None when no model has a log evidence."""
-    scores = [s for s in result.scores if np.isfinite(s.log_evidence)]
+    scores = [s for s in result.scores if s.estimated]  # not the log evidences below the ESS floor
     if not scores:
         return None
     near = [s for s in scores if scores[0].log_evidence - s.log_evidence <= ZOOM]
@@ -101,7 +108,8 @@ def _evidence_panel(ax, scores) -> None:
 def _model_section(score) -> str:
     ident = score.identification
     verdict = score.verdict.text({name: unit for name, unit in (ident.units or {}).items() if unit != "-"})
-    return (f"<details><summary>{esc(score.rank)}. {esc(score.label)} ({esc(score.model)}): parameters, verdict, "
+    rank = f"{score.rank}." if score.rank else "not ranked:"
+    return (f"<details><summary>{esc(rank)} {esc(score.label)} ({esc(score.model)}): parameters, verdict, "
             f"posterior</summary>\n{parameter_section(ident)}\n<h3>Verdict</h3>\n<pre>{esc(verdict)}</pre>\n"
             f"<p>Posterior: {esc(score.posterior_status)}; {ident.forward_runs} identification runs"
             + (f", {len(score.posterior.x)} posterior draws, ESS {score.posterior.ess:.0f}" if score.posterior else "")
@@ -110,10 +118,16 @@ def _model_section(score) -> str:
 
 def _page(result, pngs: dict, title: str, provenance) -> list:
     header, rows = result.table()
-    body = [f"<h1>{esc(title)}</h1>", f'<p class="meta">Generated {esc(generated_now())} by fracid.</p>',
-            '<ul class="notes">' + "".join(f"<li>{esc(n)}</li>" for n in result.notes()) + "</ul>",
+    warnings = result.warnings()
+    body = [f"<h1>{esc(title)}</h1>", f'<p class="meta">Generated {esc(generated_now())} by fracid.</p>']
+    if warnings:  # first: what is missing from the ranking or doubtful in it
+        body += ['<h2 class="warning">Warnings</h2>',
+                 '<ul class="warnings">' + "".join(f"<li>{esc(w)}</li>" for w in warnings) + "</ul>"]
+    body += ['<ul class="notes">' + "".join(f"<li>{esc(n)}</li>" for n in result.notes()[len(warnings):]) + "</ul>",
             "<h2>Ranking by log evidence</h2>", html_table(header, rows, text_columns=(1, 11)),
             f"<p>{esc(DEFINITIONS)}</p>"]
+    if result.settings.get("prior"):
+        body.append(f"<p>Prior of every model: {esc(result.settings['prior'])}.</p>")
     captions = {"compare_evidence": "Log evidence of every model with its Monte-Carlo error bars and the Laplace "
                                     "approximation at the estimate.",
                 "compare_fits": "The data and every model's curve computed at its estimate (its forward run's own "
@@ -131,7 +145,7 @@ def _page(result, pngs: dict, title: str, provenance) -> list:
 
 def write_compare(out, result, *, title: str = "fracid compare", provenance=None) -> list[str]:
     """Write the comparison's files into ``out``: compare.json, figures/compare_fits.png,
-    figures/compare_evidence.png (when a model has a log evidence) and report.html; their names (relative)."""
+    figures/compare_evidence.png (when a model has a log evidence) and :data:`REPORT`; their names (relative)."""
     out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     result.save(out / "compare.json")
@@ -139,5 +153,5 @@ def write_compare(out, result, *, title: str = "fracid compare", provenance=None
     pngs = {name: to_png(fig) for name, fig in drawn.items() if fig is not None}
     for name, png in pngs.items():
         (out / "figures" / f"{name}.png").write_bytes(png)
-    write_document(out / "report.html", title, _page(result, pngs, title, provenance))
-    return ["compare.json", "report.html", *(f"figures/{name}.png" for name in pngs)]
+    write_document(out / REPORT, title, _page(result, pngs, title, provenance))
+    return ["compare.json", REPORT, *(f"figures/{name}.png" for name in pngs)]

@@ -175,3 +175,66 @@ def batch_progress(bar):
         bar.refresh()
 
     return report
+
+
+class StageLines:
+    """The stage of each of several jobs that run side by side (the models of ``fracid compare``), and a line per
+    job still running every :func:`line_interval` seconds, so that minutes of work never pass in silence.
+
+    Use :meth:`log` as the jobs' ``log(text)``: a line ``"<label>: <text>"`` is written at once and sets the label's
+    stage; a text starting with one of ``ends`` (``"done"``, ``"failed"``) ends the label's job. Within ``with``, a
+    thread writes ``"<label>: 1:30 elapsed, <stage>"`` for every job still running each interval (the time since
+    the job's first line; since the start while it waits for a worker).
+
+    Parameters
+    ----------
+    labels : sequence of str
+        The jobs' labels (the lines' prefixes).
+    write : callable
+        ``write(text)``: prints a line (stdout unless ``--quiet``, in ``fracid compare``).
+    ends : tuple of str
+        The starts of a text that ends a job.
+    """
+
+    def __init__(self, labels, write, ends=("done", "failed")):
+        self.write, self.ends, self.started = write, tuple(ends), time.perf_counter()
+        self.stages = {label: "waiting for a worker" for label in labels}
+        self.since = dict.fromkeys(self.stages, self.started)  # a job's first line, or the start while it waits
+        self.running = set(self.stages)
+        self._stop, self._thread, self._lock = threading.Event(), None, threading.Lock()
+
+    def log(self, text: str) -> None:
+        """Write ``text`` and, when it starts with a known label, record the label's stage."""
+        label, _, rest = str(text).partition(": ")
+        with self._lock:
+            if label in self.stages:
+                if self.stages[label] == "waiting for a worker":
+                    self.since[label] = time.perf_counter()
+                self.stages[label] = rest
+                if rest.startswith(self.ends):
+                    self.running.discard(label)
+        self.write(text)
+
+    def status(self) -> list[str]:
+        """A line per job still running: its label, the time since its first line (since the start while it
+        waits), its last stage."""
+        now = time.perf_counter()
+        with self._lock:
+            return [f"{label}: {clock(now - self.since[label])} elapsed, {stage}"
+                    for label, stage in self.stages.items() if label in self.running]
+
+    def _beat(self, interval: float) -> None:
+        while not self._stop.wait(interval):
+            for line in self.status():
+                self.write(line)
+
+    def __enter__(self):
+        interval = max(line_interval(), 0.05)
+        self._thread = threading.Thread(target=self._beat, args=(interval,), name="fracid-stage-lines", daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+        return False

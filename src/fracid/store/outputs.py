@@ -34,7 +34,7 @@ OUTPUTS = {
     "stability": _STUDY,
     "sensitivity": ("runs.sqlite", "sensitivity.csv", "sensitivity.png"),
     "size-effect": ("size_effect.csv", "size_effect.json", "size_effect.png"),
-    "compare": ("runs.sqlite", "compare.json", "report.html", "figures"),
+    "compare": ("runs.sqlite", "compare.json", "compare.html", "figures"),  # not report.html: identify's in a shared --out
 }
 
 

@@ -52,8 +52,10 @@ class PosteriorResult:
     log_evidence, log_evidence_error : float
         log p(y_exp) of the model with its prior (uniform, or log-uniform, between the bounds) and the Gaussian
         likelihood with its normalisation (-1/2 log det(2 pi C_exp)), from the importance weights of all draws
-        (:func:`~fracid.inverse.sampling.mixture.amis_log_evidence`), and its Monte-Carlo standard error. Two
-        models fitted to the same data compare by the difference (the log Bayes factor).
+        (:func:`~fracid.inverse.sampling.mixture.amis_log_evidence`), and its Monte-Carlo standard error (the larger
+        of the delta method's and a bootstrap over the draws). Two models fitted to the same data compare by the
+        difference (the log Bayes factor); below the sampler's floor of the effective sample size neither is
+        credible (``fracid compare`` does not rank it).
     model_error : list of dict
         With the model's own error marginalised (:class:`~fracid.inverse.likelihood.marginal.MarginalLikelihood`):
         the posterior of its std per group (``group``, ``blocks``, ``mean``, ``median``, ``interval_90`` [units
@@ -177,11 +179,6 @@ class PosteriorResult:
         data = {name: sample[None, :, j] for j, name in enumerate(self.names)}
         return arviz.from_dict(posterior=data, attrs={"importance_ess": self.ess, "importance_draws": len(self.x),
                                                        "method": "adaptive importance sampling (fracid)"})
-
-
-def _finite_or_none(value: float):
-    """``value``, or None (JSON null) when it is not finite."""
-    return float(value) if np.isfinite(value) else None
 
 
 def _finite_or_none(value: float):

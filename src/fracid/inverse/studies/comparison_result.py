@@ -14,9 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.inverse.studies.evidence import TIE_SIGMAS, rank_by_evidence
+from fracid.inverse.studies.evidence import BOUND_MARGIN, BOUND_SHARE, TIE_SIGMAS, rank_by_evidence
 
-__all__ = ["ComparisonResult", "ModelScore", "map_objective"]
+#: the gap [log units] between a sampled log evidence and its Laplace value that a comparison warns about beyond
+#: the Monte-Carlo error: a Gaussian approximation is off by a few tenths on a mildly skewed posterior, and a
+#: log Bayes factor below 1 is "barely worth mentioning" (Jeffreys' scale)
+LAPLACE_TOLERANCE = 1.0
+
+__all__ = ["LAPLACE_TOLERANCE", "ComparisonResult", "ModelScore", "map_objective"]
 
 
 def map_objective(result, chi2: float) -> float:
@@ -76,8 +81,14 @@ class ModelScore:
         The prior's bounds (units of the parameters); ``log`` its log flags.
     seconds : float
         Wall time of the model's identification and sampling [s].
+    log_evidence_wider : float
+        The log evidence with the prior's box widened (:func:`~fracid.inverse.studies.evidence.widened`), by the
+        closed form of :func:`~fracid.inverse.studies.evidence.prior_volume_shift` [-] (a lower bound when
+        ``at_bounds`` exceeds :data:`~fracid.inverse.studies.evidence.BOUND_SHARE`).
+    at_bounds : float
+        The posterior's weight within :data:`~fracid.inverse.studies.evidence.BOUND_MARGIN` of a bound [-].
     rank : int
-        1 for the largest log evidence; ``tied`` whether it ties with the first (:data:`TIE_SIGMAS`), ``delta``
+        1 for the largest log evidence, 0 when not ranked (:attr:`estimated` false); ``tied`` whether it ties with the first (:data:`TIE_SIGMAS`), ``delta``
         its log evidence less the first's (the log Bayes factor against the best) [-].
     """
 
@@ -100,6 +111,8 @@ class ModelScore:
     bounds: tuple = ()
     log: list = field(default_factory=list)
     seconds: float = 0.0
+    log_evidence_wider: float = float("nan")
+    at_bounds: float = float("nan")
     rank: int = 0
     tied: bool = False
     delta: float = float("nan")
@@ -119,11 +132,29 @@ class ModelScore:
         return "; ".join(f"{n} = {v:.4g} +- {s:.2g}" + (f" {units[n]}" if units.get(n, "-") != "-" else "")
                          for n, v, s in zip(self.names, self.identification.x, self.identification.std))
 
+    @property
+    def estimated(self) -> bool:
+        """Whether the log evidence is estimated: sampled, finite, and its posterior's effective sample size at or
+        above the sampler's floor (:func:`~fracid.inverse.sampling.posterior.ess_floor`; below it the weights
+        sit on a few draws and neither log Z nor its Monte-Carlo error is credible). Only these are ranked."""
+        post = self.posterior
+        return post is not None and not post.sampling_failed and math.isfinite(self.log_evidence)
+
     def evidence_text(self) -> str:
-        """``log Z +- error``, or why there is none."""
-        if not math.isfinite(self.log_evidence):
+        """``log Z +- error``, or why there is none (``not estimated (ESS 2 below the floor)``)."""
+        if self.posterior is not None and self.posterior.sampling_failed:
+            return f"not estimated (ESS {self.posterior.ess:.2g} below the floor)"
+        if not self.estimated:
             return "n/a"
         return f"{self.log_evidence:.2f} +- {self.log_evidence_error:.2f}"
+
+    def laplace_disagrees(self) -> bool:
+        """Whether the sampled log evidence and the Laplace value differ by more than :data:`TIE_SIGMAS` times the
+        Monte-Carlo error and :data:`LAPLACE_TOLERANCE` (one of them is off: a bound, a curved valley, too few
+        draws)."""
+        gap = abs(self.log_evidence - self.log_evidence_laplace)
+        return (self.estimated and math.isfinite(gap)
+                and gap > max(TIE_SIGMAS * self.log_evidence_error, LAPLACE_TOLERANCE))
 
     def sampling_text(self) -> str:
         """The posterior's effective sample size and whether it reached the target (``ESS 212``, ``ESS 40 (below
@@ -150,8 +181,12 @@ class ModelScore:
             "covariance": np.asarray(ident.C, float), "bounds": list(self.bounds), "log": list(self.log),
             "identification_status": ident.status, "rms_percent": self.rms_percent, "chi2": self.chi2,
             "map_objective": self.map_objective, "log_likelihood": self.log_likelihood, "aic": self.aic,
-            "bic": self.bic, "log_evidence": self.log_evidence, "log_evidence_error": self.log_evidence_error,
-            "log_evidence_laplace": self.log_evidence_laplace, "delta_log_evidence": self.delta,
+            "bic": self.bic, "log_evidence": self.log_evidence if self.estimated else None,
+            "log_evidence_sampled": self.log_evidence, "log_evidence_estimated": self.estimated,
+            "log_evidence_error": self.log_evidence_error, "log_evidence_wider": self.log_evidence_wider,
+            "posterior_at_bounds": self.at_bounds,
+            "log_evidence_laplace": self.log_evidence_laplace,
+            "delta_log_evidence": self.delta if self.estimated else None,
             "tied_with_best": self.tied, "posterior_status": self.posterior_status,
             "posterior": post.to_dict() if post is not None else None, "verdict": self.verdict.as_dict(),
             "y_fit": np.asarray(ident.y_fit, float), "forward_runs": ident.forward_runs,
@@ -160,7 +195,7 @@ class ModelScore:
 
 #: the ranking table's columns (:meth:`ComparisonResult.table`)
 TABLE_HEADER = ["rank", "model", "p", "RMS [% of peak]", "chi2", "MAP objective", "AIC", "BIC",
-                "log Z (+- MC error)", "log Z Laplace", "delta log Z", "posterior"]
+                "log Z (+- MC error)", "log Z Laplace", "delta log Z", "log Z, bounds widened", "posterior"]
 
 
 @dataclass
@@ -176,27 +211,32 @@ class ComparisonResult:
     failures : dict
         label -> why the model could not be compared.
     settings : dict
-        The sampler's settings, the verdict's tolerance, the inverse method.
+        The sampler's settings, the verdict's tolerance, the inverse method, the prior sensitivity's ``widen``.
+    setup_warnings : list of str
+        What the set-up changed that the numbers depend on (e.g. bounds cut to the mesh): the first warnings.
     """
 
     data: object
     scores: list
     failures: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
+    setup_warnings: list = field(default_factory=list)
 
     @classmethod
     def ranked(cls, data, scores, failures, settings) -> "ComparisonResult":
         """The result with ``scores`` ranked (:func:`~fracid.inverse.studies.evidence.rank_by_evidence`)."""
-        order, tied = rank_by_evidence([s.log_evidence for s in scores], [s.log_evidence_error for s in scores])
-        best = scores[order[0]].log_evidence if order else float("nan")
+        ranked = [s.log_evidence if s.estimated else float("nan") for s in scores]
+        order, tied = rank_by_evidence(ranked, [s.log_evidence_error for s in scores])
+        best = ranked[order[0]] if order else float("nan")
         for rank, i in enumerate(order, start=1):
-            scores[i].rank, scores[i].tied, scores[i].delta = rank, tied[i], scores[i].log_evidence - best
+            scores[i].rank = rank if scores[i].estimated else 0
+            scores[i].tied, scores[i].delta = tied[i], ranked[i] - best
         return cls(data, [scores[i] for i in order], dict(failures), dict(settings))
 
     @property
     def best(self):
-        """The score of the largest log evidence (None when no model has one)."""
-        return self.scores[0] if self.scores and math.isfinite(self.scores[0].log_evidence) else None
+        """The score of the largest estimated log evidence (None when no model has one)."""
+        return self.scores[0] if self.scores and self.scores[0].estimated else None
 
     def score(self, label: str) -> ModelScore:
         for s in self.scores:
@@ -206,27 +246,59 @@ class ComparisonResult:
 
     def table(self) -> tuple[list, list]:
         """The ranking table's header and rows, formatted (:data:`TABLE_HEADER`)."""
-        rows = [[str(s.rank) + (" (tie)" if s.tied else ""), s.label, str(s.p), f"{s.rms_percent:.2f}", f"{s.chi2:.4g}",
-                 f"{s.map_objective:.4g}", f"{s.aic:.4g}", f"{s.bic:.4g}", s.evidence_text(),
-                 f"{s.log_evidence_laplace:.2f}", f"{s.delta:.2f}", s.sampling_text()]
-                for s in self.scores]
+        rows = [[(str(s.rank) + (" (tie)" if s.tied else "")) if s.rank else "not ranked", s.label, str(s.p),
+                 f"{s.rms_percent:.2f}", f"{s.chi2:.4g}", f"{s.map_objective:.4g}", f"{s.aic:.4g}", f"{s.bic:.4g}",
+                 s.evidence_text(), f"{s.log_evidence_laplace:.2f}", f"{s.delta:.2f}" if s.rank else "-",
+                 f"{s.log_evidence_wider:.2f}" + (" (lower bound)" if s.at_bounds > BOUND_SHARE else "") if s.rank
+                 else "-", s.sampling_text()] for s in self.scores]
         return list(TABLE_HEADER), rows
 
+    def warnings(self) -> list[str]:
+        """What makes the ranking incomplete or a number doubtful: the models not compared, those whose log evidence
+        is not estimated (not ranked), and sampled log evidences far from their Laplace value. ``fracid compare``
+        prints them on stderr and its report opens with them."""
+        lines = list(self.setup_warnings)
+        lines += [f"{label}: not compared, left out of the ranking ({why})" for label, why in self.failures.items()]
+        lines += [f"{s.label}: log evidence not estimated, not ranked: " + (
+            f"its posterior's effective sample size {s.posterior.ess:.2g} is below the sampler's floor, so log Z "
+            f"({s.log_evidence:.3g}) and its Monte-Carlo error are not credible (more draws: --samples, --rounds)"
+            if s.posterior is not None and s.posterior.sampling_failed else f"posterior {s.posterior_status}")
+                  for s in self.scores if not s.estimated]
+        lines += [f"{s.label}: log Z {s.evidence_text()} and its Laplace value {s.log_evidence_laplace:.3g} differ by "
+                  f"{abs(s.log_evidence - s.log_evidence_laplace):.3g}, more than {TIE_SIGMAS:g} Monte-Carlo errors: "
+                  "one of them is off (the Laplace value at a bound or in a curved valley, the sampled one with few "
+                  "effective draws); trust its Bayes factors to that much only"
+                  for s in self.scores if s.laplace_disagrees()]
+        return lines
+
     def notes(self) -> list[str]:
-        """What to read in the ranking: the best model and its margin, ties, failures."""
-        best = self.best
-        lines = []
-        if best is not None and len(self.scores) > 1:
-            second = self.scores[1]
-            ties = [s.label for s in self.scores if s.tied and s is not best]
+        """What to read in the ranking: the :meth:`warnings` first, then the best model and its margin or ties, and
+        how far the margin moves when the priors widen."""
+        best, ranked = self.best, [s for s in self.scores if s.rank]
+        lines = self.warnings()
+        if best is not None and len(ranked) > 1:
+            second = ranked[1]
+            ties = [s.label for s in ranked if s.tied and s is not best]
             lines.append(f"best by evidence: {best.label}" + (
                 f", tied within {TIE_SIGMAS:g} combined Monte-Carlo errors with {', '.join(ties)}" if ties else
                 f", log Bayes factor {-second.delta:.3g} against {second.label}"))
-        lines += [f"{s.label}: its posterior's effective sample size {s.posterior.ess:.0f} is below the sampler's floor: "
-                  "its log evidence and Monte-Carlo error are rough (more draws: --samples, --rounds)"
-                  for s in self.scores if s.posterior is not None and s.posterior.sampling_failed]
-        lines += [f"{label}: not compared ({why})" for label, why in self.failures.items()]
+            lines.append(self._sensitivity(best, second))
+        elif best is not None:
+            lines.append(f"{best.label}: the only model with an estimated log evidence: nothing to rank it against")
         return lines
+
+    def _sensitivity(self, best, second) -> str:
+        """The prior sensitivity of the first two: their log Bayes factor with every span widened."""
+        factor = self.settings.get("widen", float("nan"))
+        moved = (best.log_evidence_wider - second.log_evidence_wider) - (best.log_evidence - second.log_evidence)
+        bounded = [s.label for s in (best, second) if s.at_bounds > BOUND_SHARE]
+        return (f"prior sensitivity: with every prior span x {factor:g} (in x, or ln x for a log parameter; clipped to "
+                f"the valid ranges) the log Bayes factor of {best.label} against {second.label} moves by "
+                f"{moved:+.3g} to "
+                f"{best.log_evidence_wider - second.log_evidence_wider:.3g} (log Z moves by -log of the volume ratio "
+                "where the likelihood has no mass beyond the bounds)" + (
+                    f"; {', '.join(bounded)}: over {BOUND_SHARE:.0%} of the posterior weight within "
+                    f"{BOUND_MARGIN:.0%} of a bound, so its widened log Z is a lower bound" if bounded else ""))
 
     def summary(self) -> str:
         """The ranking as a text table, with the notes."""
@@ -236,12 +308,16 @@ class ComparisonResult:
         return "\n".join(text + self.notes())
 
     def to_dict(self) -> dict:
-        """compare.json: the ranking (labels, best first), every model's numbers, the failures, the settings
+        """compare.json: the ranking (labels, best first; those whose log evidence is not estimated under
+        ``not_ranked``), every model's numbers, the failures, the settings
         and the data (control [mm], values, std)."""
         data = self.data
-        return _plain({"ranking": [s.label for s in self.scores], "best": self.best.label if self.best else None,
+        return _plain({"ranking": [s.label for s in self.scores if s.rank],
+                       "not_ranked": [s.label for s in self.scores if not s.rank],
+                       "best": self.best.label if self.best else None,
                        "tie_sigmas": TIE_SIGMAS, "models": [s.to_dict() for s in self.scores],
-                       "failures": dict(self.failures), "settings": self.settings, "notes": self.notes(),
+                       "failures": dict(self.failures), "settings": self.settings,
+                       "warnings": self.warnings(), "notes": self.notes(),
                        "data": {"control": np.asarray(data.control, float), "y": np.asarray(data.y, float),
                                 "std": np.asarray(data.std, float), "blocks": [list(b) for b in data.blocks]}})
 

@@ -16,6 +16,14 @@ the space's unit cube.
   for a model linear in x with bounds far from x_hat; an estimate at a bound (half the Gaussian cut
   off) or a curved valley makes it off, which the sampled evidence is not.
 
+Prior sensitivity: the evidence depends on the prior's volume. With the prior uniform on the box B (in the prior's
+coordinates: x, or ln x for a log parameter) of volume V_B, Z_B = (1 / V_B) int_B L. A box B' containing B
+gives Z_B' = (V_B / V_B') Z_B + (1 / V_B') int_(B' - B) L: when the likelihood has negligible mass outside B,
+log Z_B' = log Z_B - log(V_B' / V_B) exactly (:func:`prior_volume_shift`), and larger otherwise (the closed form
+is then a lower bound). :func:`widened` gives B': every span multiplied by a factor about its centre, clipped to
+the parameters' valid ranges; for p parameters and no clipping the shift is -p log(factor), so the log Bayes
+factor of two models moves by -(p1 - p2) log(factor).
+
 Units: chi^2, log-likelihoods and log evidences are dimensionless (natural logarithms); the densities are
 per unit of the parameters.
 """
@@ -26,8 +34,10 @@ import math
 
 import numpy as np
 
-__all__ = ["TIE_SIGMAS", "gaussian_log_likelihood", "information_criteria", "laplace_log_evidence",
-           "log_prior_density", "rank_by_evidence"]
+from fracid.inverse.core.space import ParameterSpace
+
+__all__ = ["BOUND_MARGIN", "BOUND_SHARE", "PRIOR_WIDENING", "TIE_SIGMAS", "gaussian_log_likelihood", "information_criteria", "laplace_log_evidence",
+           "bound_share", "log_prior_density", "log_prior_volume", "prior_volume_shift", "rank_by_evidence", "widened"]
 
 #: Two log evidences closer than this many combined Monte-Carlo standard errors are a tie: the sampling
 #: cannot tell which is larger (about 95 % two-sided for normal errors)
@@ -63,6 +73,59 @@ def log_prior_density(x, space) -> float:
         return -math.inf
     span = np.where(log, np.log(space.upper / np.where(log, space.lower, 1.0)), space.upper - space.lower)
     return float(-np.sum(np.log(np.where(log, x * span, span))))
+
+
+def _spans(space) -> tuple[np.ndarray, np.ndarray]:
+    """(centre, span) of every parameter of ``space`` in the prior's coordinates (x, or ln x for a log one)."""
+    log = np.array(space.log, dtype=bool)
+    lo = np.where(log, np.log(np.where(log, space.lower, 1.0)), space.lower)
+    hi = np.where(log, np.log(np.where(log, space.upper, 1.0)), space.upper)
+    return 0.5 * (lo + hi), hi - lo
+
+
+def log_prior_volume(space) -> float:
+    """log of the prior box's volume in the prior's coordinates: sum of log(upper - lower), log(ln(upper / lower))
+    for a log parameter (units: of the linear parameters; the log ones are dimensionless)."""
+    return float(np.sum(np.log(_spans(space)[1])))
+
+
+def widened(space, factor: float, valid=None) -> ParameterSpace:
+    """``space`` with every span multiplied by ``factor`` (>= 1) about its centre in the prior's coordinates (the
+    geometric centre of a log parameter), clipped to ``valid`` = (lower, upper) when given (the parameters' valid
+    ranges, units of the parameters)."""
+    if not factor >= 1.0:
+        raise ValueError(f"a widening factor must be >= 1, got {factor!r}")
+    centre, span = _spans(space)
+    log = np.array(space.log, dtype=bool)
+    lo, hi = centre - 0.5 * factor * span, centre + 0.5 * factor * span
+    lower, upper = np.where(log, np.exp(lo), lo), np.where(log, np.exp(hi), hi)
+    if valid is not None:
+        lower = np.maximum(lower, np.where(log, np.maximum(valid[0], 1e-300), valid[0]))
+        upper = np.minimum(upper, valid[1])
+    return ParameterSpace(space.names, np.minimum(lower, space.lower), np.maximum(upper, space.upper), log=space.log)
+
+
+#: the factor on every prior span of the prior sensitivity (:func:`widened`) a comparison reports
+PRIOR_WIDENING = 2.0
+#: a draw within this share of a span (unit-cube coordinates) of a bound lies "at" the bound
+BOUND_MARGIN = 0.02
+#: the posterior weight at the bounds above which the likelihood is taken to go on beyond them (the widened
+#: evidence's closed form is then only a lower bound)
+BOUND_SHARE = 0.05
+
+
+def bound_share(u, weights, margin: float = BOUND_MARGIN) -> float:
+    """The weighted share of draws ``u`` (unit-cube coordinates, shape (N, p); ``weights`` summing to 1) within
+    ``margin`` of a bound in any parameter [-]."""
+    u = np.atleast_2d(np.asarray(u, float))
+    near = np.any((u < margin) | (u > 1.0 - margin), axis=1)
+    return float(np.sum(np.asarray(weights, float)[near]))
+
+
+def prior_volume_shift(space, wider) -> float:
+    """log Z_wider - log Z of a likelihood with negligible mass outside ``space`` (module docstring):
+    -log(V_wider / V_space) [-]; a lower bound on the change when the likelihood goes on beyond the bounds."""
+    return log_prior_volume(space) - log_prior_volume(wider)
 
 
 def laplace_log_evidence(log_likelihood: float, x, S, C_exp, space) -> float:

@@ -12,6 +12,12 @@ space):
    the importance weights, and the verdict per parameter on its credible intervals
    (:func:`fracid.inverse.studies.verdict.parameter_verdicts`; on the Gaussian when the sampling failed).
 
+4. the prior sensitivity: the log evidence with every prior span widened by ``widen``
+   (:func:`~fracid.inverse.studies.evidence.widened`, clipped to the parameters' valid ranges) by the closed form
+   log Z - log(volume ratio) (:func:`~fracid.inverse.studies.evidence.prior_volume_shift`), with the posterior's
+   weight at the bounds that makes it a lower bound. The log evidence is ranked only when the posterior's
+   effective sample size reaches the sampler's floor (:attr:`ModelScore.estimated`).
+
 Besides: the RMS misfit [% of the measured peak], the MAP objective of the method (chi^2 plus the term of the
 prior its search gave, the objective its local fit minimises), the chi^2, AIC and BIC. The models run side by side
 (:func:`fracid.runtime.executors.concurrently`: a thread per model submitting its forward runs to the shared executor)
@@ -85,7 +91,8 @@ def contender(candidate, data, specimen=None, *, control="cmod", steps=None) -> 
 
 
 def compare(data, contenders, *, method=None, posterior: PosteriorSettings = PosteriorSettings(), executor=None,
-            store=None, progress=False, log=None, retry_failed=False, tolerance=0.1, **settings) -> ComparisonResult:
+            store=None, progress=False, log=None, retry_failed=False, tolerance=0.1,
+            widen: float = evidence.PRIOR_WIDENING, **settings) -> ComparisonResult:
     """Identify every model on ``data``, sample its posterior and rank the models by log evidence.
 
     Parameters
@@ -103,11 +110,14 @@ def compare(data, contenders, *, method=None, posterior: PosteriorSettings = Pos
     progress : bool or None
         Progress bars of the identifications and samplers (False: none; several models run at once).
     log : callable, optional
-        ``log(text)``: a line per model and stage.
+        ``log(text)``: a line per model and stage, ``"<label>: <stage>"``; the last ``"<label>: done: ..."`` or
+        ``"<label>: failed (...)"`` (:class:`fracid.runtime.progress.StageLines` reads them).
     retry_failed : bool
         Run again the runs stored as failed.
     tolerance : float
         Largest relative std a verdict calls identified (:func:`~fracid.inverse.studies.verdict.parameter_verdicts`).
+    widen : float
+        The factor (>= 1) on every prior span of the prior sensitivity (module docstring).
     **settings
         Settings of the inverse method by name (``n``, ``k``, ``groups``, ...).
 
@@ -121,12 +131,13 @@ def compare(data, contenders, *, method=None, posterior: PosteriorSettings = Pos
     if len(set(labels)) != len(labels):
         raise ValueError(f"the contenders' labels must be unique, got {labels}")
     job = dict(method=method, posterior=posterior, executor=executor, store=store, progress=progress,
-               log=log or (lambda text: None), retry_failed=retry_failed, tolerance=tolerance, settings=settings)
+               log=log or (lambda text: None), retry_failed=retry_failed, tolerance=tolerance, widen=widen,
+               settings=settings)
     outcomes = concurrently(lambda c: _attempt(data, c, job), contenders, executor)
     scores = [o for o in outcomes if isinstance(o, ModelScore)]
     failures = {c.label: o for c, o in zip(contenders, outcomes) if isinstance(o, str)}
     return ComparisonResult.ranked(data, scores, failures, {"posterior": asdict(posterior), "tolerance": tolerance,
-                                                           "method": getattr(method, "name", method) or DEFAULT_METHOD})
+                                                           "widen": widen, "method": getattr(method, "name", method) or DEFAULT_METHOD})
 
 
 def _attempt(data, contender: Contender, job) -> "ModelScore | str":
@@ -158,8 +169,9 @@ def _score(data, contender: Contender, job) -> ModelScore:
                                  data=describe_data(contender.operator), tolerance=job["tolerance"],
                                  posterior=post if post is not None and not post.sampling_failed else None)
     score = _numbers(label, contender, data, result, (chi2, log_l, laplace), post, post_error, verdict)
+    score.log_evidence_wider, score.at_bounds = _sensitivity(contender, post, job["widen"])
     score.seconds = time.perf_counter() - start
-    say(f"{label}: {score.line()}")
+    say(f"{label}: done: {score.line()}")
     return score
 
 
@@ -187,6 +199,16 @@ def _posterior(label, stored, data, space, result, job):
                                 progress=job["progress"], log=lambda text: job["log"](f"{label}: {text}")), ""
     except MODEL_FAILURES as err:
         return None, f"{type(err).__name__}: {err}"
+
+
+def _sensitivity(contender: Contender, post, factor: float) -> tuple[float, float]:
+    """(log Z with every prior span times ``factor``, the posterior's weight at the bounds); NaN without a posterior."""
+    if post is None:
+        return float("nan"), float("nan")
+    space = contender.space
+    wider = evidence.widened(space, factor, contender.operator.valid_bounds())
+    return (post.log_evidence + evidence.prior_volume_shift(space, wider),
+            evidence.bound_share(space.to_unit(post.x), post.weights))
 
 
 def _numbers(label, contender, data, result, fit, post, post_error, verdict) -> ModelScore:
