@@ -75,16 +75,16 @@ def check_band_room(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, e
     for prefix, options, _ in specimen_variants(specimen, experiments):
         room = cls(**options).band_room()
         where = f" ({specimen.type})" if prefix == "specimen" else f" of {prefix}"
-        verdict = band_verdict(band.width(value) / room.length, band.warn)
-        if verdict == REFUSE:
-            raise ConfigError(f"{ck.path}: {key} = {value:g} {unit}{default}: {_band_text(band, value, room, where)}: "
+        limit = room.limit
+        if band_verdict(band.width(value) / limit.length, band.warn) == REFUSE:
+            raise ConfigError(f"{ck.path}: {key} = {value:g} {unit}{default}: {_band_text(band, value, limit, where)}: "
                               f"the band cannot form inside it, and the model no longer gives {band.promise}; "
-                              f"{band_advice(band, room.length)}")
-        if verdict == WARN:
+                              f"{band_advice(band, limit.length)}")
+        if band_verdict(band.width(value) / room.length, band.warn) is not None:
             ck.warn(f"{key} = {value:g} {unit}{default}: {_band_text(band, value, room, where)}, more than the "
                     f"{band.warn:.0%} up to which the model gives {band.promise} ({band.beyond}); "
                     f"{band_advice(band, room.length)}")
-        if upper is not None and band_verdict(band.width(upper) / room.length, band.warn) == REFUSE:
-            ck.warn(f"identify.bounds.{name}: the upper bound {upper:g} {unit}: {_band_text(band, upper, room, where)}: "
-                    f"no band forms inside it there, and the model no longer gives {band.promise}; lower the upper "
-                    f"bound below {band.value_for(room.length):.3g} {unit}")
+        if upper is not None and band_verdict(band.width(upper) / limit.length, band.warn) == REFUSE:
+            ck.warn(f"identify.bounds.{name}: the upper bound {upper:g} {unit}: {_band_text(band, upper, limit, where)}:"
+                    f" no band forms inside it there, and the model no longer gives {band.promise}; lower the upper "
+                    f"bound below {band.value_for(limit.length):.3g} {unit}")

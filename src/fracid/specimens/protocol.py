@@ -78,10 +78,20 @@ class BandRoom(NamedTuple):
         The extent [mm].
     text : str
         It in words, naming the key that sets it, e.g. ``"its length = 100 mm"``.
+    most, most_text : float or None, str
+        Where the geometry says less (a mesh: which side the crack crosses is not known), the extent beyond which no
+        band can form whatever the crack's direction [mm] and it in words; None: ``length``.
     """
 
     length: float
     text: str
+    most: float | None = None
+    most_text: str = ""
+
+    @property
+    def limit(self) -> "BandRoom":
+        """The room beyond which no band can form: ``most`` where given, else this one."""
+        return self if self.most is None else BandRoom(self.most, self.most_text)
 
 
 class SectionError(ValueError):
@@ -213,14 +223,14 @@ def element_sides(description) -> tuple:
     return float(lengths.min()), float(lengths.max())
 
 
-def bounding_room(nodes, symmetry_planes=()) -> float:
-    """The smallest side of the bounding box of ``nodes`` (n, dim) [mm], a half or quarter model mirrored about
-    its ``symmetry_planes`` ((axis, coordinate), ...) so that the side is the whole specimen's."""
+def bounding_room(nodes, symmetry_planes=(), which=min) -> float:
+    """The smallest (``which=max``: largest) side of the bounding box of ``nodes`` (n, dim) [mm], a half or quarter
+    model mirrored about its ``symmetry_planes`` ((axis, coordinate), ...) so that the side is the whole specimen's."""
     nodes = np.asarray(nodes, dtype=float)
     sides = np.ptp(nodes, axis=0)
     for axis, coordinate in symmetry_planes:
         sides[axis] = 2.0 * np.max(np.abs(nodes[:, axis] - coordinate))
-    return float(np.min(sides))
+    return float(which(sides))
 
 
 def plane_estimate(field: str | None, value, elements: int, nodes: int, vertices: int, advice: str) -> SizeEstimate:
@@ -272,10 +282,13 @@ class SpecimenDefaults:
         return plane_estimate(None, None, len(d.cells), len(d.nodes), d.n_vertices, f"use a coarser mesh ({_ENOUGH})")
 
     def band_room(self) -> BandRoom:
-        """The smallest side of the described specimen's bounding box, mirrored about its symmetry planes [mm]."""
+        """The smallest side of the described specimen's bounding box, mirrored about its symmetry planes [mm]: the
+        crack may cross it (a beam's depth) and cut the band. Which side it crosses is not known (a strip's band lies
+        along its largest side), so no band forms only beyond the largest side (``most``)."""
         d = self.describe()
-        room = bounding_room(d.nodes, d.symmetry_planes)
-        return BandRoom(room, f"the smallest side of its bounding box, {room:.4g} mm")
+        smallest, largest = bounding_room(d.nodes, d.symmetry_planes), bounding_room(d.nodes, d.symmetry_planes, max)
+        return BandRoom(smallest, f"the smallest side of its bounding box, {smallest:.4g} mm", largest,
+                        f"the largest side of its bounding box, {largest:.4g} mm")
 
     def options_text(self, options: dict) -> str:
         """The options given in ``[specimen]`` in words: ``"depth = 100, h_fine = 2"``, or ``"defaults"``."""
