@@ -134,6 +134,32 @@ def test_check_band_room_refuses_warns_and_passes():
                                                                                            ("weak_zone_width", 1.0))))
 
 
+def test_an_experiments_smaller_specimen_is_checked_and_named():
+    """An experiment that overrides the specimen's fields is checked with its own room, and named."""
+    from types import SimpleNamespace
+
+    bar = SpecimenConfig(type="bar", control="end_displacement", options=(("length", 100.0),))
+    short = SimpleNamespace(index=1, specimen=(("length", 20.0), ("weak_zone_width", 2.0)))
+    model = ModelConfig(type="gradient-damage", parameters=(("c", 4.0),))
+    ck = Checker(Path("cfg.toml"))
+    check_band_room(ck, model, bar, (SimpleNamespace(index=0, specimen=()), short), None)
+    (warning,) = ck.warnings  # 12.6 mm: 13 % of the 100 mm bar, 63 % of the 20 mm one
+    assert "of experiments[1].specimen" in warning and "63% of" in warning and "its length = 20 mm" in warning
+
+
+@pytest.mark.parametrize("upper, warned", [(300.0, True), (254.0, True), (252.0, False), (4.0, False)])
+def test_an_upper_bound_whose_band_cannot_form_is_warned(upper, warned):
+    """2 pi sqrt(c) = 100 mm at c = 253 mm^2: the bound's upper end beyond it is warned (not refused), below not."""
+    from types import SimpleNamespace
+
+    bar = SpecimenConfig(type="bar", control="end_displacement", options=(("length", 100.0),))
+    identify = SimpleNamespace(parameters=("c", "beta"), upper=(upper, 500.0))
+    warnings = _checked(ModelConfig(type="gradient-damage"), bar, identify)
+    assert len(warnings) == warned
+    if warned:
+        assert f"identify.bounds.c: the upper bound {upper:g} mm^2" in warnings[0] and "below 253 mm^2" in warnings[0]
+
+
 def test_warn_implausible_parameters_names_the_key_both_directions():
     ck = Checker(Path("cfg.toml"))
     warn_implausible_parameters(ck, ModelConfig(type="gradient-damage", parameters=(("E", 30.0), ("kappa_i", 0.05),
