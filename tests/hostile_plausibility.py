@@ -46,17 +46,17 @@ def _band(status, words, model, params):
 
 
 CASES = {
-    # ---- PF-CZM: the band's width pi l against the bar's length (warned above a quarter, refused above it)
+    # ---- PF-CZM: the band's width pi l against the bar's length (warned above a half, refused above it)
     "pf-czm-l-1000mm-on-100mm-bar-refused": _band(
         2, ["model.parameters.l = 1000 mm", "pi l = 3.14e+03 mm", "31.4 times", "its length = 100 mm",
-            "cannot form", "cohesive law", "lower l below 31.8 mm", "7.96 mm or less"], "pf-czm", "l = 1000.0"),
+            "cannot form", "cohesive law", "lower l below 31.8 mm", "15.9 mm or less"], "pf-czm", "l = 1000.0"),
     "pf-czm-l-just-beyond-bar-refused": _band(
         2, ["model.parameters.l = 32 mm", "1.01 times", "lower l below 31.8 mm"], "pf-czm", "l = 32.0"),
-    "pf-czm-l-above-quarter-warned": _band(
-        0, ["fracid: warning", "model.parameters.l = 10 mm", "pi l = 31.4 mm", "31% of", "its length = 100 mm",
-            "more than the 25%", "5 % at a half", "7.96 mm or less"], "pf-czm", "l = 10.0"),
-    "pf-czm-l-below-quarter-not-warned": case(None, config=_config("pf-czm", "l = 7.5"), csv=None,
-                                              args=IDENTIFY_CHECK, verify=_quiet(["valid"])),
+    "pf-czm-l-above-half-warned": _band(
+        0, ["fracid: warning", "model.parameters.l = 20 mm", "pi l = 62.8 mm", "63% of", "its length = 100 mm",
+            "more than the 50%", "1.4 % of the peak at the whole length", "15.9 mm or less"], "pf-czm", "l = 20.0"),
+    "pf-czm-l-below-half-not-warned": case(None, config=_config("pf-czm", "l = 15.0"), csv=None,
+                                           args=IDENTIFY_CHECK, verify=_quiet(["valid"])),
     "pf-czm-default-l-not-warned": case(None, config=_config("pf-czm", "", n_elements=200), csv=None,
                                         args=IDENTIFY_CHECK, verify=_quiet(["valid"], at_all=True)),
     # ---- gradient and integral damage: 2 pi sqrt(c) (warned above a half, refused above the length)
@@ -65,7 +65,7 @@ CASES = {
             "cannot form", "lower c below 253 mm^2", "63.3 mm^2 or less"], "gradient-damage", "c = 300.0"),
     "gradient-damage-c-above-half-warned": _band(
         0, ["fracid: warning", "model.parameters.c = 100 mm^2", "2 pi sqrt(c) = 62.8 mm", "63% of",
-            "more than the 50%", "reaches both ends", "63.3 mm^2 or less"], "gradient-damage", "c = 100.0"),
+            "more than the 50%", "9.5 % at the whole length", "63.3 mm^2 or less"], "gradient-damage", "c = 100.0"),
     "gradient-damage-c-below-half-not-warned": case(None, config=_config("gradient-damage", "c = 50.0"), csv=None,
                                                     args=IDENTIFY_CHECK, verify=_quiet(["valid"])),
     "integral-damage-c-beyond-bar-refused": _band(

@@ -31,7 +31,7 @@ def _band(kind):
 
 def test_the_models_declare_their_bands_width():
     pf, gradient, integral = _band("pf-czm"), _band("gradient-damage"), _band("integral-damage")
-    assert (pf.parameter, pf.unit, pf.warn) == ("l", "mm", 0.25)
+    assert (pf.parameter, pf.unit, pf.warn) == ("l", "mm", 0.5)
     assert pf.width(2.5) == pytest.approx(math.pi * 2.5)  # d = 1 - sin(|x| / l) vanishes at |x| = pi l / 2
     for band in (gradient, integral):
         assert (band.parameter, band.unit, band.warn) == ("c", "mm^2", 0.5)
@@ -109,7 +109,7 @@ def test_band_verdict(fraction, warn, verdict):
 
 def test_band_advice_gives_the_values_that_fit():
     text = band_advice(_band("pf-czm"), 100.0)
-    assert "lower l below 31.8 mm" in text and "7.96 mm or less" in text and "25%" in text
+    assert "lower l below 31.8 mm" in text and "15.9 mm or less" in text and "50%" in text
     text = band_advice(_band("gradient-damage"), 100.0)
     assert "lower c below 253 mm^2" in text and "63.3 mm^2 or less" in text and "50%" in text
 
@@ -124,9 +124,9 @@ def test_check_band_room_refuses_warns_and_passes():
     bar = SpecimenConfig(type="bar", control="end_displacement", options=(("length", 100.0),))
     with pytest.raises(ConfigError, match=r"model.parameters.l = 1000 mm: .*31.4 times.*lower l below 31.8 mm"):
         _checked(ModelConfig(type="pf-czm", parameters=(("l", 1000.0),)), bar)
-    (warning,) = _checked(ModelConfig(type="pf-czm", parameters=(("l", 10.0),)), bar)
-    assert "model.parameters.l = 10 mm" in warning and "31% of" in warning
-    assert _checked(ModelConfig(type="pf-czm", parameters=(("l", 7.9),)), bar) == []
+    (warning,) = _checked(ModelConfig(type="pf-czm", parameters=(("l", 16.0),)), bar)
+    assert "model.parameters.l = 16 mm" in warning and "50% of" in warning and "more than the 50%" in warning
+    assert _checked(ModelConfig(type="pf-czm", parameters=(("l", 15.9),)), bar) == []
     assert _checked(ModelConfig(type="pf-czm"), bar) == []
     assert _checked(ModelConfig(type="local-damage", parameters=(("c", 1e6),)), bar) == []  # no band: nothing
     with pytest.raises(ConfigError, match=r"model.parameters.c = 1 mm\^2 \(default\).*its length = 5 mm"):

@@ -63,17 +63,18 @@ class DamageModel(PathFollowingModel):
 
         The band then widens as the damage grows (implicit gradient): measured on the 100 mm bar (exponential law,
         defaults), the zone where omega > 0 is 1.8 (at the peak) and 2.7 (at half the peak force after it) times
-        2 pi sqrt(c) at c = 16 mm^2 (width L / 4); at 2 pi sqrt(c) = L / 2 (c = 64 mm^2) it reaches both ends of the
-        bar before the force has halved, and at L (c = 253 mm^2) it fills the bar at the peak. Hence warned above
-        half the specimen's room (the zone reaches the specimen's faces while the specimen still carries load) and
-        refused above the room (no band forms: the whole specimen softens at once). None for local damage.
+        2 pi sqrt(c) at c = 16 mm^2. Its effect on the response, measured on bars of length L at c = 16 mm^2 (the same
+        10 mm weak zone): the force against the inelastic opening after the peak departs from that of a bar 12.5
+        times longer by 0.14, 1.2, 4.1 and 9.5 % of the peak at 2 pi sqrt(c) = L / 4, L / 2, 3 L / 4 and L (7 % less
+        energy at L), 15 % at 1.3 L. Hence warned above half the specimen's room and refused above it (the whole
+        specimen softens, no band localises). None for local damage.
         """
         if self.mesh_length is None:
             return None
         return BandWidth("c", "mm^2", 2.0 * math.pi, 0.5, "the damage band's width 2 pi sqrt(c)",
                          "a damage band that localises inside the specimen", 0.5,
-                         "measured on a 100 mm bar, the damaged zone then reaches both ends before the force has "
-                         "halved after the peak, and fills the bar at the peak when the width is the length")
+                         "measured on bars, the response departs by 4 % of the peak at three quarters of the length "
+                         "and by 9.5 % at the whole length")
 
     @property
     def first_identified(self) -> tuple:
