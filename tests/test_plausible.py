@@ -125,7 +125,7 @@ def test_check_band_room_refuses_warns_and_passes():
     with pytest.raises(ConfigError, match=r"model.parameters.l = 1000 mm: .*31.4 times.*lower l below 31.8 mm"):
         _checked(ModelConfig(type="pf-czm", parameters=(("l", 1000.0),)), bar)
     (warning,) = _checked(ModelConfig(type="pf-czm", parameters=(("l", 16.0),)), bar)
-    assert "model.parameters.l = 16 mm" in warning and "50% of" in warning and "more than the 50%" in warning
+    assert "model.parameters.l = 16 mm" in warning and "50.3% of" in warning and "more than the 50%" in warning
     assert _checked(ModelConfig(type="pf-czm", parameters=(("l", 15.9),)), bar) == []
     assert _checked(ModelConfig(type="pf-czm"), bar) == []
     assert _checked(ModelConfig(type="local-damage", parameters=(("c", 1e6),)), bar) == []  # no band: nothing
@@ -143,8 +143,8 @@ def test_an_experiments_smaller_specimen_is_checked_and_named():
     model = ModelConfig(type="gradient-damage", parameters=(("c", 4.0),))
     ck = Checker(Path("cfg.toml"))
     check_band_room(ck, model, bar, (SimpleNamespace(index=0, specimen=()), short), None)
-    (warning,) = ck.warnings  # 12.6 mm: 13 % of the 100 mm bar, 63 % of the 20 mm one
-    assert "of experiments[1].specimen" in warning and "63% of" in warning and "its length = 20 mm" in warning
+    (warning,) = ck.warnings  # 12.6 mm: 12.6 % of the 100 mm bar, 62.8 % of the 20 mm one
+    assert "of experiments[1].specimen" in warning and "62.8% of" in warning and "its length = 20 mm" in warning
 
 
 @pytest.mark.parametrize("upper, warned", [(300.0, True), (254.0, True), (252.0, False), (4.0, False)])

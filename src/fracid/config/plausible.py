@@ -43,7 +43,7 @@ def band_verdict(fraction: float, warn: float) -> str | None:
 
 def band_advice(band, room: float) -> str:
     """What to do about a band too wide for ``room`` [mm]: the parameter's values that fit, e.g. ``"lower l below
-    31.8 mm (7.96 mm or less keeps the band within 25 % of it) or use a larger specimen"``."""
+    31.8 mm (15.9 mm or less keeps the band within 50% of it) or use a larger specimen"``."""
     return (f"lower {band.parameter} below {band.value_for(room):.3g} {band.unit} ({band.value_for(band.warn * room):.3g}"
             f" {band.unit} or less keeps the band within {band.warn:.0%} of it) or use a larger specimen")
 
@@ -51,7 +51,7 @@ def band_advice(band, room: float) -> str:
 def _band_text(band, value: float, room, where: str) -> str:
     width = band.width(value)
     fraction = width / room.length
-    share = f"{fraction:.0%} of" if fraction <= 1.0 else f"{fraction:.3g} times"
+    share = f"{100.0 * fraction:.3g}% of" if fraction <= 1.0 else f"{fraction:.3g} times"
     return f"{band.text} = {width:.3g} mm is {share} the room of the specimen{where} for it, {room.text}"
 
 
@@ -82,7 +82,7 @@ def check_band_room(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, e
                               f"{band_advice(band, limit.length)}")
         if band_verdict(band.width(value) / room.length, band.warn) is not None:
             ck.warn(f"{key} = {value:g} {unit}{default}: {_band_text(band, value, room, where)}, more than the "
-                    f"{band.warn:.0%} up to which the model gives {band.promise} ({band.beyond}); "
+                    f"{band.warn:.0%} within which fracid counts on {band.promise} ({band.beyond}); "
                     f"{band_advice(band, room.length)}")
         if upper is not None and band_verdict(band.width(upper) / limit.length, band.warn) == REFUSE:
             ck.warn(f"identify.bounds.{name}: the upper bound {upper:g} {unit}: {_band_text(band, upper, limit, where)}:"
