@@ -19,14 +19,12 @@ def _check_plausible(ck: Checker, key: str, pair, name: str, bounds, units: dict
     """Refuse a bound of ``name`` far outside its usual range (:func:`fracid.models.implausible`): the
     message names the parameter, the bound and the usual range, before any data are read (a kappa_i
     1000 times too large would otherwise make the data look 1000 times too short)."""
-    from fracid.models import IMPLAUSIBLE_FACTOR, implausible
+    from fracid.models import implausible, implausible_text
 
     for which, value in zip(("lower", "upper"), bounds):
         reason = implausible(name, value, units)
         if reason is not None:
-            ck.fail(key, pair, f"the {which} bound is implausible for a quasi-brittle material: {reason} (more than "
-                               f"{IMPLAUSIBLE_FACTOR:g} times outside it); check its unit and scale (e.g. kappa_i "
-                               f"~ 1e-4 for concrete, about ft / E; E in MPa, c in mm^2)")
+            ck.fail(key, pair, f"the {which} bound is {implausible_text(reason)}")
 
 
 def read_identify(ck: Checker, raw, n_y: int | None, needed: bool, model: ModelConfig) -> IdentifyConfig | None:

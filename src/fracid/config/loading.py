@@ -1,6 +1,6 @@
 """:func:`load_config`: the whole file validated section by section, then the checks joining
 sections (the model runs on the specimen, the size of the calibration data, the mesh against the
-internal length)."""
+internal length, the band of the internal length against the specimen)."""
 
 from __future__ import annotations
 
@@ -30,8 +30,10 @@ from fracid.config.sections import (
     read_simulate,
     read_specimen,
     read_study,
+    specimen_variants,
     value_text,
 )
+from fracid.config.plausible import check_band_room, warn_implausible_parameters
 from fracid.config.vocabulary import PURPOSES, TOP_KEYS
 
 
@@ -63,6 +65,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     raw = ck.table("", read_toml(path, stdin), TOP_KEYS)
     base = path.parent
     model = read_model(ck, raw.get("model"))
+    warn_implausible_parameters(ck, model)
     specimen = read_specimen(ck, raw.get("specimen"), base)
     check_model_runs_on(ck, model, specimen)
     experiments = read_experiments(ck, raw.get("experiments"), base, specimen, purpose == "identify")
@@ -77,6 +80,7 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
     posterior = read_posterior(ck, raw.get("posterior"))
     check_specimen_section(ck, model, specimen, identify)  # a mesh's units against the model's mesh length
     _mesh_warnings(ck, model, specimen, experiments, identify)
+    check_band_room(ck, model, specimen, experiments, identify)
     return Config(path=path, purpose=purpose, model=model, specimen=specimen, experiments=experiments,
                   identify=identify, output=output, simulate=simulate, study=study, posterior=posterior,
                   warnings=tuple(ck.warnings))
@@ -111,12 +115,9 @@ def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, ex
         return
     (value, where), _ = parameter_range(model, identify, resolved.parameter, resolved.unit)
     length = resolved.length(value)
-    variants = [("specimen", dict(specimen.options), dict(specimen.options))]
-    variants += [(f"experiments[{e.index}].specimen", {**dict(specimen.options), **dict(e.specimen)}, dict(e.specimen))
-                 for e in experiments if e.specimen]
     cls = specimen_class(specimen.type)
     fields = {f.name for f in dataclasses.fields(cls)}
-    for prefix, options, given in variants:
+    for prefix, options, given in specimen_variants(specimen, experiments):
         resolution = cls(**options).resolution(length)
         if resolution.h <= length:
             continue

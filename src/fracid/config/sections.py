@@ -180,6 +180,14 @@ def field_key(prefix: str, name: str, options: dict, given: dict) -> tuple[str, 
     return (f"{prefix}.{name}" if name in given else f"specimen.{name}"), ("" if name in options else " (default)")
 
 
+def specimen_variants(specimen: SpecimenConfig, experiments) -> list:
+    """The specimens a configuration runs, as (key prefix, options, the options given under that prefix): ``[specimen]``
+    and every ``[[experiments]]`` entry that overrides its fields (``experiments[i].specimen``)."""
+    base = dict(specimen.options)
+    return [("specimen", base, base)] + [(f"experiments[{e.index}].specimen", {**base, **dict(e.specimen)},
+                                          dict(e.specimen)) for e in experiments if e.specimen]
+
+
 def check_specimen_size(ck: Checker, prefix: str, kind: str, cls, options: dict, given: dict) -> None:
     """Refuse a problem beyond the specimen's limit (bar elements, unknowns of a plane mesh), estimated by
     the specimen from its geometry without building the mesh (the specimen is valid: :func:`check_specimen`

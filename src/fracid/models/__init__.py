@@ -30,6 +30,9 @@ damage_threshold, observables, sensitivities)``
 ``mesh_length`` : MeshLength or None
     The length its mesh must resolve where the crack runs, set by one of its parameters: the configuration's
     only source of the resolution warning and of a Gmsh mesh's unit check.
+``band_width`` : BandWidth or None
+    The width of the band it spreads its crack over, set by one of its parameters (pi l of the PF-CZM, 2 pi sqrt(c)
+    of gradient and integral damage): the configuration compares it with the specimen's ``band_room()``.
 ``laws`` : mapping
     The laws a configuration may name (``[model] law``): name -> factory of its ``law`` field.
 ``first_identified`` : tuple of str or None
@@ -68,12 +71,14 @@ from fracid.models.crack import CohesiveCrackModel, CrackBandModel, CrackModel
 from fracid.models.damage import DamageModel
 from fracid.models.path_model import PathFollowingModel
 from fracid.models.phase_field import PhaseFieldModel
-from fracid.models.plausibility import IMPLAUSIBLE_FACTOR, implausible, usual_range_text, usual_ranges
-from fracid.models.protocol import ForwardModel, MeshLength, ModelDefaults, SpecimenStart, declared, runs_on
+from fracid.models.plausibility import (IMPLAUSIBLE_FACTOR, implausible, implausible_text, usual_range_text,
+                                        usual_ranges)
+from fracid.models.protocol import BandWidth, ForwardModel, MeshLength, ModelDefaults, SpecimenStart, declared, runs_on
 from fracid.models.registry import MODEL_TYPES, known_units, model_from_type, model_laws, parameter_units
 
-__all__ = ["IMPLAUSIBLE_FACTOR", "MODEL_TYPES", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel", "CrackModel",
-           "DamageModel", "ForwardModel", "MeshLength", "ModelDefaults", "PathFollowingModel", "PathResult",
-           "PhaseFieldModel", "SpecimenStart", "StepOptions", "declared", "implausible", "known_units",
+__all__ = ["IMPLAUSIBLE_FACTOR", "MODEL_TYPES", "BandWidth", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel",
+           "CrackModel", "DamageModel", "ForwardModel", "MeshLength", "ModelDefaults", "PathFollowingModel", "PathResult",
+           "PhaseFieldModel", "SpecimenStart", "StepOptions", "declared", "implausible", "implausible_text",
+           "known_units",
            "model_from_type", "model_laws", "parameter_units", "probe_matrix", "runs_on", "usual_range_text",
            "usual_ranges"]

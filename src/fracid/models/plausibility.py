@@ -75,6 +75,16 @@ def implausible(name: str, value: float, units: dict | None = None, parameters: 
     return None
 
 
+#: what to check when a value is implausible (:func:`implausible_text`)
+SCALE_ADVICE = "check its unit and scale (e.g. kappa_i ~ 1e-4 for concrete, about ft / E; E in MPa, c in mm^2)"
+
+
+def implausible_text(reason: str) -> str:
+    """The words of a refusal or warning about an implausible value, ``reason`` being :func:`implausible`'s."""
+    return (f"implausible for a quasi-brittle material: {reason} (more than {IMPLAUSIBLE_FACTOR:g} times outside "
+            f"it); {SCALE_ADVICE}")
+
+
 def first_bounds(parameters: type, name: str, value: float) -> list:
     """Bounds [lower, upper] a first identification searches around ``value`` of parameter ``name``: a factor 3
     each way, inside the usual range and the valid one of the parameter class ``parameters``, to 3 digits."""

@@ -3,7 +3,8 @@ the defaults of a model that declares only ``key``, ``parameters`` and ``simulat
 (:class:`ModelDefaults`, :func:`declared`) and :func:`runs_on`.
 
 Everything the outer ring (the configuration, ``fracid init``, ``fracid compare``) asks of a model is a
-member here with its default: the length its mesh must resolve (:class:`MeshLength`), the laws a
+member here with its default: the length its mesh must resolve (:class:`MeshLength`), the width of its
+crack's band (:class:`BandWidth`), the laws a
 configuration may name, the parameters a first identification looks for and the specimen fields
 ``fracid init`` changes for it (:class:`SpecimenStart`). No caller probes a model with ``getattr``.
 """
@@ -42,6 +43,46 @@ class MeshLength(NamedTuple):
     advice: str | None = None
 
 
+class BandWidth(NamedTuple):
+    """The width of the band a model spreads its crack over, set by one of its parameters:
+    ``width(value) = factor * value ** exponent`` [mm]. A configuration compares it with the room its
+    specimen leaves the band (:meth:`~fracid.specimens.protocol.Specimen.band_room`): warned above
+    ``warn`` times the room, refused above it (the band cannot form, and what the model promises fails).
+
+    Attributes
+    ----------
+    parameter, unit : str
+        The parameter it follows and the parameter's unit.
+    factor, exponent : float
+        width = factor * value ** exponent [mm] (exponent > 0: a larger value, a wider band).
+    text : str
+        The width in words, e.g. ``"the band's width pi l"``.
+    promise : str
+        What the model promises while the band fits, e.g. ``"the cohesive law of its softening shape"``.
+    warn : float
+        The fraction of the room above which the configuration is warned [-] (the reason in the model's docstring).
+    beyond : str
+        What was measured beyond ``warn`` (how far to trust the warning), e.g. ``"the curve departs ..."``.
+    """
+
+    parameter: str
+    unit: str
+    factor: float
+    exponent: float
+    text: str
+    promise: str
+    warn: float
+    beyond: str
+
+    def width(self, value: float) -> float:
+        """The band's width at ``value`` of the parameter [mm]."""
+        return self.factor * value**self.exponent
+
+    def value_for(self, width: float) -> float:
+        """The parameter's value whose band is ``width`` [mm] wide (the inverse of :meth:`width`)."""
+        return (width / self.factor) ** (1.0 / self.exponent)
+
+
 class SpecimenStart(NamedTuple):
     """The specimen fields ``fracid init`` writes for a model instead of the specimen's defaults, and why
     (the written configuration's comment says so).
@@ -73,6 +114,7 @@ class ForwardModel(Protocol):
     observer_names: tuple
     regularization: str | None
     mesh_length: MeshLength | None
+    band_width: BandWidth | None
     laws: Mapping
     first_identified: tuple | None
     specimen_starts: Mapping
@@ -92,7 +134,7 @@ class ForwardModel(Protocol):
 class ModelDefaults:
     """The capabilities of a model that declares nothing more than ``key``, ``parameters`` and ``simulate``:
     it runs on every specimen, differentiates nothing, has no observers of its own, no regularisation, no
-    length its mesh must resolve and no laws by name, takes the specimen's default target with no
+    length its mesh must resolve, no band of a width of its own and no laws by name, takes the specimen's default target with no
     characteristic scales, a first identification looks for the two parameters after E and nu,
     ``fracid init`` writes the specimens' defaults for it, and it checks its specimen objects itself."""
 
@@ -102,6 +144,8 @@ class ModelDefaults:
     regularization: ClassVar[str | None] = None
     #: the length its mesh must resolve (:class:`MeshLength`), None: no such length
     mesh_length: ClassVar[MeshLength | None] = None
+    #: the width of the band it spreads its crack over (:class:`BandWidth`), None: no band (a local model, a crack)
+    band_width: ClassVar[BandWidth | None] = None
     #: the laws a configuration may name (``[model] law``): name -> factory of the ``law`` field's value
     laws: ClassVar[Mapping] = _NONE
     #: specimen class -> the :class:`SpecimenStart` ``fracid init`` writes for this model on it

@@ -12,6 +12,7 @@ from fracid.specimens.checks import require_positive
 from fracid.specimens.description import Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.protocol import (
     BAR_BYTES_PER_ELEMENT,
+    BandRoom,
     MAX_BAR_ELEMENTS,
     Resolution,
     SizeEstimate,
@@ -134,6 +135,10 @@ class BarWithWeakZone(SpecimenDefaults):
             stiffness_factor=(lambda points: np.ones(points.shape[:-1])) if by_area else (lambda points: self.weakness(points[..., 0])),
             zone=ZoneWidth("damaged_zone_width", along_range=(0.0, self.length)), cell_type="line3",
         )
+
+    def band_room(self) -> BandRoom:
+        """L: the band forms across the bar and must fit between its ends."""
+        return BandRoom(self.length, f"its length = {self.length:g} mm")
 
     def default_target(self, scales) -> float:
         """A control value well past the peak: 50 times the bar's elongation at the model's

@@ -9,7 +9,7 @@ import numpy as np
 
 from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
-from fracid.specimens.protocol import FineSizeDefaults
+from fracid.specimens.protocol import BandRoom, FineSizeDefaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
@@ -102,6 +102,10 @@ class NotchedBeam(FineSizeDefaults):
     def characteristic_size(self) -> float:
         """D, the depth [mm] (the size of a size-effect series)."""
         return self.depth
+
+    def band_room(self) -> BandRoom:
+        """D: the crack runs up the depth, whose faces (the notch's included) cut the band about its tip."""
+        return BandRoom(self.depth, f"its depth = {self.depth:g} mm")
 
     @property
     def nominal_section(self) -> float:

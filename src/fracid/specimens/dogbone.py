@@ -10,7 +10,7 @@ import numpy as np
 
 from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive
-from fracid.specimens.protocol import FineSizeDefaults
+from fracid.specimens.protocol import BandRoom, FineSizeDefaults
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support, ZoneWidth
 from fracid.specimens.meshing import QuadMesh, graded_count, graded_lines, quad8_grid_size, structured_quad8
 
@@ -218,6 +218,11 @@ class DogBone(FineSizeDefaults):
     def characteristic_size(self) -> float:
         """D, the width [mm] (the size of a size-effect series)."""
         return self.size
+
+    def band_room(self) -> BandRoom:
+        """The width at mid-height, notch_width D: the crack runs across it and the notches cut the band."""
+        width = self.notch_width * self.size
+        return BandRoom(width, f"its width at mid-height notch_width * size = {width:g} mm")
 
     @property
     def nominal_section(self) -> float:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Callable, ClassVar, Protocol, runtime_checkable
+from typing import Callable, ClassVar, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -64,6 +64,34 @@ class Resolution:
     h: float
     text: str
     advice: str
+
+
+class BandRoom(NamedTuple):
+    """The extent of a specimen that the band of a regularised model must fit into: across the crack path where
+    the crack forms through the whole section at once (a bar, a strip), else the depth of the section the crack
+    runs through (a beam's depth, a dog-bone's narrowest width), whose faces cut the band's profile about the
+    crack's tip.
+
+    Attributes
+    ----------
+    length : float
+        The extent [mm].
+    text : str
+        It in words, naming the key that sets it, e.g. ``"its length = 100 mm"``.
+    most, most_text : float or None, str
+        Where the geometry says less (a mesh: which side the crack crosses is not known), the extent beyond which no
+        band can form whatever the crack's direction [mm] and it in words; None: ``length``.
+    """
+
+    length: float
+    text: str
+    most: float | None = None
+    most_text: str = ""
+
+    @property
+    def limit(self) -> "BandRoom":
+        """The room beyond which no band can form: ``most`` where given, else this one."""
+        return self if self.most is None else BandRoom(self.most, self.most_text)
 
 
 class SectionError(ValueError):
@@ -145,6 +173,7 @@ class Specimen(Protocol):
     ``config_section`` reads and checks its ``[specimen]`` section when that is not its dataclass fields
     (a :class:`SpecimenSection`; None: the fields are the keys). ``snap_back_control`` is the control that
     grows through a snap-back (an opening across the crack; None: none is known).
+    ``band_room()`` is the extent the band of a regularised model must fit into (:class:`BandRoom`).
     ``refined(factor)`` is the same specimen with its element size where it localises divided by ``factor``
     (the discretisation error's finer mesh). ``default_instance()`` is the specimen with its defaults (None when
     it needs the user's input).
@@ -173,6 +202,8 @@ class Specimen(Protocol):
 
     def size_estimate(self) -> SizeEstimate: ...
 
+    def band_room(self) -> BandRoom: ...
+
     def refined(self, factor: float): ...
 
     def options_text(self, options: dict) -> str: ...
@@ -190,6 +221,16 @@ def element_sides(description) -> tuple:
         corners = description.nodes[description.corners]
         lengths = np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=-1)
     return float(lengths.min()), float(lengths.max())
+
+
+def bounding_room(nodes, symmetry_planes=(), which=min) -> float:
+    """The smallest (``which=max``: largest) side of the bounding box of ``nodes`` (n, dim) [mm], a half or quarter
+    model mirrored about its ``symmetry_planes`` ((axis, coordinate), ...) so that the side is the whole specimen's."""
+    nodes = np.asarray(nodes, dtype=float)
+    sides = np.ptp(nodes, axis=0)
+    for axis, coordinate in symmetry_planes:
+        sides[axis] = 2.0 * np.max(np.abs(nodes[:, axis] - coordinate))
+    return float(which(sides))
 
 
 def plane_estimate(field: str | None, value, elements: int, nodes: int, vertices: int, advice: str) -> SizeEstimate:
@@ -239,6 +280,15 @@ class SpecimenDefaults:
         """The size of the described mesh (built once: override for a large mesh)."""
         d = self.describe()
         return plane_estimate(None, None, len(d.cells), len(d.nodes), d.n_vertices, f"use a coarser mesh ({_ENOUGH})")
+
+    def band_room(self) -> BandRoom:
+        """The smallest side of the described specimen's bounding box, mirrored about its symmetry planes [mm]: the
+        crack may cross it (a beam's depth) and cut the band. Which side it crosses is not known (a strip's band lies
+        along its largest side), so no band forms only beyond the largest side (``most``)."""
+        d = self.describe()
+        smallest, largest = bounding_room(d.nodes, d.symmetry_planes), bounding_room(d.nodes, d.symmetry_planes, max)
+        return BandRoom(smallest, f"the smallest side of its bounding box, {smallest:.4g} mm", largest,
+                        f"the largest side of its bounding box, {largest:.4g} mm")
 
     def options_text(self, options: dict) -> str:
         """The options given in ``[specimen]`` in words: ``"depth = 100, h_fine = 2"``, or ``"defaults"``."""

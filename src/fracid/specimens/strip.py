@@ -9,7 +9,8 @@ import numpy as np
 
 from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive
-from fracid.specimens.protocol import Resolution, SizeEstimate, SpecimenDefaults, bar_resolution, plane_estimate
+from fracid.specimens.protocol import (BandRoom, Resolution, SizeEstimate, SpecimenDefaults, bar_resolution,
+                                       plane_estimate)
 from fracid.specimens.description import CrackPath, Description, Load, Measure, Support
 from fracid.specimens.meshing import quad8_grid_size, structured_quad8
 
@@ -97,6 +98,11 @@ class TensionStrip(SpecimenDefaults):
             strength_factor=lambda points: np.where(centre(points), self.weak_factor, 1.0),
             crack=CrackPath(None, normal=0, mirrored=False),
         )
+
+    def band_room(self) -> BandRoom:
+        """L: the crack forms across the whole height at once, and its band lies along the length between the
+        platens."""
+        return BandRoom(self.length, f"its length = {self.length:g} mm")
 
     def default_target(self, scales) -> float:
         """Band opening 0.99 wc [mm] (wc = ``scales["opening"]`` of the weak column, which keeps Gf at a

@@ -16,7 +16,7 @@ import numpy as np
 
 from fracid.settings.field_error import FieldError
 from fracid.specimens.checks import require_positive, resolve_defaults
-from fracid.specimens.protocol import FineSizeDefaults
+from fracid.specimens.protocol import BandRoom, FineSizeDefaults
 from fracid.specimens.description import Description
 from fracid.specimens.mesh import MeshSpecimen
 from fracid.specimens.mesh_reading import plane_mesh
@@ -132,6 +132,10 @@ class WedgeSplitting(FineSizeDefaults):
     def ligament(self) -> float:
         """Ligament length H - notch_depth [mm] (the crack area is ligament x thickness)."""
         return self.height - self.notch_depth
+
+    def band_room(self) -> BandRoom:
+        """H: the crack runs down the height, whose faces (the groove's and the notch's included) cut the band."""
+        return BandRoom(self.height, f"its height = {self.height:g} mm")
 
     @property
     def characteristic_size(self) -> float:

@@ -40,7 +40,8 @@ class DamageParameters(ParameterSet):
     beta : float
         Softening rate [-], beta >= 0 (alpha = 1, beta = 0: "perfect" damage).
     c : float
-        Gradient parameter [mm^2], c = l^2 / 2 with l the internal length, c > 0.
+        Gradient parameter [mm^2], c = l^2 / 2 with l the internal length, c > 0; the damage band, 2 pi sqrt(c)
+        wide, is refused beyond the specimen's room and warned above half of it.
     eta : float
         Ratio of compressive to tensile strength in the modified von Mises equivalent strain [-], eta >= 1.
 

@@ -35,7 +35,8 @@ SHAPES = {"linear": (2.0, -0.5, 0.0), "exponential": (2.5, 2.0 ** (5.0 / 3.0) - 
 
 LENGTH = (Field("l", 2.5, ParameterRange(0.0, False, None, False, "mm"),
                 "Length scale of the phase field (Wu's b): a numerical parameter, the band's half-width is "
-                "pi l / 2; the mesh needs h <= l / 5 where the crack runs", (0.1, 50.0)),)
+                "pi l / 2 (pi l is refused beyond the specimen's room, warned above half of it); the mesh needs "
+                "h <= l / 5 where the crack runs", (0.1, 50.0)),)
 
 
 def _shape_fields(p, a2, a3):
