@@ -338,4 +338,4 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--force", action="store_true", help="replace an existing -o file")
     p.add_argument("--list", action="store_true", help="list the (specimen, model) pairs")
     p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
-    p.set_defaults(run=run_init)
+    p.set_defaults(run=run_init, out_option="-o FILE")
