@@ -59,7 +59,7 @@ def out_dir(args, cfg) -> Path:
     file of ``--store`` (if given) is known to be usable (:func:`shared_store`)."""
     from fracid.store.outputs import claim_outputs
 
-    inputs = list(_inputs(cfg))
+    inputs = list(run_inputs(cfg))
     if getattr(args, "store", None) is not None:
         shared_store(args.store, inputs)
     out = output_path(args, cfg)
@@ -78,7 +78,7 @@ def output_path(args, cfg) -> Path:
     return out
 
 
-def _inputs(cfg):
+def run_inputs(cfg):
     """(what it is, path) of every file the run reads: the configuration, the data files, a mesh."""
     yield "the configuration", Path(cfg.path)
     for exp in cfg.experiments:

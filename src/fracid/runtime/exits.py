@@ -151,11 +151,11 @@ _STORE_ADVICE = {
         "stored before are intact and will be reused",  # SQLITE_FULL
     10: "a disk input/output error (a removed drive, a network file system that went away?). Check the disk "
         "and run again: the runs stored before the error are kept",  # SQLITE_IOERR
-    8: "it is read-only (file or directory permissions, or a read-only file system). Give a place you can "
-       "write ({option}) or fix the permissions",  # SQLITE_READONLY
-    3: "access was denied. Give a place you can write ({option})",  # SQLITE_PERM
-    14: "it cannot be opened: is it a directory, or is its directory gone or not writable? Give another "
-        "place ({option})",  # SQLITE_CANTOPEN
+    8: "it is read-only (file or directory permissions, or a read-only file system). Give another "
+       "{place} you can write ({option}) or fix the permissions",  # SQLITE_READONLY
+    3: "access was denied. Give another {place} you can write ({option})",  # SQLITE_PERM
+    14: "it cannot be opened: is it a directory, or is its directory gone or not writable? Give "
+        "another {place} ({option})",  # SQLITE_CANTOPEN
     5: "another program holds a lock on it. Close that program (a database browser?) and run again",  # BUSY
     6: "another connection holds a lock on it. Close that program and run again",  # SQLITE_LOCKED
 }
@@ -187,13 +187,14 @@ def _store_text(err, where, option="--out DIR") -> str:
     """The message of a run-store failure, by SQLite's result code and the free space of its file system: only
     a damaged file is to be moved away."""
     if isinstance(err, _loaded("fracid.store.runs", "NotARunStore")):
+        other = "" if option == "--store FILE" else " or run store (--store FILE)"
         return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
-                f"place for the run store ({option}).")
+                f"{_place(option)} ({option}){other}.")
     code = getattr(err, "sqlite_errorcode", None)
     code = code if code is not None else getattr(err.__cause__, "sqlite_errorcode", None)
     advice = _STORE_ADVICE.get(store_failure(code, _free(where)), _DAMAGED)
-    return (f"the run store {where} cannot be used ({err}): "
-            f"{advice.format(disk=_disk(where), option=option, name=os.path.basename(str(where)))}.")
+    advice = advice.format(disk=_disk(where), option=option, place=_place(option), name=os.path.basename(str(where)))
+    return f"the run store {where} cannot be used ({err}): {advice}."
 
 
 def _mount(path) -> str:
@@ -244,6 +245,15 @@ def _snap_back_advice(control, functionals) -> str:
                    "that make the specimen less brittle (a larger c, a smaller beta).")
 
 
+#: the place each option chooses, as the advice names it
+_PLACES = {"--out DIR": "output directory", "--store FILE": "run store file", "-o FILE": "file to write"}
+
+
+def _place(option: str) -> str:
+    """``output directory`` for ``--out DIR``: what ``option`` gives."""
+    return _PLACES.get(option, "place")
+
+
 def _os_text(err: OSError, name, option="--out DIR") -> str:
     """The message of a failed file operation on ``name`` (the error's file, or the output directory); ``option``
     chooses another place (``--out DIR``, ``--store FILE``, ``-o FILE``)."""
@@ -253,12 +263,13 @@ def _os_text(err: OSError, name, option="--out DIR") -> str:
         return (f"the disk is full (writing {name}{_disk(name)}). Free some space and run again: finished runs "
                 "are kept.")
     if err.errno == errno.EROFS:
-        return (f"the file system holding {name} is read-only{_disk(name)}. Choose a place on a writable disk "
-                f"({option}); the runs stored there can be copied along with the run store.")
+        return (f"the file system holding {name} is read-only{_disk(name)}. Choose another {_place(option)} on a "
+                f"writable disk ({option}); the runs stored there can be copied along with the run store.")
     if err.errno in (errno.EACCES, errno.EPERM):
-        return f"permission denied: {name}. Choose a place you can write ({option}) or fix the permissions."
+        return (f"permission denied: {name}. Choose another {_place(option)} you can write ({option}) or fix the "
+                "permissions.")
     if err.errno in (errno.ENOTDIR, errno.EEXIST) or isinstance(err, (NotADirectoryError, FileExistsError)):
-        return f"{name} is a file, not a directory: give another place ({option})."
+        return f"{name} is a file, not a directory: give another {_place(option)} ({option})."
     if isinstance(err, IsADirectoryError):
         return f"{name} is a directory where a file was expected."
     if isinstance(err, FileNotFoundError):
