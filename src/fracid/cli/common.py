@@ -170,6 +170,20 @@ def _head(path: Path) -> bytes:
         return b""
 
 
+def output_file(path, example="fracid.toml") -> Path:
+    """The file of ``-o FILE`` (``fracid init``), ``~`` expanded; :class:`~fracid.runtime.exits.UsageError` naming
+    ``-o`` for a directory or a missing directory (fracid init makes no directories)."""
+    from fracid.runtime.exits import UsageError
+
+    path = Path(path).expanduser()
+    if path.is_dir():
+        raise UsageError(f"-o {path}: a directory; give a file name such as {path / example}")
+    if not path.parent.is_dir():
+        raise UsageError(f"-o {path}: the directory {path.parent} does not exist; create it, or give a file in an "
+                         "existing directory")
+    return path
+
+
 def progress_choice(args):
     """The ``progress`` argument of the API for this command: False with ``--quiet``, else None (bars on a
     terminal, lines otherwise)."""

@@ -8,15 +8,8 @@ from typing import ClassVar
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
 from fracid.models.path_model import PathFollowingModel
-from fracid.models.protocol import MeshLength, SpecimenStart
+from fracid.models.protocol import MeshLength
 from fracid.specimens.description import at_points, conditions, described, discretize
-from fracid.specimens.beam import NotchedBeam
-from fracid.specimens.dogbone import DogBone
-from fracid.specimens.strip import TensionStrip
-from fracid.specimens.wedge import WedgeSplitting
-
-#: why ``fracid init`` refines the specimens' default meshes for the PF-CZM
-_FINER = "a finer mesh where the crack runs, h <= l / 5 = 0.5 mm, resolves the phase field's band (l = 2.5 mm)"
 
 
 @dataclass(frozen=True)
@@ -38,10 +31,6 @@ class PhaseFieldModel(PathFollowingModel):
     mesh_length: ClassVar[MeshLength] = MeshLength("l", "mm", lambda l: l / 5.0, "l / 5 (a fifth of the length scale)",
                                                    "the phase field's band",
                                                    "make the elements where the crack runs {size:.3g} mm or smaller")
-    #: the default meshes refined to h <= l / 5 at the default l
-    specimen_starts: ClassVar[dict] = {
-        **{cls: SpecimenStart({"h_fine": 0.5}, _FINER) for cls in (NotchedBeam, DogBone, WedgeSplitting)},
-        TensionStrip: SpecimenStart({"n_elements": 201}, _FINER)}
 
     @property
     def parameters(self) -> type:
