@@ -98,12 +98,11 @@ def config_text(ds, references: dict, licence: str) -> str:
 def init_dataset(args) -> int:
     """``fracid init --dataset NAME [-o FILE] [--force]``: the configuration on standard output, or written
     to FILE with the data set's files copied beside it."""
-    from fracid.cli.init import DEMO_PAIR
     from fracid.datasets import get
     from fracid.runtime.exits import UsageError
 
     ds = get(args.dataset)  # an unknown name: UnknownDataset, exit 2, the names listed
-    if args.list or (args.specimen, args.model) != DEMO_PAIR:
+    if args.list or args.specimen is not None or args.model is not None:
         raise UsageError(f"--dataset {ds.name} writes the data set's own configuration ({ds.specimen}, {ds.model}): "
                          "--specimen, --model and --list do not go with it")
     if args.output is None:

@@ -15,17 +15,15 @@ and the usual ranges of its parameters (:mod:`fracid.models.plausibility`). The 
 from __future__ import annotations
 
 import dataclasses
-import inspect
-import re
 import sys
 import tomllib
 from pathlib import Path
 
+from fracid.cli.docstrings import description, numpydoc_parameters, summary
 from fracid.settings.checks import COMMENT_COLUMN, show, toml_line
 
 #: (specimen, model) whose configuration is the bundled demo's, with its data file
 DEMO_PAIR = ("notched-beam", "gradient-damage")
-_ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
 #: comment column of the written ``key = value`` lines
 _COLUMN = COMMENT_COLUMN
 
@@ -46,54 +44,6 @@ _EXPERIMENT_COMMENTS = {
 #: the commented-out data block of the pairs without bundled data
 _EXPERIMENT_TEMPLATE = {"file": "my_test.csv", "control_column": "u_mm", "control_unit": "mm", "force_unit": "N",
                         "kind": "single", "force_columns": ["F_N"], "std": 10.0, "n_points": 24}
-
-
-def numpydoc_parameters(cls) -> dict:
-    """The entries of the numpydoc ``Parameters`` section of ``cls``'s docstring.
-
-    Parameters
-    ----------
-    cls : type
-        A class whose docstring has a ``Parameters`` section.
-
-    Returns
-    -------
-    dict
-        name -> (type text, description on one line); an entry naming several fields
-        (``width, height : float``) gives each of them the shared description.
-    """
-    doc = inspect.getdoc(cls) or ""
-    match = re.search(r"^Parameters\n-+\n(.*?)(?:\n\n(?! )|\Z)", doc, re.S | re.M)
-    entries, names = {}, []
-    for line in (match.group(1).splitlines() if match else []):
-        if line and not line.startswith(" "):
-            names_text, _, kind = line.partition(" : ")
-            names = [n.strip() for n in names_text.split(",")]
-            for i, name in enumerate(names):
-                entries[name] = (kind.strip() if len(names) == 1 else
-                                 f"{kind.strip()}; {_ORDINALS[i]} of {', '.join(names)}", "")
-        elif names:
-            for name in names:
-                kind, text = entries[name]
-                entries[name] = (kind, f"{text} {line.strip()}".strip())
-    return entries
-
-
-def summary(cls) -> str:
-    """The first paragraph of ``cls``'s docstring, on one line."""
-    return " ".join((inspect.getdoc(cls) or "").split("\n\n")[0].split())
-
-
-def description(cls) -> list:
-    """The paragraphs of ``cls``'s docstring outside its numpydoc sections (Parameters, Examples ...),
-    each on one line."""
-    kept, skipping = [], False
-    for paragraph in (inspect.getdoc(cls) or "").split("\n\n"):
-        heading = re.match(r"[A-Z][a-z ]+\n-+\n", paragraph)
-        skipping = bool(heading) or (skipping and paragraph.startswith(" "))
-        if not skipping:
-            kept.append(" ".join(paragraph.split()))
-    return kept
 
 
 def runnable_pairs() -> list:
@@ -377,6 +327,7 @@ def run_init(args) -> int:
     from fracid.runtime.exits import UsageError
 
     pairs = runnable_pairs()
+    args.specimen, args.model = args.specimen or DEMO_PAIR[0], args.model or DEMO_PAIR[1]
     if args.list:
         print("\n".join(f"--specimen {s} --model {m}" for s, m in pairs))
         return 0
@@ -403,8 +354,8 @@ def run_init(args) -> int:
 def add_parser(sub, parents) -> None:
     """The ``init`` subcommand's arguments."""
     p = sub.add_parser("init", help="write a commented configuration to start from")
-    p.add_argument("--specimen", default=DEMO_PAIR[0], help=f"specimen type (default {DEMO_PAIR[0]})")
-    p.add_argument("--model", default=DEMO_PAIR[1], help=f"model type (default {DEMO_PAIR[1]})")
+    p.add_argument("--specimen", help=f"specimen type (default {DEMO_PAIR[0]})")
+    p.add_argument("--model", help=f"model type (default {DEMO_PAIR[1]})")
     p.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
     p.add_argument("--force", action="store_true", help="replace an existing -o file")
     p.add_argument("--list", action="store_true", help="list the (specimen, model) pairs")
