@@ -246,7 +246,7 @@ def _snap_back_advice(control, functionals) -> str:
 
 
 #: the place each option chooses, as the advice names it
-_PLACES = {"--out DIR": "output directory", "--store FILE": "run store file", "-o FILE": "file to write"}
+_PLACES = {"--out DIR": "output directory", "--store FILE": "run store file", "-o FILE": "file"}
 
 
 def _place(option: str) -> str:
