@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fracid.cli.common import load, warn
+from fracid.cli.common import load, output_path, run_inputs, warn
 
 #: one forward run slower than this [s] is warned about
 SLOW_RUN = 30.0
@@ -184,9 +184,11 @@ def run_check(args) -> int:
     """``fracid check``: print the plan of the configuration; exit 2 (with the message) if it is invalid."""
     from fracid.config import build_data, build_method, build_model, build_operator, build_parameters, build_specimen
     from fracid.runtime.executors import available_cores
+    from fracid.store.outputs import check_outputs
 
     cfg = load(args, args.config, "simulate")  # [[experiments]] and [identify] validated when present
     purpose = "identify" if cfg.experiments and cfg.identify is not None else "simulate"
+    check_outputs(output_path(args, cfg), purpose, run_inputs(cfg))  # refused here as the run would refuse it
     model, params = build_model(cfg), build_parameters(cfg)
     lines = [f"configuration {cfg.path}: valid (for fracid {purpose}{' and simulate' if purpose == 'identify' else ''})"]
     lines += specimen_lines(cfg, model, params) + model_lines(cfg, params)

@@ -55,19 +55,30 @@ def load(args, path, purpose):
 
 def out_dir(args, cfg) -> Path:
     """The output directory, made if needed, once the command's outputs are known to replace neither an
-    input of the run nor a file fracid did not write (:func:`fracid.store.outputs.claim_outputs`)."""
+    input of the run nor a file fracid did not write (:func:`fracid.store.outputs.claim_outputs`), and the
+    file of ``--store`` (if given) is known to be usable (:func:`shared_store`)."""
     from fracid.store.outputs import claim_outputs
 
-    out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
-    if out.exists() and not out.is_dir():
-        raise NotADirectoryError(20, "not a directory", str(out))
+    inputs = list(run_inputs(cfg))
+    if getattr(args, "store", None) is not None:
+        shared_store(args.store, inputs)
+    out = output_path(args, cfg)
     out.mkdir(parents=True, exist_ok=True)
-    claim_outputs(out, args.command, _inputs(cfg))
+    claim_outputs(out, args.command, inputs)
     args.out_dir = out
     return out
 
 
-def _inputs(cfg):
+def output_path(args, cfg) -> Path:
+    """The output directory of ``--out`` or ``[output] directory``, not made; NotADirectoryError (exit 4, as
+    when a run writes there) if it is a file."""
+    out = args.out.expanduser() if args.out is not None else Path(cfg.output.directory)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(20, "not a directory", str(out))
+    return out
+
+
+def run_inputs(cfg):
     """(what it is, path) of every file the run reads: the configuration, the data files, a mesh."""
     yield "the configuration", Path(cfg.path)
     for exp in cfg.experiments:
@@ -96,9 +107,23 @@ def working_in(args, out, store=False):
             yield stack.enter_context(RunStore(args.store_path))
 
 
-def shared_store(path) -> Path:
-    """The run store file of ``--store PATH``; :class:`~fracid.runtime.exits.UsageError` for a directory or a missing
-    directory."""
+def shared_store(path, inputs=()) -> Path:
+    """The run store file of ``--store PATH``.
+
+    Parameters
+    ----------
+    path : path-like
+        As given (``~`` expanded).
+    inputs : iterable of (str, Path)
+        What the run reads and where (the configuration, the data files, a mesh): the store is none of them.
+
+    Raises
+    ------
+    UsageError
+        For a directory, a missing directory, a path that is not a regular file (a device such as
+        ``/dev/null``, a pipe), an input of the run, or a file that is not an SQLite database (fracid writes
+        only into a store it made); the message names ``--store``.
+    """
     from fracid.runtime.exits import UsageError
 
     path = Path(path).expanduser()
@@ -106,6 +131,55 @@ def shared_store(path) -> Path:
         raise UsageError(f"--store {path} is a directory; give the run store's file, e.g. --store {path / 'runs.sqlite'}")
     if not path.parent.is_dir():
         raise UsageError(f"--store {path}: the directory {path.parent} does not exist; create it, or give a store in an "
+                         "existing directory")
+    if not path.exists():
+        return path
+    instead = f"give the run store's own file, e.g. --store {path.parent / 'runs.sqlite'}"
+    if not path.is_file():
+        raise UsageError(f"--store {path}: not a regular file (a device, a pipe or a socket): fracid keeps its runs in "
+                         "an SQLite file; give the run store's own file, e.g. --store runs.sqlite")
+    for what, source in inputs:
+        if _same_file(path, source):
+            raise UsageError(f"--store {path} is {what}, an input of this run: fracid never writes into its inputs; "
+                             f"{instead}")
+    head = _head(path)
+    if head and not head.startswith(SQLITE_HEADER):
+        raise UsageError(f"--store {path}: not a run store (its first bytes {head[:16]!r} are not an SQLite "
+                         f"database's): fracid writes only into a store it made; {instead}")
+    return path
+
+
+#: the first bytes of every SQLite 3 database file (https://sqlite.org/fileformat.html)
+SQLITE_HEADER = b"SQLite format 3\x00"
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` are the same file (through links); False if either cannot be read."""
+    try:
+        return a.samefile(b)
+    except (OSError, ValueError):
+        return False
+
+
+def _head(path: Path) -> bytes:
+    """The first bytes of the file at ``path`` (b"" if it cannot be read: opening it will say why)."""
+    try:
+        with open(path, "rb") as handle:
+            return handle.read(len(SQLITE_HEADER))
+    except OSError:
+        return b""
+
+
+def output_file(path, example="fracid.toml") -> Path:
+    """The file of ``-o FILE`` (``fracid init``), ``~`` expanded; :class:`~fracid.runtime.exits.UsageError` naming
+    ``-o`` for a directory or a missing directory (fracid init makes no directories)."""
+    from fracid.runtime.exits import UsageError
+
+    path = Path(path).expanduser()
+    if path.is_dir():
+        raise UsageError(f"-o {path}: a directory; give a file name such as {path / example}")
+    if not path.parent.is_dir():
+        raise UsageError(f"-o {path}: the directory {path.parent} does not exist; create it, or give a file in an "
                          "existing directory")
     return path
 

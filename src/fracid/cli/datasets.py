@@ -16,6 +16,8 @@ import shutil
 import sys
 from pathlib import Path
 
+from fracid.cli.common import output_file
+
 #: the columns of ``fracid datasets``: (heading, Dataset attribute)
 COLUMNS = (("NAME", "name"), ("SPECIMEN", "specimen"), ("MODEL", "model"), ("LICENCE", "licence"),
            ("CITATION", "citation"))
@@ -96,27 +98,40 @@ def config_text(ds, references: dict, licence: str) -> str:
 def init_dataset(args) -> int:
     """``fracid init --dataset NAME [-o FILE] [--force]``: the configuration on standard output, or written
     to FILE with the data set's files copied beside it."""
-    from fracid.cli.init import DEMO_PAIR
     from fracid.datasets import get
     from fracid.runtime.exits import UsageError
 
     ds = get(args.dataset)  # an unknown name: UnknownDataset, exit 2, the names listed
-    if args.list or (args.specimen, args.model) != DEMO_PAIR:
+    if args.list or args.specimen is not None or args.model is not None:
         raise UsageError(f"--dataset {ds.name} writes the data set's own configuration ({ds.specimen}, {ds.model}): "
                          "--specimen, --model and --list do not go with it")
     if args.output is None:
         sys.stdout.write(config_text(ds, {file.name: str(file) for file in ds.file_paths}, str(ds.licence_path)))
         return 0
-    path = Path(args.output).expanduser()
-    copies = _copies(ds, path, args.force)
+    path = output_file(args.output, ds.name + ".toml")
+    copied = copy_beside(ds, path, args.force)
+    text = config_text(ds, {file.name: file.name for file in ds.file_paths}, f"{ds.licence_path.name}, beside this file")
+    path.write_text(text, encoding="utf-8")
+    print(f"wrote {path} and, beside it, {', '.join(copied)}: check it with "
+          f"`fracid check {path}`, run it with `fracid identify {path}`", file=sys.stderr)
+    return 0
+
+
+def copy_beside(ds, path: Path, force: bool) -> list[str]:
+    """Copy the data files and the licence of ``ds`` beside the configuration file ``path`` (written next by the
+    caller), once nothing would be overwritten (:func:`_copies`); returns the names copied or found there."""
+    copies = _copies(ds, path, force)
     for target, source in copies.items():
         if not target.exists():  # an existing one holds the same bytes (_copies checked)
             shutil.copyfile(source, target)
-    text = config_text(ds, {file.name: file.name for file in ds.file_paths}, f"{ds.licence_path.name}, beside this file")
-    path.write_text(text, encoding="utf-8")
-    print(f"wrote {path} and, beside it, {', '.join(sorted(t.name for t in copies))}: check it with "
-          f"`fracid check {path}`, run it with `fracid identify {path}`", file=sys.stderr)
-    return 0
+    return sorted(target.name for target in copies)
+
+
+def bundled_dataset(config: Path):
+    """The bundled data set whose configuration is ``config`` (the demo's: :func:`fracid.cli.common.demo_config_path`)."""
+    from fracid.datasets import DATASETS
+
+    return next(ds for ds in DATASETS.values() if Path(ds.config_path) == Path(config))
 
 
 def _copies(ds, path: Path, force: bool) -> dict:

@@ -82,6 +82,14 @@ def version() -> str:
     return fracid_version()
 
 
+def _options(args) -> dict:
+    """The options a failure's advice names to choose another place: ``--store FILE`` for a store given so,
+    ``out_option`` as the command declares it (``-o FILE`` of ``fracid init``), else ``--out DIR``."""
+    out_option = getattr(args, "out_option", "--out DIR")
+    return {"out_option": out_option,
+            "store_option": "--store FILE" if getattr(args, "store", None) is not None else out_option}
+
+
 def main(argv=None) -> int:
     """Run the command; returns its exit status (see :mod:`fracid.runtime.exits`), never raises."""
     from fracid.runtime import exits, stops
@@ -103,7 +111,7 @@ def main(argv=None) -> int:
             if not isinstance(err, KeyboardInterrupt) and stops.stopped_by() is not None:
                 err = stops.stopped_by()  # the signal, seen through the code it struck
             status, text = exits.describe(err, store_path=getattr(args, "store_path", None),
-                                          out=getattr(args, "out_dir", None))
+                                          out=getattr(args, "out_dir", None), **_options(args))
             if getattr(args, "debug", False):
                 traceback.print_exc()
             print(f"fracid: {text}", file=sys.stderr)

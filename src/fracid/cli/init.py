@@ -15,17 +15,15 @@ and the usual ranges of its parameters (:mod:`fracid.models.plausibility`). The 
 from __future__ import annotations
 
 import dataclasses
-import inspect
-import re
 import sys
 import tomllib
 from pathlib import Path
 
-from fracid.settings.checks import COMMENT_COLUMN, toml_line
+from fracid.cli.docstrings import description, numpydoc_parameters, summary
+from fracid.settings.checks import COMMENT_COLUMN, show, toml_line
 
 #: (specimen, model) whose configuration is the bundled demo's, with its data file
 DEMO_PAIR = ("notched-beam", "gradient-damage")
-_ORDINALS = ("1st", "2nd", "3rd", "4th", "5th", "6th")
 #: comment column of the written ``key = value`` lines
 _COLUMN = COMMENT_COLUMN
 
@@ -46,54 +44,6 @@ _EXPERIMENT_COMMENTS = {
 #: the commented-out data block of the pairs without bundled data
 _EXPERIMENT_TEMPLATE = {"file": "my_test.csv", "control_column": "u_mm", "control_unit": "mm", "force_unit": "N",
                         "kind": "single", "force_columns": ["F_N"], "std": 10.0, "n_points": 24}
-
-
-def numpydoc_parameters(cls) -> dict:
-    """The entries of the numpydoc ``Parameters`` section of ``cls``'s docstring.
-
-    Parameters
-    ----------
-    cls : type
-        A class whose docstring has a ``Parameters`` section.
-
-    Returns
-    -------
-    dict
-        name -> (type text, description on one line); an entry naming several fields
-        (``width, height : float``) gives each of them the shared description.
-    """
-    doc = inspect.getdoc(cls) or ""
-    match = re.search(r"^Parameters\n-+\n(.*?)(?:\n\n(?! )|\Z)", doc, re.S | re.M)
-    entries, names = {}, []
-    for line in (match.group(1).splitlines() if match else []):
-        if line and not line.startswith(" "):
-            names_text, _, kind = line.partition(" : ")
-            names = [n.strip() for n in names_text.split(",")]
-            for i, name in enumerate(names):
-                entries[name] = (kind.strip() if len(names) == 1 else
-                                 f"{kind.strip()}; {_ORDINALS[i]} of {', '.join(names)}", "")
-        elif names:
-            for name in names:
-                kind, text = entries[name]
-                entries[name] = (kind, f"{text} {line.strip()}".strip())
-    return entries
-
-
-def summary(cls) -> str:
-    """The first paragraph of ``cls``'s docstring, on one line."""
-    return " ".join((inspect.getdoc(cls) or "").split("\n\n")[0].split())
-
-
-def description(cls) -> list:
-    """The paragraphs of ``cls``'s docstring outside its numpydoc sections (Parameters, Examples ...),
-    each on one line."""
-    kept, skipping = [], False
-    for paragraph in (inspect.getdoc(cls) or "").split("\n\n"):
-        heading = re.match(r"[A-Z][a-z ]+\n-+\n", paragraph)
-        skipping = bool(heading) or (skipping and paragraph.startswith(" "))
-        if not skipping:
-            kept.append(" ".join(paragraph.split()))
-    return kept
 
 
 def runnable_pairs() -> list:
@@ -173,10 +123,10 @@ def _specimen_lines(kind: str, given: dict) -> list:
     return lines
 
 
-def _experiment_lines(experiment: dict | None) -> list:
-    """One ``[[experiments]]`` block: the demo's (active) or a template (commented out)."""
-    commented = experiment is None
-    block = _EXPERIMENT_TEMPLATE if commented else experiment
+def _experiment_lines(experiment: dict | None, commented: bool) -> list:
+    """One ``[[experiments]]`` block: the demo's (active, or commented out when its file is not beside) or a
+    template (commented out)."""
+    block = _EXPERIMENT_TEMPLATE if experiment is None else experiment
     lines = ["# the measured curve: without it only `fracid simulate` runs; uncomment and fill in to identify"
              if commented else "# the measured curve (README, Configuration: the other keys of a data block)",
              ("# " if commented else "") + "[[experiments]]"]
@@ -256,41 +206,83 @@ def _tail_lines() -> list:
 
 def _start_values(specimen: str, model: str) -> tuple:
     """The values written instead of the defaults: ([model.parameters], [specimen] fields, notes saying why).
-    On the notched beam, the demo's mesh (a run in seconds) and, for the demo's model, its values (fitted
-    to the Gregoire beam; the integral model's neighbourhood at c = 9 mm^2 would make a run last a minute)."""
-    params, shape, notes = {}, {}, []
-    if specimen == DEMO_PAIR[0]:
-        demo = _demo()
-        shape = {k: v for k, v in demo["specimen"].items() if k not in ("type", "control")}
-        notes.append("The mesh is the bundled demo's (h_fine, h_coarse: a run in seconds).")
-        if model == DEMO_PAIR[1]:
-            params = demo["model"]["parameters"]
-            notes.append("The parameter values are those of the demo, fitted to the Gregoire et al. (2013) beam.")
+    On the notched beam, the demo's element size in the process zone (a run in seconds; its other mesh fields
+    scale with the beam and stay at their defaults) and, for the demo's model, its values (fitted to the
+    Gregoire beam; the integral model's neighbourhood at c = 9 mm^2 would make a run last a minute). Then the
+    fields the model declares for the specimen (its ``specimen_starts``), and the mesh its ``mesh_length``
+    needs (:func:`_resolving`)."""
     from fracid.models import declared, model_from_type
     from fracid.specimens import SPECIMENS
 
-    start = declared(model_from_type(model)).specimen_starts.get(SPECIMENS[specimen])
+    cls, params, shape, notes = SPECIMENS[specimen], {}, {}, []
+    if specimen == DEMO_PAIR[0]:
+        demo = _demo()
+        scaling = {f.name for f in dataclasses.fields(cls) if f.default is None}  # derived from the size
+        shape = {k: v for k, v in demo["specimen"].items() if k not in ("type", "control", *scaling)}
+        notes.append(f"The element size in the process zone is the bundled demo's ({_assignments(shape)}: a run in "
+                     "seconds); the other mesh sizes scale with the specimen (their defaults).")
+        if model == DEMO_PAIR[1]:
+            params = demo["model"]["parameters"]
+            notes.append("The parameter values are those of the demo, fitted to the Gregoire et al. (2013) beam.")
+    start = declared(model_from_type(model)).specimen_starts.get(cls)
     if start is not None:
         shape = {**shape, **start.fields}
         notes.append(f"Specimen: {start.why}.")
+    resolving = _resolving(model, cls, shape, params)
+    if resolving is not None:
+        shape = {**shape, **resolving[0]}
+        notes.append(resolving[1])
     return params, shape, notes
 
 
-def config_text(specimen: str, model: str) -> str:
+def _assignments(fields: dict) -> str:
+    return ", ".join(f"{key} = {value:g}" for key, value in fields.items())
+
+
+def _resolving(model: str, cls, shape: dict, given: dict):
+    """The mesh field that makes the specimen ``cls(**shape)`` resolve the length the model declares (its
+    :class:`~fracid.models.protocol.MeshLength` at the written value of its parameter), and the note saying why:
+    ``({field: value}, note)``; None when the mesh already resolves it (or the model declares no such length,
+    or no field sets the mesh). The field is the one the specimen's
+    :meth:`~fracid.specimens.protocol.Specimen.resolution` names, refined by the ratio of the element size to
+    that length (:func:`fracid.specimens.protocol.refined`)."""
+    from fracid.models import declared, model_from_type
+    from fracid.specimens.protocol import refined
+
+    resolved = declared(model_from_type(model)).mesh_length
+    if resolved is None:
+        return None
+    parameters = model_from_type(model).parameters
+    value = given.get(resolved.parameter, getattr(parameters(), resolved.parameter))
+    length = resolved.length(value)
+    specimen = cls(**shape)
+    resolution = specimen.resolution(length)
+    if resolution.field is None or resolution.h <= length * (1 + 1e-9):
+        return None
+    fine = refined(specimen, resolution.h / length)
+    field = {resolution.field: getattr(fine, resolution.field)}
+    return field, (f"The mesh: {_assignments(field)}, so that the elements where the crack runs are at most "
+                   f"{resolved.text} = {length:g} mm ({resolved.parameter} = {value:g} {resolved.unit}): "
+                   f"{resolved.band} is then resolved. A larger {resolved.parameter} allows a coarser mesh.")
+
+
+def config_text(specimen: str, model: str, beside: bool = False) -> str:
     """The configuration ``fracid init --specimen SPECIMEN --model MODEL`` writes.
 
     Parameters
     ----------
     specimen, model : str
         A pair of :func:`runnable_pairs`.
+    beside : bool
+        The demo pair's data file is copied beside the written file (``-o FILE``): its block names it and is
+        active. Otherwise (standard output) the block is commented out: the file is to be put there.
 
     Returns
     -------
     str
         A TOML configuration that :func:`fracid.config.load_config` accepts and ``fracid simulate`` runs
-        (``fracid identify`` too for the demo pair, whose data file is the bundled one).
+        (``fracid identify`` too for the demo pair written with ``-o``); no path into the installed package.
     """
-    from fracid.cli.common import demo_config_path
     from fracid.models import model_from_type
 
     demo = _demo() if (specimen, model) == DEMO_PAIR else None
@@ -298,51 +290,81 @@ def config_text(specimen: str, model: str) -> str:
     params = model_from_type(model).parameters(**given)
     experiment = None
     if demo:
-        experiment = {**demo["experiments"][0], "file": str(demo_config_path().parent / demo["experiments"][0]["file"])}
+        experiment = demo["experiments"][0]
+        if not beside:
+            notes.append(f"The data block names the demo's data file {experiment['file']}, which `fracid init -o FILE` "
+                         "copies beside FILE: uncomment it there, or name your own file.")
     head = [f"# fracid configuration: {model} on the {specimen} (written by `fracid init`).",
             f"# Check it: fracid check FILE; run it: fracid simulate FILE, fracid identify FILE.",
             "# Units: N, mm, MPa. Every key is shown with its value; the comment gives the default,",
             "# the unit and the allowed values. README, Configuration, documents every section.", ""]
     head[-1:] = [line for note in notes for line in _comments(note)] + [""]
     sections = [_model_lines(model, given), _specimen_lines(specimen, shape),
-                _experiment_lines(experiment), _identify_lines(model, demo and demo["identify"], params),
+                _experiment_lines(experiment, commented=experiment is None or not beside), _identify_lines(model, demo and demo["identify"], params),
                 _tail_lines()]
     return "\n".join(head + [line for section in sections for line in section + [""]])
+
+
+def unknown_pair(specimen: str, model: str, pairs: list) -> str:
+    """Why ``fracid init`` writes nothing for (``specimen``, ``model``): an unknown specimen or model type (the
+    known ones listed, the closest suggested), a specimen without a default instance (a mesh file), or a model
+    that does not run on the specimen."""
+    import difflib
+
+    from fracid.models import MODEL_TYPES
+    from fracid.specimens import SPECIMENS
+
+    for option, name, known in (("--specimen", specimen, SPECIMENS), ("--model", model, MODEL_TYPES)):
+        if name not in known:
+            close = [k for k in known if name and name in k] or difflib.get_close_matches(name, list(known), 1, 0.4)
+            hint = f"; did you mean {close[0]}?" if close else ""
+            return f"{option} {show(name)}: unknown {option[2:]} type; the types are {', '.join(known)}{hint}"
+    if SPECIMENS[specimen].default_instance() is None:
+        return (f"--specimen {specimen}: it needs your mesh file, so fracid init writes no configuration for it; "
+                "README, 'Your own specimen: a Gmsh mesh'")
+    runs = [m for s, m in pairs if s == specimen]
+    return (f"--specimen {specimen} --model {model}: the model does not run on this specimen; on the {specimen}: "
+            f"--model {', '.join(runs)} (`fracid init --list` gives every pair)")
 
 
 def run_init(args) -> int:
     """``fracid init``: print or write the configuration (``-o FILE``, not over an existing file unless
     ``--force``), or list the pairs (``--list``)."""
+    from fracid.cli.common import output_file
     from fracid.runtime.exits import UsageError
 
     pairs = runnable_pairs()
+    args.specimen, args.model = args.specimen or DEMO_PAIR[0], args.model or DEMO_PAIR[1]
     if args.list:
         print("\n".join(f"--specimen {s} --model {m}" for s, m in pairs))
         return 0
     if (args.specimen, args.model) not in pairs:
-        raise UsageError(f"--specimen {args.specimen} --model {args.model}: no configuration for this pair; "
-                         "`fracid init --list` gives those that run (a Gmsh mesh: README, 'Your own specimen')")
-    text = config_text(args.specimen, args.model)
+        raise UsageError(unknown_pair(args.specimen, args.model, pairs))
     if args.output is None:
-        sys.stdout.write(text)
+        sys.stdout.write(config_text(args.specimen, args.model))
         return 0
-    path = Path(args.output).expanduser()
-    if path.is_dir():
-        raise UsageError(f"-o {path}: a directory; give a file name such as {path / 'fracid.toml'}")
+    path = output_file(args.output)
     if (path.exists() or path.is_symlink()) and not args.force:
         raise UsageError(f"-o {path}: the file exists; fracid init does not overwrite it (give --force to replace it)")
-    path.write_text(text, encoding="utf-8")
-    print(f"wrote {path}: check it with `fracid check {path}`", file=sys.stderr)
+    copied = []
+    if (args.specimen, args.model) == DEMO_PAIR:  # its data file and licence beside it, as --dataset does
+        from fracid.cli.common import demo_config_path
+        from fracid.cli.datasets import bundled_dataset, copy_beside
+
+        copied = copy_beside(bundled_dataset(demo_config_path()), path, args.force)
+    path.write_text(config_text(args.specimen, args.model, beside=True), encoding="utf-8")
+    also = f" and, beside it, {', '.join(copied)}" if copied else ""
+    print(f"wrote {path}{also}: check it with `fracid check {path}`", file=sys.stderr)
     return 0
 
 
 def add_parser(sub, parents) -> None:
     """The ``init`` subcommand's arguments."""
     p = sub.add_parser("init", help="write a commented configuration to start from")
-    p.add_argument("--specimen", default=DEMO_PAIR[0], help=f"specimen type (default {DEMO_PAIR[0]})")
-    p.add_argument("--model", default=DEMO_PAIR[1], help=f"model type (default {DEMO_PAIR[1]})")
+    p.add_argument("--specimen", help=f"specimen type (default {DEMO_PAIR[0]})")
+    p.add_argument("--model", help=f"model type (default {DEMO_PAIR[1]})")
     p.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
     p.add_argument("--force", action="store_true", help="replace an existing -o file")
     p.add_argument("--list", action="store_true", help="list the (specimen, model) pairs")
     p.add_argument("--debug", action="store_true", help="show the traceback of a failure")
-    p.set_defaults(run=run_init)
+    p.set_defaults(run=run_init, out_option="-o FILE")

@@ -4,6 +4,7 @@ the value given and what is allowed."""
 from __future__ import annotations
 
 import os
+import re
 import stat
 import tomllib
 from pathlib import Path
@@ -96,7 +97,32 @@ class Checker:
             self.fail(key, value, f"file not found ({where})")
         if not resolved.is_file():
             self.fail(key, value, f"not a file ({where})")
+        if resolved == self.path:
+            self.fail(key, value, f"this is the configuration itself ({where}), a TOML file, not the data file "
+                                  "this key names: give the file of the measurements")
+        if looks_like_toml(resolved):
+            self.fail(key, value, f"this is a TOML file ({where}), a configuration?, not the data file this key "
+                                  "names: give the file of the measurements")
         return resolved
+
+
+#: a TOML table header line: ``[model]``, ``[[experiments]]``, ``[identify.bounds]``
+_TABLE_HEADER = re.compile(r"^\[\[?\s*[A-Za-z_][\w.-]*\s*\]\]?\s*(#.*)?$")
+_TOML_KEY = re.compile(r"^[A-Za-z_][\w-]*\s*=")
+
+
+def looks_like_toml(path: Path, head: int = 4096) -> bool:
+    """Whether the file at ``path`` is TOML rather than a data table: its name ends in ``.toml``, or its first
+    ``head`` bytes hold a table header line (``[model]``) before any other line, then a ``key =`` line."""
+    if path.suffix.lower() == ".toml":
+        return True
+    try:
+        with open(path, "rb") as handle:
+            lines = handle.read(head).decode("utf-8", "replace").splitlines()
+    except OSError:
+        return False
+    lines = [line.strip() for line in lines if line.strip() and not line.lstrip().startswith("#")]
+    return bool(lines) and bool(_TABLE_HEADER.match(lines[0])) and any(_TOML_KEY.match(line) for line in lines[1:])
 
 
 #: the largest configuration file read [bytes]: a configuration is a few KiB; more is not one

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import stat
 import sys
 from pathlib import Path
 
@@ -89,15 +90,31 @@ def load_config(path: str | os.PathLike, *, purpose: str = "identify") -> Config
 def _config_path(path) -> tuple[Path, bytes | None]:
     """The configuration's absolute path, and its bytes when it is read from standard input (``"-"``: then
     the relative paths inside it are resolved against the working directory)."""
-    if os.fspath(path) == STDIN:
-        return Path.cwd() / "<stdin>", sys.stdin.buffer.read(MAX_CONFIG_BYTES + 1)
     text = os.fspath(path)
+    if text == STDIN or (text in STDIN_NAMES and not _stdin_is_a_file()):
+        return Path.cwd() / "<stdin>", sys.stdin.buffer.read(MAX_CONFIG_BYTES + 1)
     if "\0" in str(text):
         raise ConfigError(f"{text!r}: a path cannot contain a NUL byte (\\0): check how it was typed or generated")
     try:
-        return Path(path).expanduser().resolve(), None
+        resolved = Path(path).expanduser().resolve()
     except (OSError, RuntimeError) as err:  # a symbolic-link loop
         raise ConfigError(f"{text}: cannot be resolved ({err}): a symbolic link that points to itself?") from None
+    if not resolved.exists() and os.path.exists(text):  # /dev/fd/N of a pipe: links to "pipe:[...]", no file
+        return Path(text).expanduser().absolute(), None  # read_toml names it: not a regular file, give '-'
+    return resolved, None
+
+
+#: the names of standard input as a file: read as ``-`` when it is a pipe or a terminal (a redirected file
+#: is read as that file, its relative paths against its directory)
+STDIN_NAMES = ("/dev/stdin", "/dev/fd/0", "/proc/self/fd/0")
+
+
+def _stdin_is_a_file() -> bool:
+    """Whether standard input is a regular file (``< cfg.toml``); False for a pipe, a terminal or none."""
+    try:
+        return stat.S_ISREG(os.fstat(sys.stdin.fileno()).st_mode)
+    except (OSError, ValueError, AttributeError):  # closed, or replaced by an object without a descriptor
+        return False
 
 
 def _mesh_warnings(ck: Checker, model: ModelConfig, specimen: SpecimenConfig, experiments, identify) -> None:

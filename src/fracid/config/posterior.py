@@ -6,7 +6,7 @@ from __future__ import annotations
 from fracid.config.checker import Checker
 from fracid.config.schema import PosteriorConfig
 from fracid.config.vocabulary import POSTERIOR_KEYS
-from fracid.inverse.sampling.posterior import MIN_ESS, ess_floor
+from fracid.inverse.sampling.posterior import MIN_ESS, ess_floor, floor_text
 
 
 def read_posterior(ck: Checker, raw) -> PosteriorConfig:
@@ -45,8 +45,8 @@ def _warn_floor(ck: Checker, config: PosteriorConfig) -> None:
     floor = ess_floor(config.target_ess)
     if total < floor:
         ck.warn(f"posterior.samples_per_round {config.samples_per_round} x posterior.max_rounds {config.max_rounds} = "
-                f"{total} draws at most, below the floor of {floor:g} effective samples (and posterior.target_ess = "
-                f"{config.target_ess:g}): the effective sample size never exceeds the number of draws, so the "
+                f"{total} draws at most, below the floor of {floor:g} effective samples ({floor_text(config.target_ess)}): "
+                "the effective sample size never exceeds the number of draws, so the "
                 "posterior fails whatever the data (exit status 3) and gives no credible intervals; raise "
                 "samples_per_round or max_rounds")
     elif config.target_ess > total:

@@ -14,6 +14,7 @@ import re
 from collections.abc import Sequence
 
 from fracid.data.errors import DataError
+from fracid.settings.checks import show
 
 #: the advice for a number written with thousands separators
 _REMOVE_THOUSANDS = "remove the thousands separators ({}; in a spreadsheet: a number format without them)"
@@ -127,18 +128,18 @@ def parse_cell(path: str, line: int, column: str, text: str, decimal: str = ".",
     """The number of a cell, else a DataError naming the file, its row and column, and the cause if known."""
     stripped = text.strip()
     if not stripped:
-        raise DataError(f"{path}: row {line}, column {column!r}: empty cell (missing value)")
+        raise DataError(f"{path}: row {line}, column {show(column)}: empty cell (missing value)")
     try:
         value = _to_float(stripped, decimal)
     except ValueError:
         hint = _number_hint(stripped, delimiter, decimal)
         raise DataError(
-            f"{path}: row {line}, column {column!r}: {stripped!r} is not a number" + (f"; {hint}" if hint else "")
+            f"{path}: row {line}, column {show(column)}: {stripped!r} is not a number" + (f"; {hint}" if hint else "")
         ) from None
     if math.isnan(value):
-        raise DataError(f"{path}: row {line}, column {column!r}: missing value ({stripped!r})")
+        raise DataError(f"{path}: row {line}, column {show(column)}: missing value ({stripped!r})")
     if math.isinf(value):
-        raise DataError(f"{path}: row {line}, column {column!r}: {stripped!r} is not finite")
+        raise DataError(f"{path}: row {line}, column {show(column)}: {stripped!r} is not finite")
     return value
 
 
@@ -150,5 +151,5 @@ def check_cell_count(path: str, line: int, cells: list[str], header: list[str], 
         cells, delimiter, len(header))
     raise DataError(
         f"{path}: row {line} has {len(cells)} cells but the header has {len(header)} "
-        f"({', '.join(repr(cell) for cell in header)})" + (f"; {hint}" if hint else "")
+        f"({', '.join(show(cell) for cell in header)})" + (f"; {hint}" if hint else "")
     )

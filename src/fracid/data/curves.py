@@ -27,6 +27,7 @@ from fracid.data.arguments import (
 from fracid.data.checks import Labels, checked_curve
 from fracid.data.errors import DataError
 from fracid.data.table import CsvTable, check_format, column_indices, parse_table, read_table
+from fracid.settings.checks import show
 
 __all__ = ["Curve", "curve_from_arrays", "read_curve_csv"]
 
@@ -261,13 +262,13 @@ def _curves(path, table: CsvTable, values, wanted: list, scales: tuple, notes) -
     control_column, (c_scale, f_scale) = wanted[0], scales
     scale_notes = list(table.notes())
     if c_scale != 1.0:
-        scale_notes.append(f"{path}: control column {control_column!r} multiplied by {c_scale:g} to mm")
+        scale_notes.append(f"{path}: control column {show(control_column)} multiplied by {c_scale:g} to mm")
     return [
         Curve(
             control=values[:, 0] * c_scale,
             force=values[:, k + 1] * f_scale,
-            source=f"{path}, column {name!r} against {control_column!r}",
-            notes=(*scale_notes, *([f"{path}: force column {name!r} multiplied by {f_scale:g} to N"]
+            source=f"{path}, column {show(name)} against {show(control_column)}",
+            notes=(*scale_notes, *([f"{path}: force column {show(name)} multiplied by {f_scale:g} to N"]
                                    if f_scale != 1.0 else []), *notes),
         )
         for k, name in enumerate(wanted[1:])

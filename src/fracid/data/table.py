@@ -30,6 +30,7 @@ import numpy as np
 from fracid.data.arguments import shown
 from fracid.data.cells import check_cell_count, is_number, parse_cell, trimmed
 from fracid.data.errors import DataError, DataTypeError
+from fracid.settings.checks import show
 
 #: cell separators read by :func:`read_table`; " " splits at any run of spaces and tabs
 DELIMITERS = (",", ";", "\t", " ")
@@ -77,18 +78,20 @@ class CsvTable:
         return (f"{self.path}: line{'s' if len(self.skipped) > 1 else ''} {lines} above the header (line "
                 f"{self.header_line}) skipped (a sep= line, comments, text of the export)",)
 
-    def missing_column(self, name: str) -> str:
+    def missing_column(self, name: str, named: bool = True) -> str:
         """Why ``name`` is not a column: the header's line and columns, and the line that looks like
-        the header instead if there is one."""
-        available = ", ".join(repr(cell) for cell in self.header)
-        text = f"the header (line {self.header_line}) has no column {name!r}; available columns: {available}"
+        the header instead if there is one (``named``: the name is said, else the message already said it;
+        a long name is cut, :func:`fracid.settings.checks.show`)."""
+        available = ", ".join(show(cell) for cell in self.header)
+        column = f"column {show(name)}" if named else "such column"
+        text = f"the header (line {self.header_line}) has no {column}; available columns: {available}"
         close = difflib.get_close_matches(name, self.header, n=1)
         if close:
-            text += f"; did you mean {close[0]!r}?"
+            text += f"; did you mean {show(close[0])}?"
         if self.other_header is not None:
             line, cells = self.other_header
             text += (f"; if the header is not on line {self.header_line}: line {line}, the last text line above the "
-                     f"data, looks like it ({', '.join(repr(cell) for cell in cells)}) but names no column {name!r} "
+                     f"data, looks like it ({', '.join(show(cell) for cell in cells)}) but names no {column} "
                      "either; give the column names as written there (lines above the line naming them are skipped)")
         return text
 
@@ -290,13 +293,13 @@ def column_indices(table: CsvTable, wanted: list[str], delimiter: str = ",") -> 
             guess = delimiter_hint(table.header, delimiter)
             if guess is not None:
                 raise DataError(
-                    f"{table.path}: the header is one cell {table.header[0]!r} when split by delimiter = "
+                    f"{table.path}: the header is one cell {show(table.header[0])} when split by delimiter = "
                     f"{delimiter!r}: the file seems to be separated by {guess!r}; give delimiter = {guess!r} "
                     "(and decimal = \",\" for decimal commas)"
                 )
             raise DataError(f"{table.path}: {table.missing_column(name)}")
         if len(hits) > 1:
-            raise DataError(f"{table.path}: the header names column {name!r} {len(hits)} times; it is ambiguous")
+            raise DataError(f"{table.path}: the header names column {show(name)} {len(hits)} times; it is ambiguous")
         indices.append(hits[0])
     return indices
 

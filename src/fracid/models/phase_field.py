@@ -9,15 +9,8 @@ from typing import ClassVar
 from fracid.fem.formulations.phase_field_problem import PhaseFieldProblem
 from fracid.fem.material.phase_field import PHASE_FIELD_SHAPES, PhaseFieldSoftening
 from fracid.models.path_model import PathFollowingModel
-from fracid.models.protocol import BandWidth, MeshLength, SpecimenStart
+from fracid.models.protocol import BandWidth, MeshLength
 from fracid.specimens.description import at_points, conditions, described, discretize
-from fracid.specimens.beam import NotchedBeam
-from fracid.specimens.dogbone import DogBone
-from fracid.specimens.strip import TensionStrip
-from fracid.specimens.wedge import WedgeSplitting
-
-#: why ``fracid init`` refines the specimens' default meshes for the PF-CZM
-_FINER = "a finer mesh where the crack runs, h <= l / 5 = 0.5 mm, resolves the phase field's band (l = 2.5 mm)"
 
 
 @dataclass(frozen=True)
@@ -50,10 +43,6 @@ class PhaseFieldModel(PathFollowingModel):
                                                 "the cohesive law of its softening shape", 0.5,
                                                 "measured on bars, the law departs by 1.4 % of the peak at the whole "
                                                 "length and by 8 %, with 22 % less energy, at 1.3 times it")
-    #: the default meshes refined to h <= l / 5 at the default l
-    specimen_starts: ClassVar[dict] = {
-        **{cls: SpecimenStart({"h_fine": 0.5}, _FINER) for cls in (NotchedBeam, DogBone, WedgeSplitting)},
-        TensionStrip: SpecimenStart({"n_elements": 201}, _FINER)}
 
     @property
     def parameters(self) -> type:

@@ -102,8 +102,11 @@ class OutputInUse(OSError):
     """Another fracid process holds the lock of the output directory."""
 
 
-def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str]:
-    """(exit status, message) for an exception that ended a command."""
+def describe(err: BaseException, *, store_path=None, out=None, store_option="--out DIR",
+             out_option="--out DIR") -> tuple[int, str]:
+    """(exit status, message) for an exception that ended a command; ``store_option`` and ``out_option``: the
+    options that choose the run store's place (``--store FILE`` when given) and the command's outputs' (``-o
+    FILE`` of ``fracid init``), named in the advice."""
     config_error = _loaded("fracid.config.schema", "ConfigError")
     data_error = _loaded("fracid.data.errors", "DataError")
     mesh_error = _loaded("fracid.specimens.mesh_reading", "MeshError")
@@ -133,9 +136,11 @@ def describe(err: BaseException, *, store_path=None, out=None) -> tuple[int, str
     if isinstance(err, OutputInUse):
         return FILES, str(err)
     if isinstance(err, sqlite3.Error):
-        return FILES, _store_text(err, store_path or "the run store")
+        return FILES, _store_text(err, store_path or "the run store", store_option)
     if isinstance(err, OSError):
-        return FILES, _os_text(err, out)
+        name = err.filename or out or ""
+        on_store = store_path is not None and str(name).startswith(str(store_path))
+        return FILES, _os_text(err, name, store_option if on_store else out_option)
     return INTERNAL, (f"internal error ({type(err).__name__}: {err}). Run again with --debug to see the traceback, "
                       "and please report it.")
 
@@ -146,38 +151,72 @@ _STORE_ADVICE = {
         "stored before are intact and will be reused",  # SQLITE_FULL
     10: "a disk input/output error (a removed drive, a network file system that went away?). Check the disk "
         "and run again: the runs stored before the error are kept",  # SQLITE_IOERR
-    8: "it is read-only (file or directory permissions, or a read-only file system). Give an output "
-       "directory you can write (--out DIR) or fix the permissions",  # SQLITE_READONLY
-    3: "access was denied. Give an output directory you can write (--out DIR)",  # SQLITE_PERM
-    14: "it cannot be opened: is it a directory, or is its directory gone or not writable? Give another "
-        "output directory (--out DIR)",  # SQLITE_CANTOPEN
+    8: "it is read-only (file or directory permissions, or a read-only file system). Give another "
+       "{place} you can write ({option}) or fix the permissions",  # SQLITE_READONLY
+    3: "access was denied. Give another {place} you can write ({option})",  # SQLITE_PERM
+    14: "it cannot be opened: is it a directory, or is its directory gone or not writable? Give "
+        "another {place} ({option})",  # SQLITE_CANTOPEN
     5: "another program holds a lock on it. Close that program (a database browser?) and run again",  # BUSY
     6: "another connection holds a lock on it. Close that program and run again",  # SQLITE_LOCKED
 }
 _DAMAGED = ("it is damaged (truncated, or not written by fracid); move it away (e.g. rename it to "
-            "runs.sqlite.bad) and run again: its runs will be recomputed")
+            "{name}.bad) and run again: its runs will be recomputed")
+#: free bytes [B] below which an input/output error of the store is taken for a full disk: SQLite grows the
+#: write-ahead log a page (4 KiB) and its index a 32 KiB region at a time, and a full file system makes some
+#: of these writes fail as I/O errors (SQLITE_IOERR_SHMSIZE, _WRITE) rather than SQLITE_FULL
+NEARLY_FULL = 1 << 20
 
 
-def _store_text(err, where) -> str:
-    """The message of a run-store failure, by SQLite's result code: only a damaged file is to be moved away."""
+def store_failure(code, free) -> int:
+    """The primary SQLite result code that explains a store failure: ``code`` masked to its primary part
+    (None: not known), but SQLITE_FULL (13) for an input/output error (10) on a file system with fewer than
+    :data:`NEARLY_FULL` bytes ``free`` (None: not known).
+
+    Examples
+    --------
+    >>> store_failure(4874, 24_576), store_failure(4874, 70 * 2**30), store_failure(10, None), store_failure(None, 0)
+    (13, 10, 10, None)
+    """
+    primary = code & 0xFF if isinstance(code, int) else None
+    if primary == 10 and free is not None and free < NEARLY_FULL:
+        return 13
+    return primary
+
+
+def _store_text(err, where, option="--out DIR") -> str:
+    """The message of a run-store failure, by SQLite's result code and the free space of its file system: only
+    a damaged file is to be moved away."""
     if isinstance(err, _loaded("fracid.store.runs", "NotARunStore")):
+        other = "" if option == "--store FILE" else " or run store (--store FILE)"
         return (f"the run store {where} cannot be used: {err}. fracid does not write into it: give another "
-                "output directory (--out DIR) or run store (--store FILE).")
+                f"{_place(option)} ({option}){other}.")
     code = getattr(err, "sqlite_errorcode", None)
     code = code if code is not None else getattr(err.__cause__, "sqlite_errorcode", None)
-    advice = _STORE_ADVICE.get(code & 0xFF if isinstance(code, int) else None, _DAMAGED)
-    return f"the run store {where} cannot be used ({err}): {advice.format(disk=_disk(where))}."
+    advice = _STORE_ADVICE.get(store_failure(code, _free(where)), _DAMAGED)
+    advice = advice.format(disk=_disk(where), option=option, place=_place(option), name=os.path.basename(str(where)))
+    return f"the run store {where} cannot be used ({err}): {advice}."
+
+
+def _mount(path) -> str:
+    """The mount point of the file system that holds ``path`` (or would, for a file not made yet)."""
+    mount = os.path.abspath(path)
+    while not os.path.ismount(mount):
+        mount = os.path.dirname(mount)
+    return mount
+
+
+def _free(path) -> int | None:
+    """Free bytes [B] of the file system that holds ``path``; None if that cannot be told."""
+    try:
+        return shutil.disk_usage(_mount(path)).free
+    except (OSError, ValueError, TypeError):
+        return None
 
 
 def _disk(path) -> str:
     """`` (the file system mounted at /data, 0 bytes free)``, or '' if that cannot be told."""
-    try:
-        mount = os.path.abspath(path)
-        while not os.path.ismount(mount):
-            mount = os.path.dirname(mount)
-        return f" (the file system mounted at {mount}, {shutil.disk_usage(mount).free:,} bytes free)"
-    except (OSError, ValueError, TypeError):
-        return ""
+    free = _free(path)
+    return "" if free is None else f" (the file system mounted at {_mount(path)}, {free:,} bytes free)"
 
 
 def _convergence_text(err) -> str:
@@ -206,20 +245,31 @@ def _snap_back_advice(control, functionals) -> str:
                    "that make the specimen less brittle (a larger c, a smaller beta).")
 
 
-def _os_text(err: OSError, out) -> str:
+#: the place each option chooses, as the advice names it
+_PLACES = {"--out DIR": "output directory", "--store FILE": "run store file", "-o FILE": "file"}
+
+
+def _place(option: str) -> str:
+    """``output directory`` for ``--out DIR``: what ``option`` gives."""
+    return _PLACES.get(option, "place")
+
+
+def _os_text(err: OSError, name, option="--out DIR") -> str:
+    """The message of a failed file operation on ``name`` (the error's file, or the output directory); ``option``
+    chooses another place (``--out DIR``, ``--store FILE``, ``-o FILE``)."""
     if err.filename is None and err.errno is None:  # not about a file (e.g. a connection)
         return f"{err}"
-    name = err.filename or out or ""
     if err.errno == errno.ENOSPC:
         return (f"the disk is full (writing {name}{_disk(name)}). Free some space and run again: finished runs "
                 "are kept.")
     if err.errno == errno.EROFS:
-        return (f"the file system holding {name} is read-only{_disk(name)}. Choose an output directory on a "
-                "writable disk (--out DIR); the runs stored there can be copied along with runs.sqlite.")
+        return (f"the file system holding {name} is read-only{_disk(name)}. Choose another {_place(option)} on a "
+                f"writable disk ({option}); the runs stored there can be copied along with the run store.")
     if err.errno in (errno.EACCES, errno.EPERM):
-        return f"permission denied: {name}. Choose a directory you can write (--out DIR) or fix the permissions."
+        return (f"permission denied: {name}. Choose another {_place(option)} you can write ({option}) or fix the "
+                "permissions.")
     if err.errno in (errno.ENOTDIR, errno.EEXIST) or isinstance(err, (NotADirectoryError, FileExistsError)):
-        return f"{name} is a file, not a directory: give another output directory (--out DIR)."
+        return f"{name} is a file, not a directory: give another {_place(option)} ({option})."
     if isinstance(err, IsADirectoryError):
         return f"{name} is a directory where a file was expected."
     if isinstance(err, FileNotFoundError):

@@ -40,13 +40,22 @@ def _file_lock(path, what: str, instead: str):
             handle.seek(0)
             holder = handle.read().strip() or "unknown"
             raise OutputInUse(f"another fracid process (pid {holder}) is using {what}. Wait until it ends, or {instead}.")
-        handle.seek(0)
-        handle.truncate()
-        handle.write(str(os.getpid()))
-        handle.flush()
+        _write_pid(handle, path)
         yield path
     finally:
         handle.close()  # closing releases the lock
+
+
+def _write_pid(handle, path) -> None:
+    """This process's id into the lock file (for the message of another process); a failed write (a full
+    disk) names the lock file, so that the message names its file system, not the output directory's."""
+    try:  # unbuffered: a failed write leaves nothing for close() to write again
+        os.ftruncate(handle.fileno(), 0)
+        os.write(handle.fileno(), str(os.getpid()).encode("ascii"))
+    except OSError as err:
+        if err.filename is not None:
+            raise
+        raise type(err)(err.errno, err.strerror, str(path)) from err
 
 
 def _try_lock(handle) -> bool:

@@ -64,6 +64,20 @@ def claim_outputs(out: Path, command: str, inputs: Iterable[tuple[str, Path]]) -
     OutputRefused
         Naming the output and the input it would replace, or the existing file fracid did not write.
     """
+    written = check_outputs(out, command, inputs)
+    if not set(OUTPUTS[command]) <= written:
+        _write_manifest(Path(out), written | set(OUTPUTS[command]))
+
+
+def check_outputs(out: Path, command: str, inputs: Iterable[tuple[str, Path]]) -> set[str]:
+    """What :func:`claim_outputs` checks, recording nothing (``out`` need not exist: ``fracid check``); returns
+    the names already recorded as fracid's in ``out``.
+
+    Raises
+    ------
+    OutputRefused
+        Naming the output and the input it would replace, or the existing file fracid did not write.
+    """
     out = Path(out)
     written = read_manifest(out)
     sources = [(role, _real(Path(path))) for role, path in inputs]
@@ -81,8 +95,7 @@ def claim_outputs(out: Path, command: str, inputs: Iterable[tuple[str, Path]]) -
                 f"{target} exists and was not written by fracid (it is not listed in {out / MANIFEST}); "
                 f"`fracid {command}` would replace it. Give another output directory (--out DIR or [output] "
                 "directory), or move the file away if it may be replaced.")
-    if not set(OUTPUTS[command]) <= written:
-        _write_manifest(out, written | set(OUTPUTS[command]))
+    return written
 
 
 def read_manifest(out: Path) -> set[str]:

@@ -25,6 +25,7 @@ from fracid.data.dic.assemble import FrameCloud, assemble
 from fracid.data.dic.vtk_frames import read_vtk_cloud
 from fracid.data.errors import DataError
 from fracid.data.table import column_indices, parse_table, read_table
+from fracid.settings.checks import show
 
 #: cells read as a missing value in the columns that may have holes
 MISSING_CELLS = ("", "nan")
@@ -64,7 +65,7 @@ def read_cloud(path: str, columns: dict) -> FrameCloud:
     sigma = by_key.get("sigma")
     if sigma is not None and np.any(sigma < 0.0):
         r = int(np.flatnonzero(sigma < 0.0)[0])
-        raise DataError(f"{path}: row {rows[r]}, column {wanted['sigma']!r}: {sigma[r]:g} is negative; a "
+        raise DataError(f"{path}: row {rows[r]}, column {show(wanted['sigma'])}: {sigma[r]:g} is negative; a "
                         "standard deviation is >= 0")
     return FrameCloud(path, xy, np.column_stack([by_key["u"], by_key["v"]]), rows, sigma, by_key.get("quality"))
 
@@ -84,14 +85,14 @@ def read_frame_table(path: str, frame_column: str, file_column: str, load_column
     frames = []
     for line, number in zip(rows, values[:, 0]):
         if number != int(number):
-            raise DataError(f"{path}: row {line}, column {frame_column!r}: {number:g} is not an integer frame number")
+            raise DataError(f"{path}: row {line}, column {show(frame_column)}: {number:g} is not an integer frame number")
         frames.append(int(number))
     folder = os.path.dirname(path)
     files = []
     for line, cells in table.rows:
         name = cells[file_index].strip()
         if not name:
-            raise DataError(f"{path}: row {line}, column {file_column!r}: empty cell; give the point-cloud file")
+            raise DataError(f"{path}: row {line}, column {show(file_column)}: empty cell; give the point-cloud file")
         files.append((os.path.join(folder, name), line))
     load = {name: values[:, 1 + k] for k, name in enumerate(load_columns)}
     return frames, files, load, table.notes()
@@ -152,7 +153,7 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
     clouds = []
     for path, line in files:
         if not os.path.isfile(path):
-            raise DataError(f"{table_path}: row {line}, column {file_column!r}: the point-cloud file {path} does "
+            raise DataError(f"{table_path}: row {line}, column {show(file_column)}: the point-cloud file {path} does "
                             "not exist (paths are relative to the frame table's folder)")
         vtk = path.lower().endswith((".vtu", ".vtk"))
         clouds.append(read_vtk_cloud(path, displacement, sigma, quality) if vtk else read_cloud(path, columns))

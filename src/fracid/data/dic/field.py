@@ -20,6 +20,7 @@ from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dataset import ExperimentalData
 from fracid.data.dic.data import DicData
 from fracid.data.errors import DataError, DataTypeError
+from fracid.settings.checks import show
 
 #: component names -> indices (0: u_x, 1: u_y)
 COMPONENTS = {"u": 0, "v": 1}
@@ -68,16 +69,16 @@ def component_indices(components) -> tuple[int, ...]:
 def frame_controls(dic: DicData, frame_indices: np.ndarray, control: str) -> np.ndarray:
     """The control value [mm] of the selected frames: the load column ``control``, strictly increasing."""
     if control not in dic.load:
-        raise DataError(f"control = {control!r} is not a load column of the frame table; its columns are "
+        raise DataError(f"control = {show(control)} is not a load column of the frame table; its columns are "
                         f"{sorted(dic.load)}")
     values = np.asarray(dic.load[control][frame_indices], dtype=float)
     if not np.all(np.isfinite(values)):
-        raise DataError(f"control column {control!r}: a selected frame has no value (NaN)")
+        raise DataError(f"control column {show(control)}: a selected frame has no value (NaN)")
     steps = np.diff(values)
     if np.any(steps <= 0):
         k = int(np.argmax(steps <= 0))
         numbers = [dic.frames[i] for i in frame_indices]
-        raise DataError(f"control column {control!r} must increase strictly over the frames used, but frame "
+        raise DataError(f"control column {show(control)} must increase strictly over the frames used, but frame "
                         f"{numbers[k + 1]} ({values[k + 1]:.6g} mm) does not exceed frame {numbers[k]} "
                         f"({values[k]:.6g} mm)")
     return values

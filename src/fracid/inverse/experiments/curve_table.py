@@ -14,6 +14,7 @@ from pathlib import Path
 from fracid.data.sampling import SAMPLINGS
 from fracid.inverse.core.observations import FORCE
 from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE_UNITS, LOCAL_UNITS, ROLES
+from fracid.settings.checks import show
 
 #: the keys of a curve block's table (the column keys of every curve kind among them: a block refuses another
 #: kind's with a message naming its own)
@@ -40,13 +41,13 @@ def _csv_table(ck, key: str, value, path: Path, delimiter: str, decimal: str, co
     guess = delimiter_hint(header, delimiter)
     if guess is not None:
         given = _toml_text(delimiter) + (" (the default)" if delimiter == "," else "")
-        ck.fail(key, value, f"the header is one cell {header[0]!r} when split by delimiter = {given}: the file seems "
+        ck.fail(key, value, f"the header is one cell {show(header[0])} when split by delimiter = {given}: the file seems "
                             f"to be separated by {guess!r}; set delimiter = {_toml_text(guess)} (and decimal = \",\" "
                             "for decimal commas)")
     first = table.rows[0][1] if table.rows else None
     hint = first is not None and decimal_comma_hint(first, delimiter, decimal, len(header))
     if hint:
-        row = ", ".join(repr(cell.strip()) for cell in first)
+        row = ", ".join(show(cell.strip()) for cell in first)
         ck.fail(key, value, f"the first data row ({row}) cannot be read with delimiter = {_toml_text(delimiter)} and "
                             f"decimal = {_toml_text(decimal)}: {hint}")
     return table
@@ -154,7 +155,9 @@ def _check_columns(ck, prefix: str, raw: dict, file: Path, delimiter: str, decim
     for key, (value, names) in columns.items():
         for name in names:
             if name not in table.header:
-                ck.fail(key, value, f"{name!r} is not a column of {file}: {table.missing_column(name)}")
+                said = value == name  # the key's value is this one name: said once, by ck.fail
+                what = "not" if said else f"{show(name)} is not"
+                ck.fail(key, value, f"{what} a column of {file}: {table.missing_column(name, named=False)}")
 
 
 def _control_range(ck, prefix: str, raw: dict, control_unit: str) -> tuple | None:

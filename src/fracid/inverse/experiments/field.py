@@ -25,6 +25,7 @@ import numpy as np
 
 from fracid.inverse.experiments.crack_region import away_from_crack
 from fracid.inverse.experiments.vocabulary import ROLES
+from fracid.settings.checks import show
 
 #: the keys of a field block
 FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "displacement",
@@ -178,7 +179,7 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
     if message.startswith(("frames", "control column")):
         return "frames"
     for name, column in (("control_column", exp.control_column), *exp.columns):
-        if column is not None and f"column {column!r}" in message:
+        if column is not None and f"column {show(column)}" in message:
             return name
     for name in ("std", "subset_size"):
         if message.startswith(f"{name} "):

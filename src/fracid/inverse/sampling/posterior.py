@@ -36,7 +36,8 @@ from fracid.inverse.sampling.mixture import (
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
-__all__ = ["ESS_ADVICE", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "posterior", "sample_posterior"]
+__all__ = ["ESS_ADVICE", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "floor_text", "posterior",
+           "sample_posterior"]
 
 #: Effective sample size below which the sampling has failed: the weights sit on a few draws, and
 #: quantiles of a few points are not credible intervals (at ESS 1 the interval is a point)
@@ -59,6 +60,25 @@ def ess_floor(target_ess: float) -> float:
     (50.0, 200.0, 30.0)
     """
     return float(min(target_ess, max(MIN_ESS, MIN_ESS_FRACTION * target_ess)))
+
+
+def floor_text(target_ess: float) -> str:
+    """Which of its terms sets :func:`ess_floor` for ``target_ess``, in words (the messages that name the floor).
+
+    Examples
+    --------
+    >>> floor_text(500.0)
+    'the least effective sample size whose quantiles are credible intervals'
+    >>> floor_text(4000.0)
+    '5% of target_ess = 4000'
+    >>> floor_text(30.0)
+    'target_ess = 30 itself, below the usual floor 50'
+    """
+    if target_ess < MIN_ESS:
+        return f"target_ess = {target_ess:g} itself, below the usual floor {MIN_ESS:g}"
+    if MIN_ESS_FRACTION * target_ess > MIN_ESS:
+        return f"{MIN_ESS_FRACTION:.0%} of target_ess = {target_ess:g}"
+    return "the least effective sample size whose quantiles are credible intervals"
 
 
 @dataclass(frozen=True)
@@ -215,9 +235,8 @@ def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) ->
         return "converged"
     floor = ess_floor(settings.target_ess)
     if ess < floor:
-        return (f"failed: effective sample size {ess:.3g} < {floor:g} (the floor: {MIN_ESS:g}, or "
-                f"{MIN_ESS_FRACTION:.0%} of target_ess = {settings.target_ess:g}) after {draws} draws in {rounds} "
-                f"round{'s' if rounds != 1 else ''}: the weights sit on a few draws, so there are no credible "
+        return (f"failed: effective sample size {ess:.3g} < {floor:g} (the floor: {floor_text(settings.target_ess)}) "
+                f"after {draws} draws in {rounds} round{'s' if rounds != 1 else ''}: the weights sit on a few draws, so there are no credible "
                 f"intervals; {ESS_ADVICE}")
     return (f"ESS {ess:.0f} below the target {settings.target_ess:g} after {rounds} rounds: the intervals are "
             "rough; raise max_rounds or samples_per_round")
