@@ -86,7 +86,7 @@ def usable_std(value) -> bool:
 
 
 def check_positive_std(s, what: str) -> None:
-    """Raise DataError, naming ``what``, the first bad value and how many there are, unless every standard
+    """Raise DataError, naming ``what`` (e.g. "block 'global': std"), the first bad value and how many there are, unless every standard
     deviation in ``s`` is > 0 with a square that is a finite positive normal float (:func:`unusable_variances`)."""
     s = np.atleast_1d(np.asarray(s, dtype=float))
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
@@ -94,7 +94,7 @@ def check_positive_std(s, what: str) -> None:
     if bad.size:
         i = int(bad[0])
         where = f" (at {bad.size} of {s.size} values, the first at index {i})" if s.size > 1 else ""
-        raise DataError(f"{what}: std = {s[i]:.3g}{where}: every standard deviation must be {STD_ALLOWED} (a zero "
+        raise DataError(f"{what} = {s[i]:.3g}{where}: every standard deviation must be {STD_ALLOWED} (a zero "
                         "variance gives infinite weight; a std beyond that range is a unit mistake)")
 
 
@@ -113,7 +113,7 @@ def diagonal_data(points, y, s, name: str, notes: list[str]) -> ExperimentalData
             f"block {name!r}: a standard deviation is zero (the scatter vanishes at some point); "
             "use std_floor > 0 or give the standard deviation explicitly"
         )
-    check_positive_std(s, f"block {name!r}")
+    check_positive_std(s, f"block {name!r}: std")
     return ExperimentalData(
         control=points, y=y, covariance=Diagonal(s**2), blocks=((str(name), 0, len(y)),), notes=tuple(notes)
     )

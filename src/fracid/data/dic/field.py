@@ -91,7 +91,7 @@ def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -
     n = len(frame_indices) * len(components) * dic.n_points
     if std is not None:
         value = real_number(std, "std")
-        check_positive_std(value, "std [mm] (the DIC displacement error)")
+        check_positive_std(value, "std")
         return np.full(n, value), f"std {value:g} mm declared for every value"
     if dic.std is None:
         raise DataError("the DIC data have no per-point sigma: give std [mm] (the displacement error), or read "
@@ -129,7 +129,7 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
     from fracid.data.dic.rigid import prior_columns
 
     std = real_number(rigid_std, "rigid_std")
-    check_positive_std(std, "rigid_std [mm] (the prior std of the rigid motion)")
+    check_positive_std(std, "rigid_std")
     rigid = prior_columns(points, components, std)
     noise_U, noise_d = scipy.linalg.block_diag(*[U] * n_c), np.tile(d, n_c)  # one frame, unit sigma
     frames = [LowRankPlusDiagonal(np.hstack([noise_U * s[:, None], rigid]), noise_d * s**2, nuisance=rigid.shape[1])
