@@ -155,9 +155,9 @@ def derived_block(field: FieldBlock, estimator, *, name: str, rigid_motion=None,
     if np.any(unusable):
         i = int(np.argmax(unusable))
         raise DataError(f"{name!r}: the value at height {estimator.heights[i % m]:g} mm, frame at control "
-                        f"{field.frames[i // m]:.6g} mm has no usable variance ({variance[i]:.3g} mm^2: it does not "
-                        "depend on the data, e.g. a width with at most one sample above the threshold, or too small "
-                        "to be a normal number); leave that frame out or lower the threshold")
+                        f"{field.frames[i // m]:.6g} mm has no variance ({variance[i]:.3g} mm^2, not a positive normal "
+                        "number: it does not depend on the data, e.g. a width with at most one sample above the "
+                        "threshold, or the field's std is too small); leave that frame out or lower the threshold")
     data = ExperimentalData(control=np.repeat(field.frames, m), y=y, covariance=Dense(covariance),
                             blocks=((name, 0, y.size),),
                             notes=(*field.data.notes, *notes, *applied,
