@@ -12,7 +12,9 @@ errors), ``rigid_motion`` (true, the default: the rigid motion of every frame re
 vague prior of std ``rigid_std`` [mm], default 1; false: the data have none), ``exclude_near`` [mm] (points
 nearer the specimen's crack path dropped), ``point_spacing`` [mm] (the points thinned to one per square of this
 side, :mod:`fracid.data.dic.reduction`), ``name``, ``weight``, ``role``.
-The data are read while the configuration is checked: every problem names its key.
+The data are read while the configuration is checked: every problem names its key. Their points are located on
+the specimen's mesh then (:mod:`fracid.inverse.experiments.field_on_mesh`: a few outside dropped with a warning,
+more refused with the likely cause), and a frame without any valid value is dropped with a warning naming it.
 """
 
 from __future__ import annotations
