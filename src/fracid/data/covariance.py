@@ -86,8 +86,9 @@ def usable_std(value) -> bool:
 
 
 def check_positive_std(s, what: str) -> None:
-    """Raise DataError, naming ``what`` (e.g. "block 'global': std"), the first bad value and how many there are, unless every standard
-    deviation in ``s`` is > 0 with a square that is a finite positive normal float (:func:`unusable_variances`)."""
+    """Raise DataError, naming ``what`` (e.g. "block 'global': std"), the first bad value and how many there are,
+    unless every standard deviation in ``s`` is > 0 with a square that is a finite positive normal float
+    (:func:`unusable_variances`)."""
     s = np.atleast_1d(np.asarray(s, dtype=float))
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         bad = np.flatnonzero(unusable_variances(np.square(s)) | ~(s > 0.0))
