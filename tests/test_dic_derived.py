@@ -263,3 +263,13 @@ def test_bad_model_side_input_is_named(blocks):
         DerivedFieldObservation(BEAM, block.points, FRAMES[::-1], block.estimator)
     with pytest.raises(ValueError, match="outside"):
         FieldObservation(BEAM, [[200.0, 30.0]], FRAMES)  # the wrapped observation names points off the mesh
+
+
+def test_a_derived_variance_too_small_to_be_normal_is_refused(twin):
+    """A field whose std squares to a normal variance (2e-154 mm: 4e-308 mm^2) whose openings' variances, averages
+    of it, fall below the smallest normal float: refused naming the block, not an internal error later."""
+    tiny = field_block(as_dic(twin.points, twin.U), std=2e-154)
+    with pytest.raises(DataError, match=r"'opening'.*has no variance \(.*mm\^2, not a positive normal number"):
+        opening_profile(tiny, BEAM, HEIGHTS, GAUGE, radius=RADIUS)
+    usual = opening_profile(field_block(as_dic(twin.points, twin.U), std=1e-150), BEAM, HEIGHTS, GAUGE, radius=RADIUS)
+    assert np.all(np.diag(usual.data.covariance.dense()) > np.finfo(float).tiny)

@@ -106,8 +106,10 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     coordinate_unit = "px"              # "mm" (default) | "px" (needs the placement)
     scale = 0.1                         # placement: mm per camera unit, rotation_deg, origin_camera [X, Y],
                                         #   origin_specimen [x, y] mm; or marked_camera and marked_specimen
-                                        #   (lists of the same points in both frames, fitted)
-    # frames = [1, 2, 3]                # frame numbers used (default all), control increasing
+                                        #   (lists of the same points in both frames, fitted); points off the
+                                        #   specimen's mesh: up to 10 % dropped (warned), more refused
+    # frames = [1, 2, 3]                # frame numbers used (default all), control increasing; a frame
+                                        #   without any valid value is dropped (warned)
     # components = ["u", "v"]           # "u" | "v" | both (default)
     # std = 0.001                       # mm, every value; default the files' sigma (scaled to mm)
     # subset_size = 6.0                 # mm: errors correlated over a subset (low rank + diagonal)

@@ -23,6 +23,13 @@ from fracid.data.errors import DataError
 #: default standard-deviation floor, fraction of the peak |y| of a block
 DEFAULT_STD_FLOOR = 0.01
 
+#: the smallest and largest standard deviation whose square is a finite positive normal float (any unit)
+STD_RANGE = (math.sqrt(np.finfo(float).tiny), math.sqrt(np.finfo(float).max) * (1.0 - 1e-15))
+
+#: what a standard deviation may be, in words (for messages)
+STD_ALLOWED = (f"> 0 with a square that is a normal number: between {STD_RANGE[0]:.3g} and {STD_RANGE[1]:.3g} in "
+               "the unit of the values")
+
 _RULE = re.compile(r"^range/(\d+(?:\.\d*)?)$")
 
 
@@ -64,10 +71,32 @@ def apply_floor(s: np.ndarray, y: np.ndarray, points: np.ndarray, std_floor: flo
     return np.maximum(s, floor), [note]
 
 
-def check_positive_std(s: np.ndarray, what: str) -> None:
-    """Raise DataError, naming ``what``, unless every standard deviation in ``s`` is > 0."""
-    if not np.all(s > 0.0):
-        raise DataError(f"{what}: every standard deviation must be > 0 (a zero variance gives infinite weight)")
+def unusable_variances(var) -> np.ndarray:
+    """True where a variance [units of y squared] cannot enter a covariance: not finite, or not a positive normal
+    float (a std whose square underflows to 0 or to a subnormal number gives an infinite or inexact weight)."""
+    var = np.asarray(var, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return ~(np.isfinite(var) & (var >= np.finfo(float).tiny))
+
+
+def usable_std(value) -> bool:
+    """Whether the standard deviation ``value`` is > 0 and its square a finite positive normal float:
+    between :data:`STD_RANGE`'s bounds (about 1.5e-154 and 1.3e154 in any unit)."""
+    return bool(STD_RANGE[0] <= value <= STD_RANGE[1])
+
+
+def check_positive_std(s, what: str) -> None:
+    """Raise DataError, naming ``what`` (e.g. "block 'global': std"), the first bad value and how many there are,
+    unless every standard deviation in ``s`` is > 0 with a square that is a finite positive normal float
+    (:func:`unusable_variances`)."""
+    s = np.atleast_1d(np.asarray(s, dtype=float))
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        bad = np.flatnonzero(unusable_variances(np.square(s)) | ~(s > 0.0))
+    if bad.size:
+        i = int(bad[0])
+        where = f" (at {bad.size} of {s.size} values, the first at index {i})" if s.size > 1 else ""
+        raise DataError(f"{what} = {s[i]:.3g}{where}: every standard deviation must be {STD_ALLOWED} (a zero "
+                        "variance gives infinite weight; a std beyond that range is a unit mistake)")
 
 
 def envelope_divisor(rule: str) -> float:
@@ -85,6 +114,7 @@ def diagonal_data(points, y, s, name: str, notes: list[str]) -> ExperimentalData
             f"block {name!r}: a standard deviation is zero (the scatter vanishes at some point); "
             "use std_floor > 0 or give the standard deviation explicitly"
         )
+    check_positive_std(s, f"block {name!r}: std")
     return ExperimentalData(
         control=points, y=y, covariance=Diagonal(s**2), blocks=((str(name), 0, len(y)),), notes=tuple(notes)
     )

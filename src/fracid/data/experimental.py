@@ -240,7 +240,7 @@ def with_std(
         s, floor_notes = apply_floor(s, y, points, check_floor(std_floor))
         notes += floor_notes
     else:
-        check_positive_std(given, f"block {name!r}")
+        check_positive_std(given, f"block {name!r}: std")
         s = np.array(given, dtype=float)
         text = f"{float(given[0]):g} N" if np.ndim(std) == 0 else "per-point values [N]"
         notes.append(f"s = {text} given by the user (absolute); covariance diag(s^2)")
@@ -298,7 +298,7 @@ def local_block(values_series, std, name: str = "local", *, points=None) -> Expe
     s = np.full(y.shape, float(given)) if given.ndim == 0 else given
     if s.shape != y.shape or not np.all(np.isfinite(s)):
         raise DataError(f"std must be a finite number or have shape ({len(y)},), got {np.shape(std)}")
-    check_positive_std(s, f"block {name!r}")
+    check_positive_std(s, f"block {name!r}: std")
     notes.append("s given by the user (absolute); covariance diag(s^2)")
     return diagonal_data(sample, y, s, name, notes)
 

@@ -60,12 +60,12 @@ local or integral damage; cohesive interface; crack band; phase field) with a ma
 (:mod:`fracid.fem.material.laws`).
 
 It may import :mod:`fracid.fem`, :mod:`fracid.specimens` and :mod:`fracid.settings` (the lower floors). Below are
-the names other packages import from it; ``ConvergenceError``, ``PathResult``, ``StepOptions`` and
-``probe_matrix`` are the finite elements' names the inverse code sees through this window (it does not import
-:mod:`fracid.fem`).
+the names other packages import from it; ``ConvergenceError``, ``PathResult``, ``StepOptions``, ``probe_matrix``
+and ``find_elements`` are the finite elements' names the inverse code sees through this window (it does not
+import :mod:`fracid.fem`).
 """
 
-from fracid.fem.mesh.probes import probe_matrix
+from fracid.fem.mesh.probes import find_elements, probe_matrix
 from fracid.fem.path.path_following import ConvergenceError, PathResult, StepOptions
 from fracid.models.crack import CohesiveCrackModel, CrackBandModel, CrackModel
 from fracid.models.damage import DamageModel
@@ -78,7 +78,6 @@ from fracid.models.registry import MODEL_TYPES, known_units, model_from_type, mo
 
 __all__ = ["IMPLAUSIBLE_FACTOR", "MODEL_TYPES", "BandWidth", "CohesiveCrackModel", "ConvergenceError", "CrackBandModel",
            "CrackModel", "DamageModel", "ForwardModel", "MeshLength", "ModelDefaults", "PathFollowingModel", "PathResult",
-           "PhaseFieldModel", "SpecimenStart", "StepOptions", "declared", "implausible", "implausible_text",
-           "known_units",
-           "model_from_type", "model_laws", "parameter_units", "probe_matrix", "runs_on", "usual_range_text",
-           "usual_ranges"]
+           "PhaseFieldModel", "SpecimenStart", "StepOptions", "declared", "find_elements", "implausible",
+           "implausible_text", "known_units", "model_from_type", "model_laws", "parameter_units", "probe_matrix",
+           "runs_on", "usual_range_text", "usual_ranges"]

@@ -9,13 +9,13 @@ lines. The size of a mesh (:func:`mesh_size`, :func:`mesh_unknowns`) is known be
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import io
 import os
 from dataclasses import dataclass
 
 import numpy as np
+
+from fracid.fem.mesh.meshio_files import UnreadableFile, meshio_read
 
 _SURFACES = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4}
 _SOLIDS = ("tetra", "hexahedron", "wedge", "pyramid")
@@ -74,28 +74,14 @@ def _read(path, mtime, size) -> PlaneMesh:
 
 @functools.lru_cache(maxsize=1)
 def _meshio_mesh(path, mtime, size) -> tuple:
-    """meshio's points, cell blocks [(type, connectivity)] and physical groups of the file."""
+    """meshio's points, cell blocks [(type, connectivity)] and physical groups of the file, or MeshError naming
+    the file and the formats to export (:func:`~fracid.fem.mesh.meshio_files.meshio_read`, the guard of meshio)."""
     try:
-        import meshio
-    except ImportError as err:
-        raise ImportError(f"reading {path} needs meshio, a dependency of fracid: pip install meshio ({err})") from err
-    raw = _meshio_read(meshio, path)
+        raw = meshio_read(path)
+    except UnreadableFile as err:
+        reason = _GMSH_1 if _is_gmsh_1(path) else err.reason
+        raise MeshError(f"{path}: not a mesh file fracid can read ({reason}). {_EXPORT}") from None
     return raw.points, [(block.type, block.data) for block in raw.cells], _physical_groups(raw)
-
-
-def _meshio_read(meshio, path):
-    """meshio's mesh of ``path``, or MeshError naming the file and the formats to export: meshio may
-    raise any exception, or print an error and call ``sys.exit``, on a file it cannot read."""
-    said = io.StringIO()
-    try:
-        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
-            return meshio.read(path)
-    except MemoryError:
-        raise
-    except (SystemExit, Exception) as err:  # noqa: BLE001 -- every failure of the reader is a bad file
-        reason = " ".join(said.getvalue().split()).removeprefix("Error: ") or f"{type(err).__name__}: {err}"
-        raise MeshError(f"{path}: not a mesh file fracid can read ({_GMSH_1 if _is_gmsh_1(path) else reason}). "
-                        f"{_EXPORT}") from None
 
 
 _GMSH_1 = "a Gmsh 1.0 file ($NOD), a format meshio does not read"

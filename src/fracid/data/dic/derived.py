@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fracid.data.arguments import numeric_array
+from fracid.data.covariance import unusable_variances
 from fracid.data.covariance_matrix import Dense
 from fracid.data.dataset import ExperimentalData
 from fracid.data.dic.estimators import Extensometers, StrainTransects
@@ -150,11 +151,13 @@ def derived_block(field: FieldBlock, estimator, *, name: str, rigid_motion=None,
                   else np.zeros((y.size, y.size)))
     covariance = 0.5 * (covariance + covariance.T)  # symmetric to rounding (a large rigid-motion prior breaks it)
     variance = np.diag(covariance)
-    if np.any(variance <= 0):
-        i = int(np.argmax(variance <= 0))
+    unusable = unusable_variances(variance)
+    if np.any(unusable):
+        i = int(np.argmax(unusable))
         raise DataError(f"{name!r}: the value at height {estimator.heights[i % m]:g} mm, frame at control "
-                        f"{field.frames[i // m]:.6g} mm has no variance (it does not depend on the data: e.g. a width "
-                        "with at most one sample above the threshold); leave that frame out or lower the threshold")
+                        f"{field.frames[i // m]:.6g} mm has no variance ({variance[i]:.3g} mm^2, not a positive normal "
+                        "number: it does not depend on the data, e.g. a width with at most one sample above the "
+                        "threshold, or the field's std is too small); leave that frame out or lower the threshold")
     data = ExperimentalData(control=np.repeat(field.frames, m), y=y, covariance=Dense(covariance),
                             blocks=((name, 0, y.size),),
                             notes=(*field.data.notes, *notes, *applied,

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from fracid.data.arguments import real_number
+from fracid.data.covariance import check_positive_std
 from fracid.data.covariance_matrix import Covariance, Diagonal, block_diagonal
 from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dataset import ExperimentalData
@@ -53,6 +54,7 @@ class FieldBlock:
     frame_numbers: tuple
     components: tuple
     keep: np.ndarray
+    dropped_frames: tuple = ()  # the frame numbers without any valid value, left out (a warning note says so)
 
 
 
@@ -90,8 +92,7 @@ def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -
     n = len(frame_indices) * len(components) * dic.n_points
     if std is not None:
         value = real_number(std, "std")
-        if not (np.isfinite(value) and value > 0):
-            raise DataError(f"std = {std!r} [mm]: give a finite number > 0 (the DIC displacement error)")
+        check_positive_std(value, "std")
         return np.full(n, value), f"std {value:g} mm declared for every value"
     if dic.std is None:
         raise DataError("the DIC data have no per-point sigma: give std [mm] (the displacement error), or read "
@@ -129,14 +130,32 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
     from fracid.data.dic.rigid import prior_columns
 
     std = real_number(rigid_std, "rigid_std")
-    if not (np.isfinite(std) and std > 0):
-        raise DataError(f"rigid_std = {rigid_std!r} [mm]: give a finite number > 0 (the prior std of the rigid motion)")
+    check_positive_std(std, "rigid_std")
     rigid = prior_columns(points, components, std)
     noise_U, noise_d = scipy.linalg.block_diag(*[U] * n_c), np.tile(d, n_c)  # one frame, unit sigma
     frames = [LowRankPlusDiagonal(np.hstack([noise_U * s[:, None], rigid]), noise_d * s**2, nuisance=rigid.shape[1])
               for s in sigma.reshape(n_frames, n)]
     return block_diagonal(frames), (f"{note}; the rigid motion of every frame (t_x, t_y, theta) marginalised: "
                                     f"prior std {std:g} mm, removed from data and model alike")
+
+
+def _without_empty_frames(indices, controls, values, missing, sigma) -> tuple:
+    """The frames that hold at least one value: (their positions, their controls, (values, missing, sigma) of
+    their entries, the positions of the frames dropped). All frames empty: none dropped (the caller refuses)."""
+    present = (~missing).reshape(len(indices), -1).any(axis=1)
+    if present.all() or not present.any():
+        return indices, controls, (values, missing, sigma), indices[:0]
+    kept = [a.reshape(len(indices), -1)[present].reshape(-1) for a in (values, missing, sigma)]
+    return indices[present], controls[present], tuple(kept), indices[~present]
+
+
+def empty_frames_text(dic: DicData, empty, control: str, name: str) -> str:
+    """What the warning of frames without a value says: the frames, their files and control values."""
+    files = dic.source[len(dic.source) - dic.n_frames:] if len(dic.source) >= dic.n_frames else ()
+    listed = ", ".join(f"{dic.frames[i]} ({control} = {dic.load[control][i]:.6g} mm"
+                       + (f", {files[i]}" if files else "") + ")" for i in empty)
+    return (f"field {name!r}: {len(empty)} frame(s) without any valid value (every displacement NaN, of low "
+            f"quality or without sigma) dropped: frame {listed}; the other frames are used")
 
 
 def _selected(dic: DicData, frames, region, spacing) -> tuple[DicData, np.ndarray]:
@@ -200,7 +219,11 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     controls = frame_controls(dic, indices, control)
     values, missing = dic.values(indices, comps)
     sigma, std_note = entry_std(dic, indices, comps, std)
-    missing = missing | ~(sigma > 0)  # no usable sigma: no value
+    missing = missing | ~(sigma > 0)  # no sigma (0 or NaN): no value
+    if std is None:
+        check_positive_std(sigma[~missing], "the per-point sigma of the files [mm]")
+    indices, controls, (values, missing, sigma), empty = _without_empty_frames(indices, controls, values, missing,
+                                                                                sigma)
     per_point = (~missing).reshape(len(indices), len(comps), dic.n_points).any(axis=(0, 1))
     if not per_point.any():
         raise DataError(f"field {name!r}: no value left in the frames and region used (all NaN or without sigma)")
@@ -213,9 +236,10 @@ def field_block(dic: DicData, frames=None, components=("u", "v"), *, control: st
     n_c, n_p = len(comps), len(points)
     notes = (*dic.notes, f"field {name!r}: frames {[dic.frames[i] for i in indices]} at {control} = "
              f"{np.round(controls, 6).tolist()} mm, components {[('u', 'v')[c] for c in comps]}, {n_p} points",
-             f"{kept.size} of {keep.size} values kept ({keep.size - kept.size} missing dropped)", std_note, cov_note)
+             f"{kept.size} of {keep.size} values kept ({keep.size - kept.size} missing dropped)", std_note, cov_note,
+             *([f"WARNING: {empty_frames_text(dic, empty, control, name)}"] if empty.size else []))
     data = ExperimentalData(control=np.repeat(controls, n_c * n_p)[kept],
                             y=values.reshape(full)[:, :, per_point].reshape(-1)[kept], covariance=cov.take(kept),
                             blocks=((name, 0, kept.size),), notes=notes)
     frame_numbers = tuple(dic.frames[i] for i in indices)
-    return FieldBlock(data, points, controls, frame_numbers, comps, keep)
+    return FieldBlock(data, points, controls, frame_numbers, comps, keep, tuple(dic.frames[i] for i in empty))

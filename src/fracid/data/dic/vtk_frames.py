@@ -15,23 +15,24 @@ import numpy as np
 from fracid.data.arguments import file_path
 from fracid.data.dic.assemble import FrameCloud, assemble
 from fracid.data.errors import DataError
+from fracid.fem.mesh.meshio_files import UnreadableFile, meshio_read
 
 #: displacement arrays tried in turn when no name is given
 DISPLACEMENT_NAMES = ("displacement", "U")
 
 
 def _read_mesh(path: str):
-    """meshio's mesh of ``path``, with a missing or unreadable file named."""
-    import meshio
-
+    """meshio's mesh of ``path`` (:func:`~fracid.fem.mesh.meshio_files.meshio_read`, the guard of meshio's
+    errors and exits), with a missing, unreadable or truncated file named."""
     if not os.path.isfile(path):
         raise DataError(f"VTK file {path}: cannot be read (the file does not exist)")
     try:
-        return meshio.read(path)
-    except OSError as error:
-        raise DataError(f"VTK file {path}: cannot be read ({error.strerror or error})") from None
-    except Exception as error:  # meshio raises its own ReadError and parser errors
-        raise DataError(f"VTK file {path}: not a readable VTU/VTK file ({type(error).__name__}: {error})") from None
+        return meshio_read(path)
+    except UnreadableFile as error:
+        if error.os_error:
+            raise DataError(f"VTK file {path}: cannot be read ({error.reason})") from None
+        raise DataError(f"VTK file {path}: not a readable VTU/VTK file ({error.reason}); is it truncated, or of "
+                        "another format?") from None
 
 
 def _array(mesh, path: str, names: tuple, what: str) -> np.ndarray:

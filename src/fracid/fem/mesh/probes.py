@@ -124,6 +124,14 @@ def locate(nodes, cells, points) -> tuple[np.ndarray, np.ndarray]:
     ValueError
         For points outside the mesh (the message lists them) or a malformed mesh.
     """
+    element, xi = find_elements(nodes, cells, points)
+    _reject_outside(np.asarray(points, dtype=float), element)
+    return element, xi
+
+
+def find_elements(nodes, cells, points) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`locate` without the refusal: the element of each point, -1 for a point outside the mesh (its
+    reference coordinates then 0); ValueError for a malformed mesh only."""
     nodes, cells, points = _check_mesh(nodes, cells, points)
     shape = _shape_of(cells)
     X = nodes[cells]
@@ -144,7 +152,6 @@ def locate(nodes, cells, points) -> tuple[np.ndarray, np.ndarray]:
             for candidate in boxes:
                 if element[p] < 0:
                     _try(shape, X, points[p:p + 1], np.array([candidate]), element[p:p + 1], xi[p:p + 1])
-    _reject_outside(points, element)
     return element, xi
 
 

@@ -206,6 +206,17 @@ def mirrored_points(description, points) -> tuple[np.ndarray, dict]:
     return sampled, flip
 
 
+def points_outside(specimen, points) -> np.ndarray:
+    """True for the points (n, 2) [mm] that a :class:`FieldObservation` on ``specimen`` cannot sample: outside
+    its mesh (a symmetric half's other half taken at its mirror image, as the observation samples it), found by
+    the probes' element search."""
+    from fracid.models import find_elements
+
+    d = describe(specimen)
+    sampled, _ = mirrored_points(d, check_points(points))
+    return find_elements(d.nodes, d.cells, sampled)[0] < 0
+
+
 def field_observation(block, specimen, *, control: str | None = None, name: str | None = None) -> FieldObservation:
     """The :class:`FieldObservation` of a DIC data block (:func:`fracid.data.dic.field_block`: its points,
     frames as control values, components and mask of the values present) on ``specimen``."""
@@ -213,4 +224,4 @@ def field_observation(block, specimen, *, control: str | None = None, name: str 
                             name=block.data.blocks[0][0] if name is None else name, keep=block.keep)
 
 
-__all__ = ["FieldObservation", "check_points", "field_observation", "mirrored_points"]
+__all__ = ["FieldObservation", "check_points", "field_observation", "mirrored_points", "points_outside"]

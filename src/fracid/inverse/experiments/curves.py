@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.inverse.experiments.curve_table import CURVE_KEYS, read_curve_fields, required
 from fracid.inverse.core.observations import FORCE
 from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, FORCE_UNITS, LOCAL_UNITS
@@ -206,7 +207,7 @@ class Single(ForceColumns):
             ck.fail(key, raw[given[1]], text)
         name = given[0]
         unit = f" [{force_unit}]" if name == "std" else " (fraction of |y|)"
-        value = ck.number(f"{prefix}.{name}", raw[name], f"must be a number > 0{unit}", lambda v: v > 0)
+        value = ck.number(f"{prefix}.{name}", raw[name], f"must be a number {STD_ALLOWED}{unit}", usable_std)
         if name == "relative_std" and value > 1:
             ck.warn(f"{prefix}.relative_std = {value:g} is more than 1, i.e. more than 100 % of the value; "
                     f"if you meant {value:g} %, write {value / 100:g}")

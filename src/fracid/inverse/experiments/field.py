@@ -12,7 +12,9 @@ errors), ``rigid_motion`` (true, the default: the rigid motion of every frame re
 vague prior of std ``rigid_std`` [mm], default 1; false: the data have none), ``exclude_near`` [mm] (points
 nearer the specimen's crack path dropped), ``point_spacing`` [mm] (the points thinned to one per square of this
 side, :mod:`fracid.data.dic.reduction`), ``name``, ``weight``, ``role``.
-The data are read while the configuration is checked: every problem names its key.
+The data are read while the configuration is checked: every problem names its key. Their points are located on
+the specimen's mesh then (:mod:`fracid.inverse.experiments.field_on_mesh`: a few outside dropped with a warning,
+more refused with the likely cause), and a frame without any valid value is dropped with a warning naming it.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.inverse.experiments.crack_region import away_from_crack
 from fracid.inverse.experiments.vocabulary import ROLES
 from fracid.settings.checks import show
@@ -70,14 +73,26 @@ class FieldExperimentConfig:
 def field_block(exp: FieldExperimentConfig, specimen):
     """The :class:`~fracid.data.dic.FieldBlock` of the block on the specimen object ``specimen`` (whose crack path
     ``exclude_near`` refers to). Raises :class:`~fracid.data.DataError` for bad data."""
+    return placed_field_block(exp, specimen)[0]
+
+
+def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
+    """(:func:`field_block`, its warnings): its points located on the specimen's mesh (the few outside dropped,
+    :func:`~fracid.inverse.experiments.field_on_mesh.points_on_mesh`), its frames without a value dropped."""
     from fracid.data.dic import field_block as block_of, read_dic_frames
+    from fracid.inverse.experiments.field_on_mesh import points_on_mesh
 
     dic = read_dic_frames(exp.file, **dict(exp.columns), min_quality=exp.min_quality,
                           coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
                           placement=exp.placement)
-    return block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
-                    subset_size=exp.subset_size, rigid_std=exp.rigid_std,
-                    region=away_from_crack(specimen, exp.exclude_near), point_spacing=exp.point_spacing, name=exp.name)
+    inside, dropped = points_on_mesh(specimen, dic.points, exp.placement)
+    away = away_from_crack(specimen, exp.exclude_near)
+    region = inside if away is None else (lambda points: inside & away(points))
+    block = block_of(dic, exp.frames, exp.components, control=exp.control_column, std=exp.std,
+                     subset_size=exp.subset_size, rigid_std=exp.rigid_std, region=region,
+                     point_spacing=exp.point_spacing, name=exp.name)
+    notes = [note.removeprefix("WARNING: ") for note in block.data.notes if note.startswith("WARNING: field ")]
+    return block, [*([dropped] if dropped else []), *notes]
 
 
 def _optional_number(ck, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
@@ -144,7 +159,7 @@ def _rigid_std(ck, prefix: str, raw: dict) -> float | None:
                     "rigid_motion = true")
         return None
     return ck.number(f"{prefix}.rigid_std", raw.get("rigid_std", RIGID_STD),
-                     "must be a number > 0 [mm], larger than the rigid motion (e.g. 1)", lambda v: v > 0)
+                     f"must be a number {STD_ALLOWED} [mm], larger than the rigid motion (e.g. 1)", usable_std)
 
 
 def _frames(ck, key: str, raw: dict) -> tuple | None:
@@ -181,10 +196,10 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
     for name, column in (("control_column", exp.control_column), *exp.columns):
         if column is not None and f"column {show(column)}" in message:
             return name
-    for name in ("std", "subset_size"):
+    for name in ("std", "subset_size", "rigid_std"):
         if message.startswith(f"{name} "):
             return name
-    if "no per-point sigma" in message:
+    if "per-point sigma" in message:
         return "sigma"
     for name, what in (("displacement", "(the displacements)"), ("sigma", "(the displacement std)"),
                        ("quality", "(the correlation quality)")):
@@ -216,7 +231,7 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
         index=i, file=file, control_column=control_column, columns=columns, n_points=0,
         placement=_placement(ck, prefix, raw, unit), min_quality=min_quality, coordinate_unit=unit,
         frames=_frames(ck, f"{prefix}.frames", raw), components=_components(ck, f"{prefix}.components", raw),
-        std=_optional_number(ck, f"{prefix}.std", raw, "std", positive, lambda v: v > 0),
+        std=_optional_number(ck, f"{prefix}.std", raw, "std", f"must be a number {STD_ALLOWED} [mm]", usable_std),
         subset_size=_optional_number(ck, f"{prefix}.subset_size", raw, "subset_size", positive, lambda v: v > 0),
         rigid_std=_rigid_std(ck, prefix, raw),
         exclude_near=_optional_number(ck, f"{prefix}.exclude_near", raw, "exclude_near", "must be a number >= 0 [mm]",
@@ -226,12 +241,14 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
         role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))
     try:
-        block = field_block(exp, context.specimen())
+        block, warnings = placed_field_block(exp, context.specimen())
     except DataError as err:
         key = _blamed_key(exp, str(err))
         ck.fail(f"{prefix}.{key}", raw.get(key, COLUMN_KEYS.get(key)), str(err))
     except ValueError as err:
         ck.fail(f"{prefix}.exclude_near", raw.get("exclude_near"), str(err))
+    for warning in warnings:
+        ck.warn(f"{prefix}.frames_file: {warning}")
     return replace(exp, n_points=block.data.n_y), block
 
 
@@ -277,4 +294,4 @@ class FieldKind:
 FIELD = FieldKind()
 
 __all__ = ["COLUMN_KEYS", "FIELD", "FIELD_KEYS", "PLACEMENT_KEYS", "FieldExperimentConfig", "FieldKind",
-           "check_matches", "field_block", "read_field_experiment"]
+           "check_matches", "field_block", "placed_field_block", "read_field_experiment"]
