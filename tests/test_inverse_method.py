@@ -91,7 +91,7 @@ def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path
     text = write_report(tmp_path / "report.html", result, control=data.control).read_text(encoding="utf-8")
     headings = re.findall(r"<h2>(.*?)</h2>", text)
     assert headings == ["Identified parameters", "Correlation", "Fit", "least squares", "Run statistics", "Notes"]
-    assert "least squares: converged." in text
+    assert "least squares: converged (what to do: the estimate and its std can be used)." in text
     assert "<td class=\"text\">least squares forward runs</td>" in text
     assert "<td class=\"text\">least squares evaluations</td>" in text
     assert "<td class=\"text\">least squares converged</td><td>yes</td>" in text
@@ -150,7 +150,7 @@ def test_study_settings_group_the_options_and_replace_by_name():
 def _fit(y_fit, std=0.001, x=2.0):
     """A one-parameter result on 10 values from 1 to 2 with the fit ``y_fit(y)`` and the data's std ``std``."""
     y = np.linspace(1.0, 2.0, 10)
-    return MethodResult(names=["c"], x=np.array([x]), C=np.eye(1), y_exp=y, y_fit=y_fit(y), std_exp=np.full(10, std),
+    return MethodResult(names=["c"], x=np.array([x]), C=np.eye(1) * 0.01, y_exp=y, y_fit=y_fit(y), std_exp=np.full(10, std),
                         converged=True, status="converged", units={"c": "mm^2"}, bounds=([0.5], [4.0]),
                         at_bound=["c"] if x in (0.5, 4.0) else [])
 
