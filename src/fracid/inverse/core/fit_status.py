@@ -24,9 +24,9 @@ STATUS_ACTIONS = {
     CONVERGED: "the estimate and its std can be used",
     VALLEY: "the data fix a combination of parameters, not each: read the correlation, fix or bound one of them, "
             "or run `fracid study` to map the valley",
-    STABLE: "the estimate is usable (the last passes moved it by less than half a std) but not converged by the "
-            "strict criterion: raise [identify.kalman] max_iterations to confirm",
-    NOT_CONVERGED: "do not use the estimate as it is: it still moves between passes; raise max_iterations, "
+    STABLE: "the estimate is usable (its last moves were below half a std) but not converged by the strict "
+            "criterion: raise the method's max_iterations (its table in [identify]) to confirm",
+    NOT_CONVERGED: "do not use the estimate as it is: it still moves; raise the method's max_iterations, "
                    "narrow the bounds or start elsewhere (`fracid study` checks several starts)",
     FAILED: "there is no usable estimate: read the failed runs' errors in result.json, then check the bounds and "
             "the model's settings",
