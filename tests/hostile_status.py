@@ -97,7 +97,7 @@ CASES = {
         0, ["not identified by the data", "c = ", "beta = ", "% of the estimate", "fracid study"],
         config=PRE_PEAK, args=IDENTIFY, slow=True),
     "unsensed-parameter-within-bounds-warned": case(
-        0, ["not identified by the data: beta = ", "over its bounds", "fracid study"],
+        0, ["not identified by the data: beta = ", "bounds alone", "fracid study"],
         config={**E_BETA, **PRE_PEAK}, args=IDENTIFY, slow=True),
     "well-identified-fit-not-warned": case(None, config=E_BETA, args=IDENTIFY, verify=_no_identification_warning,
                                            slow=True),

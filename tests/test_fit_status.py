@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from fracid.inverse.core.fit_status import (CONVERGED, FAILED, NOT_CONVERGED, STABLE, STATUS_ACTIONS, VALLEY,
-                                            correlated_pairs, stable_step, status_action, status_word, unidentified)
+                                            correlated_pairs, fit_action, stable_step, status_action, status_word,
+                                            unidentified)
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.kalman import kalman_filter
 from fracid.inverse.methods.kalman_status import KalmanResult, judge_stop, restarted
@@ -55,7 +56,7 @@ def test_a_wide_or_correlated_parameter_is_named_and_a_sharp_one_is_not():
     assert correlated_pairs(r(0.989)) == [] and correlated_pairs(r(-0.991))[0][:2] == (0, 1)
     # a std as wide as the bounds' (uniform over [100, 500]: 115): the data add nothing
     texts = unidentified(names, [2.0, 310.0], np.diag([0.05**2, 139.0**2]), ([0.5, 100.0], [4.0, 500.0]))
-    assert len(texts) == 1 and "beta = 310 +- 1.4e+02" in texts[0] and "over its bounds" in texts[0]
+    assert len(texts) == 1 and "beta = 310 +- 1.4e+02" in texts[0] and "bounds alone" in texts[0]
     assert unidentified(names, [np.nan, 1.0], np.eye(2)) == []  # no estimate: another warning says so
 
 
@@ -102,3 +103,10 @@ def test_the_progress_of_a_restarted_filter_never_passes_its_total_and_ends_on_t
     assert counts and all(n <= m for n, m in counts) and counts[-1][1] == 2 * 17, lines
     assert any("start 2/3" in line for line in lines)
     assert lines[-1].endswith(f"returned x = {result.x[0]:.4g}") and result.x[0] == pytest.approx(2.0)
+
+
+def test_a_converged_fit_with_an_unidentified_parameter_is_not_said_usable_as_a_whole():
+    assert fit_action("converged", False) == STATUS_ACTIONS[CONVERGED]
+    assert "except the parameters the data do not identify" in fit_action("converged: small step", True)
+    assert "except" in fit_action("stopped but stable: 3 global iterations reached", True)
+    assert fit_action("not converged: oscillates", True) == STATUS_ACTIONS[NOT_CONVERGED]

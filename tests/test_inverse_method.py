@@ -91,7 +91,7 @@ def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path
     text = write_report(tmp_path / "report.html", result, control=data.control).read_text(encoding="utf-8")
     headings = re.findall(r"<h2>(.*?)</h2>", text)
     assert headings == ["Identified parameters", "Correlation", "Fit", "least squares", "Run statistics", "Notes"]
-    assert "least squares: converged (what to do: the estimate and its std can be used)." in text
+    assert "least squares: converged (what to do: the estimate and its std can be used, except the parameters" in text
     assert "<td class=\"text\">least squares forward runs</td>" in text
     assert "<td class=\"text\">least squares evaluations</td>" in text
     assert "<td class=\"text\">least squares converged</td><td>yes</td>" in text

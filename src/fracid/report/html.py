@@ -90,7 +90,8 @@ def parameter_section(result, control=None) -> str:
     table = html_table(["parameter", "value", "std", "unit", "std / value [%]"], rows, text_columns=(0, 3))
     text = getattr(result, "status", "") or ("converged" if result.converged else "not converged")
     status = esc(text) if result.converged else f'<span class="warn">{esc(text)}</span>'
-    action = status_action(text)
+    action = getattr(result, "status_action", None)  # a MethodResult's knows its unidentified parameters
+    action = action if isinstance(action, str) else status_action(text)
     status += f" (what to do: {esc(action)})" if action else ""
     warnings = result.warnings(control=control) if hasattr(result, "warnings") else []
     shown = "".join(f'<li><span class="warn">warning</span>: {esc(w)}</li>' for w in warnings)

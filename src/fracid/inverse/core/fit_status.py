@@ -65,6 +65,15 @@ def status_action(status: str) -> str:
     return STATUS_ACTIONS.get(status_word(status), "")
 
 
+def fit_action(status: str, warned: bool) -> str:
+    """:func:`status_action`, qualified for a converged or stable fit when ``warned`` (:func:`unidentified` named
+    parameters): the fit converged, but not every parameter is fixed by the data."""
+    action = status_action(status)
+    if warned and status_word(status) in (CONVERGED, STABLE):
+        action += ", except the parameters the data do not identify (see the warning; `fracid study` maps them)"
+    return action
+
+
 def stable_step(points, C) -> float:
     """The largest move of a parameter between successive ``points`` (the last two and three), in std of C."""
     points = [np.asarray(p, float) for p in points][-3:]
@@ -113,7 +122,7 @@ def unidentified(names, x, C, bounds=None) -> list[str]:
         if std[i] > 0 and relative[i] > RELATIVE_STD_LIMIT:
             reasons[i] = f"std {100 * relative[i]:.3g} % of the estimate"
         elif std[i] > BOUNDS_STD_FRACTION * prior[i]:
-            reasons[i] = f"std {std[i] / prior[i]:.2g} times a uniform's over its bounds: the data add less than they"
+            reasons[i] = f"std {std[i] / prior[i]:.2g} times that of the bounds alone, a uniform over them"
     out = []
     if reasons:
         listed = "; ".join(f"{names[i]} = {x[i]:.3g} +- {std[i]:.2g} ({why})" for i, why in reasons.items())
@@ -150,5 +159,5 @@ def correlated_pairs(C) -> list[tuple]:
 
 
 __all__ = ["BOUNDS_STD_FRACTION", "CONVERGED", "CORRELATION_LIMIT", "FAILED", "NOT_CONVERGED", "RELATIVE_STD_LIMIT", "STABLE", "STABLE_STEP",
-           "STATUS_ACTIONS", "VALLEY", "correlated_pairs", "measurement_part", "stable_step", "status_action", "status_word",
+           "STATUS_ACTIONS", "VALLEY", "correlated_pairs", "fit_action", "measurement_part", "stable_step", "status_action", "status_word",
            "unidentified", "with_measurement"]
