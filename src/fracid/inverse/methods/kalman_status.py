@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fracid.inverse.core.estimate import GaussianEstimate
-from fracid.inverse.core.fit_status import FAILED, NOT_CONVERGED, STABLE, STABLE_STEP, measurement_part, stable_step
+from fracid.inverse.core.fit_status import (FAILED, NOT_CONVERGED, STABLE, STABLE_STEP, VALLEY, measurement_part,
+                                            stable_step)
 
 #: Converged: the last pass moved every parameter by less than this many standard deviations (of C) ...
 CONVERGED_STEP = 0.1
@@ -198,7 +199,7 @@ def judge(result, change: PassChange | None, strict: bool, max_iterations: int, 
     valley = valley_text(result.C, names) if change is not None else None
     if valley is not None and change.flat and change.across < CONVERGED_STEP:
         result.converged = True
-        result.status = f"converged along a valley ({valley}: see the study)"
+        result.status = f"{VALLEY} ({valley}: `fracid study` maps the valley)"
         return
     result.converged = False
     reason = f"{max_iterations} global iterations reached"
