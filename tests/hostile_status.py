@@ -62,7 +62,8 @@ def _progress_within_total(proc, d):
 
 
 def _model_error_no_worse(proc, d):
-    """With the model error the fit ends no worse (measurement-only RMS) than without it, and its std are wider."""
+    """With the model error the fit ends no worse (measurement-only RMS, within 2 %) than without it, and its std are
+    wider."""
     check(proc, d, 0)
     with_term = _result(d)
     (d / "plain.toml").write_text((d / "cfg.toml").read_text().replace('model_error = "variance"\n', ""))
@@ -70,19 +71,22 @@ def _model_error_no_worse(proc, d):
     check(plain, d, 0)
     without = json.loads((d / "plain" / "result.json").read_text())
     assert with_term["error_terms"] and not without["error_terms"]
-    assert "starts tried after a poor end" in without["status"], without["status"]  # a poor end was there
 
     def rms(result):
         return float(np.sqrt(np.mean((np.array(result["y_fit"]) - np.array(result["y_exp"])) ** 2)))
 
-    assert rms(with_term) <= 1.05 * rms(without), (rms(with_term), rms(without))
+    assert rms(with_term) <= 1.02 * rms(without), (rms(with_term), rms(without))  # the other minimum: 1.04
     assert np.all(np.array(with_term["std"]) > np.array(without["std"])), (with_term["std"], without["std"])
 
 
 def _model_form_error(d, curve):
-    """The bar's curve with a 5 % ripple no parameter reproduces (a model-form error): every end of the filter is
-    poor on a std of 0.1 % of the peak, the first one is restarted."""
-    write_csv(d / "bar.csv", curve[0], curve[1] * (1 + 0.05 * np.sin(np.linspace(0.0, 9.0, curve[1].size))))
+    """The bar's curve with a 5 % ripple no parameter reproduces (a model-form error, 2.2 periods over the 12 points
+    of [0.004, 0.03] mm) has two minima. Measured: without the term the fit ends at c = 0.5 (its lower bound), beta =
+    138, RMS 2.59 % of the peak; with the term started again from the KNN prior (before issue 38) it ended in the
+    other, c = 2.21, beta = 259, RMS 2.69 %; started from the estimate without the term: 2.59 %, std 0.5 and 58
+    (0.027 and 3.1 without)."""
+    ripple = 0.05 * np.sin(14.0 * (curve[0] - 0.004) / 0.026)
+    write_csv(d / "bar.csv", curve[0], curve[1] * (1 + ripple))
 
 
 def _off_by(factor):
@@ -104,7 +108,7 @@ CASES = {
     "progress-never-past-total-over-restarts": case(
         None, config={"kalman": "max_starts = 3"}, csv=_off_by(1.3), env=LINES,
         args=("identify", "cfg.toml", "--out", "out", "--workers", "1"), verify=_progress_within_total, slow=True),
-    "model-error-on-a-poor-fit-ends-no-worse": case(
+    "model-error-with-two-minima-ends-no-worse": case(
         None, config={"identify": 'model_error = "variance"', "std": "std = 0.002", "kalman": "max_starts = 3"},
         csv=_model_form_error, args=IDENTIFY, verify=_model_error_no_worse, slow=True),
 }
