@@ -143,7 +143,7 @@ def test_failed_runs_shrink_the_step_and_are_recorded(method):
 def test_a_failure_at_the_starting_point_stops_with_a_status():
     h, A, y, R, x0, C0, _ = linear_problem()
     result = gauss_newton(lambda x, needed=None: np.full(12, np.nan), y, R, x0, C0)
-    assert result.status.startswith("stopped:") and result.failed and not result.converged
+    assert result.status.startswith("failed:") and result.failed and not result.converged
     assert len(result.failures) == 1 and result.runs == 1
     np.testing.assert_array_equal(result.x, x0)
 

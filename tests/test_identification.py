@@ -73,7 +73,7 @@ def test_failed_forward_runs_are_recorded_and_do_not_stop_the_study(bar_operator
     assert np.all(np.isinf(res.f[failed])) and set(res.order[-len(failed):]) == set(failed)
     # the Kalman filter cannot do without its own point: it stops, says why and never raises
     result = kalman_filter(bar_operator, y, np.eye(y.size) * std**2, np.array([0.02, 20000.0]), np.diag([0.01, 1e6]))
-    assert result.failed and result.status.startswith("stopped:") and "forward run failed" in result.status
+    assert result.failed and result.status.startswith("failed:") and "forward run failed" in result.status
     assert result.failures and result.failures[0]["x"] == [0.02, 20000.0]
 
 

@@ -11,6 +11,7 @@ import pytest
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
+from fracid.inverse.core.fit_status import status_action
 from fracid.inverse.core.method import POOR_FIT_PERCENT, POOR_FIT_STD, InverseMethod, MethodResult, result_fields
 from fracid.inverse.methods.kalman_settings import KalmanSettings
 from fracid.inverse.methods.knn_kalman import IdentificationResult, KnnKalman
@@ -76,7 +77,9 @@ def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path
     result = identify(op, data.y, data.covariance, SPACE, method=method, blocks=list(data.blocks))
     assert type(result) is MethodResult and result.method == "least-squares"
     np.testing.assert_allclose(result.x, TRUTH, rtol=0.02)
-    assert result.converged and result.warnings() == [] and result.rms_percent < 0.5
+    # c and beta of the bar trade off (r > 0.99): the one warning names them and points to the study
+    assert result.converged and result.rms_percent < 0.5
+    assert [w for w in result.warnings() if "c and beta" not in w or "fracid study" not in w] == []
     assert result.forward_runs == result.runs["least_squares"] > 0 and result.runs["wall_seconds"] > 0
     assert result.stage_runs()["least_squares"]["evaluations"] == result.records["least_squares"]["evaluations"]
     assert "least squares: converged" in result.summary() and "mm^2" in result.summary()
@@ -88,7 +91,7 @@ def test_a_custom_method_plugs_into_identify_result_and_report(problem, tmp_path
     text = write_report(tmp_path / "report.html", result, control=data.control).read_text(encoding="utf-8")
     headings = re.findall(r"<h2>(.*?)</h2>", text)
     assert headings == ["Identified parameters", "Correlation", "Fit", "least squares", "Run statistics", "Notes"]
-    assert "least squares: converged." in text
+    assert "least squares: converged (what to do: the estimate and its std can be used, except the parameters" in text
     assert "<td class=\"text\">least squares forward runs</td>" in text
     assert "<td class=\"text\">least squares evaluations</td>" in text
     assert "<td class=\"text\">least squares converged</td><td>yes</td>" in text
@@ -101,7 +104,7 @@ def test_default_method_settings_belong_to_the_default_method(problem):
     with pytest.raises(TypeError, match="unknown setting.s. groups, n: the method 'least-squares' has no settings"):
         identify(op, data.y, data.covariance, SPACE, method=LeastSquares(), n=8, groups="all")
     with pytest.raises(TypeError, match="unknown setting.s. population of the method 'knn-gauss-newton'; known: k, "
-                                        "knn, max_iterations, n, seed, tol"):
+                                        "knn, max_iterations, n, seed, start, tol"):
         identify(op, data.y, data.covariance, SPACE, method="knn-gauss-newton", population=8)
     with pytest.raises(ValueError, match="method = 'simplex': not a registered inverse method"):
         identify(op, data.y, data.covariance, SPACE, method="simplex")
@@ -122,7 +125,7 @@ def test_failed_runs_and_status_of_a_stage_named_by_the_method():
     result = MethodResult(names=["c"], x=np.array([2.0]), C=np.array([[0.01]]), y_exp=np.array([1.0, 2.0]),
                           y_fit=np.array([1.0, 2.0]), std_exp=np.array([0.1, 0.1]), status="stopped: no step",
                           runs={"grid": 9, "grid_failed": 2, "wall_seconds": 1.0}, stages={"grid": "grid search"})
-    assert result.warnings() == ["grid search stopped: no step",
+    assert result.warnings() == ["grid search stopped: no step. What to do: " + status_action("not converged"),
                                  "failed forward runs: 2 of 9 in the grid search stage (each with its reason, in "
                                  "the result)"]
     assert result.stage_runs() == {"grid": {"runs": 9, "failed": 2}} and result.forward_runs == 9
@@ -147,7 +150,7 @@ def test_study_settings_group_the_options_and_replace_by_name():
 def _fit(y_fit, std=0.001, x=2.0):
     """A one-parameter result on 10 values from 1 to 2 with the fit ``y_fit(y)`` and the data's std ``std``."""
     y = np.linspace(1.0, 2.0, 10)
-    return MethodResult(names=["c"], x=np.array([x]), C=np.eye(1), y_exp=y, y_fit=y_fit(y), std_exp=np.full(10, std),
+    return MethodResult(names=["c"], x=np.array([x]), C=np.eye(1) * 0.01, y_exp=y, y_fit=y_fit(y), std_exp=np.full(10, std),
                         converged=True, status="converged", units={"c": "mm^2"}, bounds=([0.5], [4.0]),
                         at_bound=["c"] if x in (0.5, 4.0) else [])
 

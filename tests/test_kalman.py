@@ -138,5 +138,5 @@ def test_a_filter_that_cannot_run_anywhere_stops_with_a_status():
     h, y, R, x0, C0, _ = linear_problem()
     evaluate, _ = recording(h, fails=lambda x: True)
     result = kalman_filter(evaluate, y, R, x0, C0)
-    assert result.failed and result.status.startswith("stopped:") and "diverged" in result.status
+    assert result.failed and result.status.startswith("failed:") and "diverged" in result.status
     np.testing.assert_array_equal(result.x, x0)

@@ -136,10 +136,43 @@ def test_convergence_is_judged_on_the_step_in_std_and_the_objective():
     cases = [(pass_change([0.0, 0.0], [0.03, 0.0], C, 173.0, 173.5), "converged: the last pass moved the "
               "estimate by 0.03 std and changed the objective by 0.5 (from 173)"),
              (pass_change([0.0, 0.0], [0.03, 0.0], C, 1000.0, 1009.0), "converged: "),  # 0.9 %: flat
-             (pass_change([0.0, 0.0], [0.03, 0.0], C, 173.0, 175.0), "not converged: 10 global iterations "
+             (pass_change([0.0, 0.0], [0.03, 0.0], C, 173.0, 175.0), "stopped but stable: 10 global iterations "
               "reached, the last pass moved the estimate by 0.03 std and changed the objective by 2"),
-             (pass_change([0.0, 0.0], [0.2, 0.0], C, 173.0, 173.1), "not converged: 10 global iterations")]
+             (pass_change([0.0, 0.0], [0.2, 0.0], C, 173.0, 173.1), "stopped but stable: 10 global iterations"),
+             (pass_change([0.0, 0.0], [0.6, 0.0], C, 173.0, 173.1), "not converged: 10 global iterations")]
     for change, status in cases:
         result = KalmanResult(x=np.zeros(2), C=C)
         judge(result, change, False, 10, names)
         assert result.status.startswith(status) and result.converged == status.startswith("converged")
+
+
+def test_a_model_error_fitted_at_a_poor_end_does_not_hide_it():
+    """Issue 38: a model-error std fitted at the poor point (the residual's RMS there) widens C so that chi^2 per
+    point falls to about 1 and no restart was tried. Judged on the measurement's misfit (the widened covariance
+    carries C_exp), the filter restarts, ends no worse than the run without the term, and its std is wider."""
+    from fracid.data.covariance_matrix import Dense
+    from fracid.inverse.core.fit_status import measurement_part, with_measurement
+
+    y = two_basins(np.array([2.0]))
+    C_exp = np.eye(y.size) * (0.01 * y.max()) ** 2
+    space = ParameterSpace(("x",), [-0.5], [3.0])
+    points = design(space, 16, "sobol", seed=1)
+    knn = replace(knn_from_population(space, points, np.array([two_basins(p) for p in points]), ["ok"] * 16,
+                                      [""] * 16, y, C_exp, 3), x0=np.array([0.0]))
+    sigma2 = float(np.mean((y - two_basins(np.array([0.0]))) ** 2))  # the model error at the poor point
+
+    def fit(C):
+        def run(x0):
+            return kalman_filter(two_basins, y, C, x0, np.eye(1), bounds=(space.lower, space.upper), names=["x"])
+        return restarted(run, run(knn.x0), knn, y, C, max_starts=3)
+
+    hidden = fit(Dense(C_exp + sigma2 * np.eye(y.size)))  # the term alone: the poor end passes for a fit
+    assert hidden.x[0] == 0.0 and len(hidden.starts) == 1 and hidden.starts[0]["chi2_per_point"] < 1.01
+    widened = with_measurement(Dense(C_exp + sigma2 * np.eye(y.size)), Dense(C_exp))
+    assert np.allclose(np.asarray(measurement_part(widened)), C_exp)
+    judged, alone = fit(widened), fit(C_exp)
+    assert judged.x[0] == pytest.approx(2.0, rel=1e-3) and len(judged.starts) == 2  # the prior pulls a little
+    # no worse than without the term: both within a fraction of the data's std, the hidden end 100s of std off
+    assert max(chi2_per_point(judged, y, C_exp), chi2_per_point(alone, y, C_exp)) < 0.05
+    assert chi2_per_point(hidden, y, C_exp) > 100 * POOR_CHI2_PER_POINT
+    assert judged.std[0] > 3 * alone.std[0]  # sigma_m is 30 times the measurement std here

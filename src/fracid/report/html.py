@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fracid.inverse.core.fit_status import status_action
 from fracid.report.error_terms import error_terms_section
 from fracid.report.markup import esc, generated_now, html_image, num, provenance_section, html_table, write_document
 from fracid.report.stages import stage_sections, runs_section, status_label
@@ -90,6 +91,9 @@ def parameter_section(result, control=None) -> str:
     table = html_table(["parameter", "value", "std", "unit", "std / value [%]"], rows, text_columns=(0, 3))
     text = getattr(result, "status", "") or ("converged" if result.converged else "not converged")
     status = esc(text) if result.converged else f'<span class="warn">{esc(text)}</span>'
+    action = getattr(result, "status_action", None)  # a MethodResult's knows its unidentified parameters
+    action = action if isinstance(action, str) else status_action(text)
+    status += f" (what to do: {esc(action)})" if action else ""
     warnings = result.warnings(control=control) if hasattr(result, "warnings") else []
     shown = "".join(f'<li><span class="warn">warning</span>: {esc(w)}</li>' for w in warnings)
     rms = getattr(result, "rms_percent", float("nan"))

@@ -21,6 +21,7 @@ import numpy as np
 from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.core.estimate import GaussianEstimate
 from fracid.inverse.core.diagnostics import diagnostic_warnings, diagnostics_lines, fit_diagnostics
+from fracid.inverse.core.fit_status import fit_action, status_word, unidentified
 from fracid.inverse.core.problem_check import check_problem
 from fracid.inverse.core.stage_records import StageRecords
 
@@ -104,8 +105,10 @@ class MethodResult(GaussianEstimate, StageRecords):
     units : dict
         Unit of every parameter.
     status : str
-        What the stage that gave the estimate says: ``"converged"``, ``"not converged: ..."``,
-        ``"stopped: ..."``.
+        What the stage that gave the estimate says, beginning with a word of
+        :data:`~fracid.inverse.core.fit_status.STATUS_ACTIONS` (``"converged"``, ``"converged along a valley"``,
+        ``"stopped but stable"``, ``"not converged"``, ``"failed"``); ``result.json`` adds the word and its
+        action (``status_word``, ``status_action``).
     at_bound : list of str
         Parameters whose estimate lies on a bound.
     bounds : (list, list)
@@ -185,6 +188,12 @@ class MethodResult(GaussianEstimate, StageRecords):
         return float(np.sqrt(np.mean(scaled**2))) if scaled.size else float("nan")
 
     @property
+    def status_action(self) -> str:
+        """What to do after a fit of this status (:func:`~fracid.inverse.core.fit_status.fit_action`: qualified when
+        a parameter is not identified)."""
+        return fit_action(self.status, bool(unidentified(self.names, self.x, self.C, self.bounds or None)))
+
+    @property
     def status_label(self) -> str:
         """Label of the stage that gave the estimate (and the status), e.g. ``"Kalman filter"``."""
         labels = list((self.stages or {}).values())
@@ -223,7 +232,8 @@ class MethodResult(GaussianEstimate, StageRecords):
         """What a user must know before trusting the result: a non-finite or poor fit (in % of the peak, or
         in units of the data's std), an elastic slope or a peak off the data's
         (:mod:`fracid.inverse.core.diagnostics`, at ``control`` [mm] or the result's own), estimates at a bound,
-        a method that did not converge or stopped, failed forward runs."""
+        a method that did not converge or stopped (with what to do), parameters the data do not identify
+        (:func:`~fracid.inverse.core.fit_status.unidentified`), failed forward runs."""
         out = []
         rms = self.rms_percent
         if not np.all(np.isfinite(np.asarray(self.x, float))) or not math.isfinite(rms):
@@ -236,7 +246,9 @@ class MethodResult(GaussianEstimate, StageRecords):
             out.append(f"estimate at a bound of [identify.bounds]: {where}; the data pull it outside the bounds "
                        "(widen them if that is physical); its std is the curvature there, not a spread")
         if self.status and not self.converged:
-            out.append(f"{self.status_label} {self.status}")
+            action = self.status_action
+            out.append(f"{self.status_label} {self.status}" + (f". What to do: {action}" if action else ""))
+        out += unidentified(self.names, self.x, self.C, self.bounds or None)
         if any(c["failed"] for c in self.stage_runs().values()):
             out.append(f"failed forward runs: {self.failed_runs_text()} (each with its reason, in the result)")
         return out
@@ -265,7 +277,8 @@ class MethodResult(GaussianEstimate, StageRecords):
             lines.append(f"{name:>8} = {estimate_text(v, s)} {units.get(name, '')}{flag}".rstrip())
         lines.append("correlation:\n" + np.array2string(self.correlation, precision=3))
         if self.status:
-            lines.append(f"{self.status_label}: {self.status}")
+            action = self.status_action
+            lines.append(f"{self.status_label}: {self.status}" + (f"\n  what to do: {action}" if action else ""))
         if np.size(self.y_fit) == np.size(self.y_exp) and np.any(np.isfinite(np.asarray(self.y_fit, float))):
             lines.append("fit diagnostics:")
             lines += [f"  {line}" for line in diagnostics_lines(self.diagnostics())]
@@ -290,6 +303,7 @@ class MethodResult(GaussianEstimate, StageRecords):
         d["std"], d["correlation"] = self.std.tolist(), self.correlation.tolist()
         d["f_fit"] = float(np.sum(((self.y_exp - self.y_fit) / self.std_exp) ** 2))
         d["diagnostics"] = plain(self.diagnostics())
+        d["status_word"], d["status_action"] = status_word(self.status), self.status_action
         return json.loads(json.dumps(d, allow_nan=True).replace("Infinity", "null"))
 
     def save(self, path) -> Path:

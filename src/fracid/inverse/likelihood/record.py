@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from fracid.data.covariance_update import low_rank_update
+from fracid.inverse.core.fit_status import with_measurement
 from fracid.inverse.likelihood.correlation import block_modes
 from fracid.inverse.likelihood.marginal import MarginalLikelihood
 from fracid.inverse.likelihood.model_error import error_groups, with_model_error
@@ -25,9 +26,11 @@ DOMINANT = 1.0
 
 def widened(C_exp, blocks, control, *, error=None, length=None, sigma=None, groups=None):
     """(base, total): C_exp plus the discretisation term (modes of ``error`` [units of y] correlated over
-    ``length`` of each block's control range), then plus the model error ``sigma`` per group."""
+    ``length`` of each block's control range), then plus the model error ``sigma`` per group. Both carry C_exp
+    (:func:`~fracid.inverse.core.fit_status.measurement_part`): restarts are decided on the measurement's misfit."""
     base = C_exp if error is None else low_rank_update(C_exp, block_modes(error, control, blocks, length))
-    return base, (base if sigma is None else with_model_error(base, sigma, groups))
+    total = base if sigma is None else with_model_error(base, sigma, groups)
+    return with_measurement(base, C_exp), with_measurement(total, C_exp)  # a poor fit is judged on C_exp alone
 
 
 def _rms(values) -> float:

@@ -4,8 +4,10 @@ error and the model's own error, and the identification run again with it (to a 
 :func:`identify_with_terms` runs the method with the data covariance C_exp (the measurement scatter alone), then
 per loop: the discretisation error at the estimate (:mod:`~fracid.inverse.likelihood.discretisation`; once, or
 at every loop when its ``iterations`` ask), sigma_m at the estimate
-(:mod:`~fracid.inverse.likelihood.model_error`), and the method again with the widened covariance. The loops stop
-when the estimate moves less than :data:`FIXED_POINT_TOL` of its std. The re-identifications reuse the stored
+(:mod:`~fracid.inverse.likelihood.model_error`), and the method again with the widened covariance, its local
+fit started from the last estimate (a KNN-started method's ``start``: the search and restarts of the first
+identification, on the measurement's misfit, are not undone by a term that widens the covariance at a poor
+point; restarts stay judged on the measurement's misfit). The loops stop when the estimate moves less than :data:`FIXED_POINT_TOL` of its std. The re-identifications reuse the stored
 runs (the population is the same points; a temporary run store when none is given). With a term correlated along
 the curves a Kalman filter assimilates one data block per step (its steps assume no correlation between them).
 
@@ -146,7 +148,7 @@ def with_error_terms(method, fit, problem: Problem, terms: ErrorTerms, first, *,
         return first
     refit = _by_blocks(method) if terms.correlated else method
     options = {"store": store, "executor": executor, "retry_failed": retry_failed}
-    result, loops, disc, computed = _loops(lambda C: fit(refit, C), problem, terms, first, options)
+    result, loops, disc, computed = _loops(lambda C, x: fit(_started(refit, x), C), problem, terms, first, options)
     result.error_terms = terms_record(problem, terms, first, result, loops, disc, computed)
     result.std_exp = problem.C_exp.std()
     result.notes = list(result.notes) + result.error_terms["notes"]
@@ -166,7 +168,7 @@ def _loops(refit, problem, terms, first, options):
                           length=getattr(terms.discretisation, "correlation_length", None))
         sigma = None if groups is None else _sigma(problem, state.x, base, groups, terms.model_error, options)
         _, C = widened(base, problem.blocks, problem.control, sigma=sigma, groups=groups)
-        new = refit(C)
+        new = refit(C, state.x)
         computed += _computed(new)
         moved = float(np.max(np.abs(np.asarray(new.x) - np.asarray(state.x)) / np.asarray(new.std)))
         loops.append({"loop": loop + 1, "x": np.asarray(new.x).tolist(), "std": np.asarray(new.std).tolist(),
@@ -190,6 +192,16 @@ def _sigma(problem, x, base, groups, settings, options) -> np.ndarray:
     span = np.asarray(problem.space.upper, float) - np.asarray(problem.space.lower, float)
     precision = np.diag(12.0 / span**2)  # the uniform prior over the bounds
     return estimate_sigma(problem.y_exp - np.asarray(y, float), np.asarray(J, float), base, groups, precision, settings)
+
+
+def _started(method, x):
+    """``method`` whose local fit starts from x, the last estimate (when it has such a setting): the search for the
+    minimum was done with the measurement covariance, and a model error fitted at a poor point would widen the
+    covariance there and hide it (its restarts are still judged on the measurement's misfit)."""
+    try:
+        return with_settings(method, start=tuple(float(v) for v in x))
+    except TypeError:  # no start of its own: the method searches again
+        return method
 
 
 def _by_blocks(method):

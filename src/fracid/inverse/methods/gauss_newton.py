@@ -27,6 +27,7 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares, lsq_linear
 
+from fracid.inverse.core.fit_status import CONVERGED, FAILED, NOT_CONVERGED, STABLE, STABLE_STEP
 from fracid.inverse.methods.kalman_status import KalmanResult
 from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity, memoized
@@ -144,7 +145,7 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
         x, C (posterior covariance at x), y = h(x), runs, iterations (linearisations), status,
         failures (``{"iteration", "x", "error"}``), at_bound, and a history entry per linearisation
         ``{"iteration", "step", "observations", "x", "C"}``. Never raises for a failed forward run:
-        when the run at the starting point fails, ``status = "stopped: ..."``.
+        when the run at the starting point fails, ``status = "failed: ..."``.
     """
     y_exp, C_exp, x0, C0 = check_inputs(y_exp, C_exp, x0, C0)
     if sensitivity is None:
@@ -159,14 +160,14 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
     z_start = _strictly_inside(x0 / problem.s, lower / problem.s, upper / problem.s)
     if problem.at(problem.x(z_start)) is None:
         result.y = np.full(y_exp.size, np.nan)
-        result.status = f"stopped: the forward run at the starting point failed: {result.failures[-1]['error']}"
+        result.status = f"{FAILED}: the forward run at the starting point failed: {result.failures[-1]['error']}"
         result.at_bound = at_bound(x0, lower, upper)
         return result
     message = _solve(problem, z_start, max_iterations, tol, callback)
     x, y, C = _last_step(problem, tol, callback)
     result.x, result.y, result.C, result.iterations = x, y, C, problem.iteration
-    result.status = ("converged" if result.converged else
-                     f"not converged: {message}, the last Gauss-Newton step was {problem.moved:.3g} std")
+    word = CONVERGED if result.converged else STABLE if problem.moved < STABLE_STEP else NOT_CONVERGED
+    result.status = word if result.converged else f"{word}: {message}, the last Gauss-Newton step was {problem.moved:.3g} std"
     result.at_bound = at_bound(x, lower, upper)
     return result
 

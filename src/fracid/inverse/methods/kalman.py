@@ -21,7 +21,7 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from fracid.inverse.methods.assimilation import assimilate
-from fracid.inverse.methods.kalman_status import KalmanResult, judge_last_pass, relaxed
+from fracid.inverse.methods.kalman_status import KalmanResult, judge_last_pass, judge_stop, relaxed
 from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points, exact_sensitivity, memoized
 
@@ -173,7 +173,7 @@ def kalman_filter(evaluate, y_exp, C_exp, x0, C0, *, groups=None, max_iterations
     -------
     KalmanResult
         Never raises for a failed forward run: when no point near the filter's runs, the stage
-        stops with the last complete estimate and ``status = "stopped: ..."``. The status judges
+        stops with the last complete estimate and a status of :func:`~fracid.inverse.methods.kalman_status.judge_stop`. The status judges
         convergence on the last pass's step in std and objective change
         (:func:`~fracid.inverse.methods.kalman_status.judge`): the loop itself stops at ``tol``.
     """
@@ -325,8 +325,7 @@ def _finish(result, lin, lower, upper, stopped) -> str:
         result.y = np.full(result.y.size if result.y is not None else lin.n_outputs, np.nan)
         stopped = stopped or f"the forward run at the final estimate failed: {lin.last_error}"
     if stopped:
-        result.converged = False
-        result.status = f"stopped: {stopped}"
+        judge_stop(result, stopped)
     result.at_bound = at_bound(result.x, lower, upper)
     return stopped
 

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fracid.inverse.core.estimate import GaussianEstimate
+from fracid.inverse.core.fit_status import (FAILED, NOT_CONVERGED, STABLE, STABLE_STEP, VALLEY, measurement_part,
+                                            stable_step)
 
 #: Converged: the last pass moved every parameter by less than this many standard deviations (of C) ...
 CONVERGED_STEP = 0.1
@@ -61,9 +63,10 @@ class KalmanResult(GaussianEstimate):
         Forward runs asked for; ``run_equivalents`` weights each by the share of the curve it computed.
     status : str
         ``"converged"`` (or ``"converged: ..."`` with the last pass's step and objective change),
-        ``"converged along a valley (...)"``, ``"not converged: ..."`` (iterations reached, an
-        oscillation) or ``"stopped: ..."`` (forward runs failed at and around the filter's point, or
-        the objective no longer decreased along the step); see :mod:`fracid.inverse.methods.kalman_status`.
+        ``"converged along a valley (...)"``, ``"stopped but stable: ..."`` (iterations reached, or a failed
+        run or no decrease of the objective stopped it, with the last passes moving less than half a std),
+        ``"not converged: ..."`` (the same, still moving or oscillating) or ``"failed: ..."`` (no run
+        succeeded at the estimate): the words of :mod:`fracid.inverse.core.fit_status`.
     failures : list of dict
         Failed forward runs at points the filter wanted: ``{"iteration", "step", "x", "error"}``.
     at_bound : ndarray of bool
@@ -196,17 +199,19 @@ def judge(result, change: PassChange | None, strict: bool, max_iterations: int, 
     valley = valley_text(result.C, names) if change is not None else None
     if valley is not None and change.flat and change.across < CONVERGED_STEP:
         result.converged = True
-        result.status = f"converged along a valley ({valley}: see the study)"
+        result.status = f"{VALLEY} ({valley}: `fracid study` maps the valley)"
         return
     result.converged = False
     reason = f"{max_iterations} global iterations reached"
-    if oscillates(result.passes_x, result.C):
+    swinging = oscillates(result.passes_x, result.C)
+    if swinging:
         reason = "the estimate oscillates between passes"
     elif oscillates(first_steps(result.history), result.C):
         reason = f"{reason}; the estimate oscillates at the first step of every pass"
     reason += damped
     detail = change.text() if change is not None else "a single pass"
-    result.status = f"not converged: {reason}, {detail}"
+    stable = change is not None and change.moved < STABLE_STEP and not swinging
+    result.status = f"{STABLE if stable else NOT_CONVERGED}: {reason}, {detail}"
 
 
 def relaxed(result, x, previous, C):
@@ -236,6 +241,20 @@ def judge_last_pass(result, objective_at, objective, last, max_iterations, names
     judge(result, change, result.converged, max_iterations, names)
 
 
+def judge_stop(result, stopped: str) -> None:
+    """The status of a filter that ``stopped`` (a failed run, or no decrease of the objective along the step):
+    ``"failed: ..."`` when no run succeeded at its estimate; else ``"stopped but stable: ..."`` when the final
+    estimate is within :data:`~fracid.inverse.core.fit_status.STABLE_STEP` std of the last passes' estimates
+    (the step it could not take stays inside the reported uncertainty), ``"not converged: ..."`` otherwise."""
+    result.converged = False
+    if result.failed:
+        result.status = f"{FAILED}: stopped, {stopped}"
+        return
+    moved = stable_step([*result.passes_x[-2:], result.x], result.C) if len(result.passes_x) > 1 else np.inf
+    word = STABLE if moved < STABLE_STEP else NOT_CONVERGED
+    result.status = f"{word}: stopped {stopped}; the last passes moved the estimate by {moved:.3g} std"
+
+
 # ------------------------------------------------------------------------------------------ restarts
 
 
@@ -262,6 +281,9 @@ def restarted(run, first, knn, y_exp, C_exp, max_starts: int = DEFAULT_MAX_START
     """The filter ``first`` (from the KNN prior), restarted from the next-best population points while
     it ends at a poor point (:func:`is_poor`), up to ``max_starts`` starts in all; the best end wins.
 
+    Both are judged on the measurement-only misfit (:func:`~fracid.inverse.core.fit_status.measurement_part`
+    of ``C_exp``): a model-error term in ``C_exp`` widens it where the fit is poor and would hide the poor end.
+
     Parameters
     ----------
     run : callable(x0) -> KalmanResult
@@ -278,7 +300,8 @@ def restarted(run, first, knn, y_exp, C_exp, max_starts: int = DEFAULT_MAX_START
         added, ``starts`` (one dict per start: ``{"start", "x0", "x", "chi2_per_point", "status"}``) and
         the status saying how many starts were tried and which won.
     """
-    best = float(knn.f[knn.order[0]]) if np.size(knn.f) else np.inf
+    C_exp = measurement_part(C_exp)  # a poor end is judged on the data's scatter alone, not on error terms
+    best = best_population(knn, y_exp, C_exp)
     tried = [("the KNN prior", knn.x0, first)]
     if max_starts > 1 and is_poor(first, y_exp, C_exp, best):
         for index in knn.next_starts(max_starts - 1, avoid=[knn.x0]):
@@ -298,6 +321,17 @@ def restarted(run, first, knn, y_exp, C_exp, max_starts: int = DEFAULT_MAX_START
                          f"(chi^2 per point {chi2[0]:.3g}), the start from {tried[win][0]} won "
                          f"(chi^2 per point {chi2[win]:.3g})")
     return winner
+
+
+def best_population(knn, y_exp, C_exp) -> float:
+    """The lowest chi^2 of the population under ``C_exp`` (from its computed values; its own objective ``f``
+    when it did not keep them)."""
+    from fracid.inverse.core.misfit import objective
+
+    Y = getattr(knn, "Y", None)
+    if Y is not None and np.size(Y):
+        return float(np.min(objective(y_exp, C_exp, Y)))
+    return float(knn.f[knn.order[0]]) if np.size(knn.f) else np.inf
 
 
 def _merge_runs(winner, results):

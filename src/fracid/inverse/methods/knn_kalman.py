@@ -18,6 +18,7 @@ from typing import ClassVar
 import numpy as np
 
 from fracid.inverse.core.plans import StagePlan, plural, runs_per_linearisation
+from fracid.inverse.core.fit_status import NOT_CONVERGED
 from fracid.inverse.core.sensitivity import sensitivity_label
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.kalman import kalman_filter
@@ -132,18 +133,20 @@ class KnnKalman(KnnStarted):
         (every run near its points failed), the fit is the best point of the population with the KNN prior
         covariance, and the status says so."""
         options = self.kalman.options(np.size(y_exp), blocks)
-        with kalman_progress(progress, options["groups"], y_exp.size, self.kalman.max_iterations) as callback:
+        with kalman_progress(progress, options["groups"], y_exp.size, self.kalman.max_iterations,
+                             self.kalman.max_starts) as shown:
             def run(x0):
-                return kalman_filter(evaluate, y_exp, C_exp, x0, C0, executor=executor, bounds=bounds, callback=callback,
-                                     sensitivity=sensitivity, names=knn.space.names, **options)
+                return kalman_filter(evaluate, y_exp, C_exp, x0, C0, executor=executor, bounds=bounds,
+                                     callback=shown.start(), sensitivity=sensitivity, names=knn.space.names, **options)
 
             kalman = restarted(run, run(knn.x0), knn, y_exp, C_exp, self.kalman.max_starts)
-        x, C, y_fit, status = kalman.x, kalman.C, kalman.y, kalman.status
-        if kalman.failed and np.isfinite(knn.f[knn.order[0]]):
-            best = knn.order[0]
-            x, C = knn.points[best], knn.C0
-            y_fit = np.asarray(knn_output(knn, best, y_exp.size))
-            status = f"{kalman.status}; the result is the best point of the KNN population"
+            x, C, y_fit, status = kalman.x, kalman.C, kalman.y, kalman.status
+            if kalman.failed and np.isfinite(knn.f[knn.order[0]]):
+                best = knn.order[0]
+                x, C = knn.points[best], knn.C0
+                y_fit = np.asarray(knn_output(knn, best, y_exp.size))
+                status = f"{NOT_CONVERGED}: the result is the best point of the KNN population; the filter {kalman.status}"
+            shown.returned(x)
         note = (f"Kalman filter: step by step, {kalman.iterations} global iteration(s), tol {self.kalman.tol} std, "
                 f"sensitivities by {sensitivity_label(sensitivity)}; {status}")
         return LocalFit(x=x, C=C, y=y_fit, history=kalman.history, converged=kalman.converged, status=status,
@@ -151,23 +154,50 @@ class KnnKalman(KnnStarted):
                         counters={"run_equivalents": kalman.run_equivalents, "iterations": kalman.iterations})
 
 
+class KalmanProgress:
+    """The Kalman stage's progress bar over its starts: each start (:meth:`start`) adds its linearisations to the
+    total (the first pass's steps, then one per pass), so the count never passes the total; the bar's note is the
+    running estimate, and at the end the returned one (:meth:`returned`)."""
+
+    def __init__(self, bar, per_start: int, max_starts: int):
+        self.bar, self.per_start, self.max_starts, self.starts = bar, per_start, max_starts, 0
+
+    def start(self):
+        """The filter's callback for the next start."""
+        self.starts += 1
+        if self.starts > 1:
+            self.bar.total += self.per_start
+        label = f"start {self.starts}/{self.max_starts}, " if self.max_starts > 1 else ""
+
+        def callback(iteration, step, x, C):
+            if iteration == 1 or step == 1:
+                self.bar.update(1)
+            self.bar.set_postfix_str(f"{label}iteration {iteration}, x = " + _values(x))
+
+        return callback
+
+    def returned(self, x):
+        """The note of the last line: the estimate the stage returns."""
+        self.bar.n = self.bar.total
+        self.bar.set_postfix_str("returned x = " + _values(x))
+
+
+def _values(x) -> str:
+    return ", ".join(f"{v:.4g}" for v in np.asarray(x, float))
+
+
 @contextmanager
-def kalman_progress(progress, groups, n_outputs, max_iterations):
-    """A progress bar of the Kalman stage (linearisations: the first pass's steps, then one per pass);
-    yields the filter's callback."""
+def kalman_progress(progress, groups, n_outputs, max_iterations, max_starts=1):
+    """A progress bar of the Kalman stage (:class:`KalmanProgress`; ``max_starts``: the filter's starts at most)."""
     from fracid.runtime.progress import progress_bar
 
     steps = n_outputs if groups is None else len(groups)
-    total = steps + max_iterations - 1
-    with progress_bar(total, "Kalman filter", progress, unit="step") as bar:
-        def callback(iteration, step, x, C):
-            if iteration == 1 or step == 1:
-                bar.update(1)
-            bar.set_postfix_str(f"iteration {iteration}, x = " + ", ".join(f"{v:.4g}" for v in x))
-
-        yield callback
+    per_start = steps + max_iterations - 1
+    with progress_bar(per_start, "Kalman filter", progress, unit="step") as bar:
+        shown = KalmanProgress(bar, per_start, max_starts)
+        yield shown
         bar.n = bar.total
         bar.refresh()
 
 
-__all__ = ["IdentificationResult", "KnnKalman", "kalman_progress"]
+__all__ = ["IdentificationResult", "KalmanProgress", "KnnKalman", "kalman_progress"]

@@ -24,12 +24,17 @@ class KnnSettings:
         Seed of the design.
     k : int
         Nearest neighbours whose mean and spread are the Kalman filter's prior.
+    start : tuple of float or None
+        The prior mean of the local fit instead of the neighbours' mean (units of the parameters; the
+        neighbours' spread stays its covariance): the error terms' loops start from the last estimate
+        (:mod:`fracid.inverse.likelihood.terms`). Not a key of the configuration.
     """
 
     n: int = 64
     method: str = "sobol"
     seed: int = 0
     k: int = 5
+    start: tuple | None = None
 
     def population(self, p: int) -> int:
         """Number of forward runs of the population for ``p`` parameters (``n``, or ``n**p`` for a grid)."""

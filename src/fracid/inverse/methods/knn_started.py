@@ -12,7 +12,7 @@ settings' ``from_config`` / ``config_template``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
@@ -126,6 +126,8 @@ class KnnStarted:
         :class:`~fracid.inverse.core.runs.StoredOperator` (its runs are then stored and counted); the stage
         stays inside the space's bounds and does not raise on failed forward runs."""
         start = time.perf_counter() if started is None else started
+        if self.knn.start is not None:  # a given start (the error terms' loops) replaces the neighbours' mean
+            knn = replace(knn, x0=np.clip(np.asarray(self.knn.start, float), knn.space.lower, knn.space.upper))
         evaluate, sensitivity = exact_sensitivity(operator)
         before = _counters(evaluate)
         bounds = identification_bounds(operator, knn.space)
