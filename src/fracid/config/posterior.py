@@ -44,9 +44,10 @@ def _warn_floor(ck: Checker, config: PosteriorConfig) -> None:
     total = config.samples_per_round * config.max_rounds
     floor = ess_floor(config.target_ess)
     if total < floor:
+        floor_words = floor_text(config.target_ess, "posterior.target_ess")
         ck.warn(f"posterior.samples_per_round {config.samples_per_round} x posterior.max_rounds {config.max_rounds} = "
-                f"{total} draws at most, below the floor of {floor:g} effective samples ({floor_text(config.target_ess)}): "
-                "the effective sample size never exceeds the number of draws, so the "
+                f"{total} draws at most, below the floor of {floor:g} effective samples ({floor_words}): the "
+                "effective sample size never exceeds the number of draws, so the "
                 "posterior fails whatever the data (exit status 3) and gives no credible intervals; raise "
                 "samples_per_round or max_rounds")
     elif config.target_ess > total:

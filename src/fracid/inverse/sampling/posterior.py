@@ -62,23 +62,25 @@ def ess_floor(target_ess: float) -> float:
     return float(min(target_ess, max(MIN_ESS, MIN_ESS_FRACTION * target_ess)))
 
 
-def floor_text(target_ess: float) -> str:
-    """Which of its terms sets :func:`ess_floor` for ``target_ess``, in words (the messages that name the floor).
+def floor_text(target_ess: float, key: str = "target_ess") -> str:
+    """Which of its terms sets :func:`ess_floor` for ``target_ess``, in words (the messages that name the floor);
+    ``key`` is the setting's name as the reader knows it (``posterior.target_ess`` in a configuration).
 
     Examples
     --------
     >>> floor_text(500.0)
-    'the least effective sample size whose quantiles are credible intervals'
+    'the least effective sample size whose quantiles are credible intervals, above 5% of target_ess = 500'
     >>> floor_text(4000.0)
     '5% of target_ess = 4000'
     >>> floor_text(30.0)
     'target_ess = 30 itself, below the usual floor 50'
     """
     if target_ess < MIN_ESS:
-        return f"target_ess = {target_ess:g} itself, below the usual floor {MIN_ESS:g}"
+        return f"{key} = {target_ess:g} itself, below the usual floor {MIN_ESS:g}"
     if MIN_ESS_FRACTION * target_ess > MIN_ESS:
-        return f"{MIN_ESS_FRACTION:.0%} of target_ess = {target_ess:g}"
-    return "the least effective sample size whose quantiles are credible intervals"
+        return f"{MIN_ESS_FRACTION:.0%} of {key} = {target_ess:g}"
+    return (f"the least effective sample size whose quantiles are credible intervals, above {MIN_ESS_FRACTION:.0%} "
+            f"of {key} = {target_ess:g}")
 
 
 @dataclass(frozen=True)
