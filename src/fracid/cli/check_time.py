@@ -122,15 +122,15 @@ def timing_line(timing: Timing) -> str:
     """``"time: ..."``: what was timed and how long it took."""
     if not timing.across:
         slow = f" (over {SLOW_RUN:.0f} s: the only run timed, its warm-up included)" if timing.first > SLOW_RUN else ""
-        return f"time: one forward run at [model.parameters] took {timing.first:.1f} s{slow}"
+        return f"time: one forward run at [model.parameters] took {_secs(timing.first)} s{slow}"
     low, high = ACROSS
     failed = f", {timing.failed} of them failed" if timing.failed else ""
-    text = (f"time: one forward run took {timing.plain:.1f} s (the mean of {len(timing.across)} runs across the bounds, "
-            f"at {low:g} and {high:g} of the ranges: {', '.join(f'{t:.1f}' for t in timing.across)} s{failed}; "
+    text = (f"time: one forward run took {_secs(timing.plain)} s (the mean of {len(timing.across)} runs across the bounds, "
+            f"at {low:g} and {high:g} of the ranges: {', '.join(_secs(t) for t in timing.across)} s{failed}; "
             f"the first, at [model.parameters], took {timing.first:.1f} s with its warm-up and is not counted)")
     if timing.exact is not None:
-        text += (f"; with exact sensitivities {timing.exact:.1f} s at [model.parameters] "
-                 f"({timing.exact / timing.plain:.2g} plain runs)")
+        text += (f"; with exact sensitivities {_secs(timing.exact)} s at [model.parameters] "
+                 f"({timing.exact / timing.plain:.2f} times a plain run)")
     return text
 
 
@@ -173,7 +173,8 @@ def assumptions(timing: Timing, times) -> str:
     exact = ("" if timing.exact is not None else
              f"; a run with exact sensitivities as {SENSITIVITY_COST:g} plain runs (not timed)")
     load = ("the machine's load unknown when timed" if not np.isfinite(timing.load) else
-            f"the machine's load {timing.load:.2f} (1-min average) on {times.cores} core(s) when timed")
+            f"the machine's load {timing.load:.2f} (1-min average) on {times.cores} core(s) when timed"
+            + (" (busy: on a quiet machine the runs are faster)" if timing.load >= times.cores else ""))
     return (f"{times.workers} worker(s) on {cores}; every run as long as the timed ones{exact}; {load}: a machine "
             f"busier during the identification makes it longer; {REPORT_SECONDS:.0f} s to start and write the report")
 
@@ -182,7 +183,14 @@ def _refits_text(count: int) -> str:
     return f"; the local stages {count} more time(s) for the error terms" if count else ""
 
 
+def _secs(seconds: float) -> str:
+    """A run's seconds to 3 digits (a whole number from 100 s)."""
+    return f"{seconds:.3g}" if seconds < 100 else f"{seconds:.0f}"
+
+
 def _duration(seconds: float) -> str:
+    if seconds < 10:
+        return f"{seconds:.1f} s"
     if seconds < 90:
         return f"{seconds:.0f} s"
     if seconds < 5400:
