@@ -162,6 +162,13 @@ def test_the_error_terms_refits_are_said(monkeypatch):
     assert "1 more time(s) for the error terms" in text and "3 more time(s) for the error terms" in text
 
 
+def test_a_busy_machine_is_said_and_a_quiet_one_is_not(monkeypatch):
+    busy, _ = _lines(monkeypatch, kalman_plan(), Timing(first=1.0, across=(1.0,), exact=1.5, load=2.5))
+    quiet, _ = _lines(monkeypatch, kalman_plan(), Timing(first=1.0, across=(1.0,), exact=1.5, load=0.3))
+    assert "load 2.50" in busy and "busy: on a quiet machine the runs are faster" in busy
+    assert "load 0.30" in quiet and "busy" not in quiet
+
+
 def test_an_unknown_load_is_said(monkeypatch):
     text, _ = _lines(monkeypatch, kalman_plan(), Timing(first=1.0, across=(1.0,), exact=1.5))
     assert "load unknown" in text and math.isnan(Timing(first=1.0).load)
