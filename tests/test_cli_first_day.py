@@ -124,8 +124,9 @@ def test_check_prints_the_plan_with_unknowns_runs_and_time(tmp_path, capsys):
     assert 100 < unknowns < 6000  # h_fine 2 of the demo, h_coarse D / 12.5 = 4 mm (its scaling default)
     assert "stage KNN: 32 forward runs" in out
     assert re.search(r"Kalman filter: 4 steps per pass, 1 run per step \(the run with its exact sensitivities\)", out)
-    assert re.search(r"one forward run at \[model.parameters\] took [\d.]+ s", out)
-    assert re.search(r"estimate for fracid identify on 2 worker\(s\).*at most", out)
+    assert re.search(r"one forward run took [\d.]+ s \(the mean of 2 runs across the bounds", out)
+    assert re.search(r"estimate for fracid identify on 2 worker\(s\): about .*, at most", out)
+    assert re.search(r"assumes: 2 worker\(s\) on \d+ core\(s\)", out) and "the machine's load" in out
     assert not list(tmp_path.glob("results*"))  # nothing computed into the output directory
 
 
@@ -134,7 +135,9 @@ def test_check_warns_of_a_slow_plan_naming_the_key(tmp_path, capsys, monkeypatch
 
     text = re.sub(r"^n = \S+", "n = 5000", small(init(tmp_path)), flags=re.M)
     (tmp_path / "fracid.toml").write_text(text, encoding="utf-8")
-    monkeypatch.setattr(cli_check, "_timed_run", lambda *args: 40.0)  # a 40 s run, not measured
+    from fracid.cli.check_time import Timing
+
+    monkeypatch.setattr(cli_check, "timed_runs", lambda *args: Timing(40.0))  # a 40 s run, not measured
     assert cli.main(["check", str(tmp_path / "fracid.toml"), "--workers", "2"]) == 0
     err = capsys.readouterr().err
     assert "one forward run takes 40 s" in err and "specimen.h_fine = 2" in err

@@ -2,27 +2,21 @@
 
 The plan: the specimen and its mesh (nodes, elements, unknowns, element sizes), the model and its
 parameters, the data blocks, the identified parameters and their bounds, the stages with their forward
-runs, and (unless ``--no-time``) a time estimate from one timed forward run at ``[model.parameters]``.
-A warning names the key that makes a run slow (more than :data:`SLOW_RUN` seconds) or the whole plan
-long (more than :data:`SLOW_PLAN` seconds on the available workers).
+runs, and (unless ``--no-time``) a time estimate from timed forward runs, likely and at most, with its
+assumptions (:mod:`fracid.cli.check_time`). A warning names the key that makes a run slow (more than
+:data:`~fracid.cli.check_time.SLOW_RUN` seconds) or the whole plan long (more than
+:data:`~fracid.cli.check_time.SLOW_PLAN` seconds on the available workers).
 """
 
 from __future__ import annotations
 
-import math
-import time
 from pathlib import Path
 
 import numpy as np
 
-from fracid.cli.common import load, output_path, run_inputs, warn
+from fracid.cli.check_time import time_lines, timed_runs
+from fracid.cli.common import load, output_path, run_inputs
 
-#: one forward run slower than this [s] is warned about
-SLOW_RUN = 30.0
-#: a whole plan longer than this [s] on the available workers is warned about
-SLOW_PLAN = 3600.0
-#: a run with exact sensitivities costs this many plain runs (benchmarks/sensitivities.py: 1.65 on the demo beam)
-SENSITIVITY_COST = 1.65
 
 
 def add_parser(sub, parents) -> None:
@@ -107,10 +101,8 @@ def plan_lines(cfg, method, plan) -> list:
 def error_terms_lines(cfg) -> list:
     """What ``[identify] discretisation_error`` and ``model_error`` add: the refinement again with them (its
     population reused from the run store) and a run on a refined mesh; none when both are off."""
-    from fracid.inverse.likelihood.terms import ErrorTerms
-
-    terms = ErrorTerms(cfg.identify.discretisation_error, cfg.identify.model_error)
-    if terms.discretisation is None and terms.model_error is None:
+    terms = error_terms_of(cfg)
+    if terms is None:
         return []
     parts = []
     if terms.discretisation is not None:
@@ -121,68 +113,30 @@ def error_terms_lines(cfg) -> list:
     if terms.model_error is not None:
         parts.append("the model error's std at every estimate (from the stored run there)")
     return [f"error terms: the identification again with them, at most {terms.loops} time(s), its population "
-            f"reused from the run store; {'; '.join(parts)}"]
+            f"reused from the run store; {'; '.join(parts)} (the refined mesh's runs are not in the time estimate)"]
 
 
-def _timed_run(cfg, model, specimen, params, operator) -> float:
-    """Seconds of one forward run at [model.parameters]: the identification's (``operator``) or the
-    simulation's. A failed run raises (a ConvergenceError: exit 3)."""
-    from fracid.config import simulate_settings
-    from fracid.runtime.exits import UsageError
+def error_terms_of(cfg):
+    """The configuration's :class:`~fracid.inverse.likelihood.terms.ErrorTerms`; None when both are off."""
+    from fracid.inverse.likelihood.terms import ErrorTerms
 
-    start = time.perf_counter()
-    if operator is None:
-        settings = simulate_settings(cfg)
-        settings.pop("regularization", None)
-        model.simulate(specimen, params, **settings)
-        return time.perf_counter() - start
-    record = operator(np.array([getattr(params, name) for name in operator.names]))
-    if not record.ok:
-        raise UsageError(f"{cfg.path}: the forward run at [model.parameters] failed ({record.error}); "
-                         "set values for which the analysis runs")
-    return time.perf_counter() - start
+    terms = ErrorTerms(cfg.identify.discretisation_error, cfg.identify.model_error)
+    return None if terms.discretisation is None and terms.model_error is None else terms
 
 
-def time_lines(cfg, seconds, plan, workers) -> list:
-    """The time estimate, and a warning for a slow run or plan naming the key that makes it so."""
-    lines = [f"time: one forward run at [model.parameters] took {seconds:.1f} s"]
-    if seconds > SLOW_RUN:
-        warn(f"one forward run takes {seconds:.0f} s (over {SLOW_RUN:.0f} s): the mesh makes it so "
-             f"({mesh_key(cfg)}); a coarser mesh runs faster, if it still resolves the process zone")
-    if not plan:
-        return lines
-    times = [(stage, _stage_seconds(stage, seconds, workers)) for stage in plan]
-    total = sum(t for _, t in times)
-    parts = ", ".join(f"{stage.label} {'at most ' if not stage.side_by_side else ''}{_duration(t)}" for stage, t in times)
-    lines.append(f"estimate for fracid identify on {workers} worker(s): {parts}: at most {_duration(total)}")
-    if total > SLOW_PLAN:
-        slowest = max(times, key=lambda pair: pair[1])[0]
-        warn(f"the identification may take {_duration(total)} (over {_duration(SLOW_PLAN)}) on {workers} worker(s): "
-             f"mostly because of {slowest.keys or slowest.label}, with each run taking {seconds:.1f} s "
-             f"({mesh_key(cfg)}); --workers or a Dask cluster (--scheduler) shares the stages whose runs are side "
-             "by side")
-    return lines
+def refits(cfg) -> tuple:
+    """(likely, most) identifications after the first, for the error terms: (1, their loops), (0, 0) without."""
+    terms = error_terms_of(cfg) if cfg.identify is not None else None
+    return (0, 0) if terms is None else (1, terms.loops)
 
 
-def _stage_seconds(stage, seconds: float, workers: int) -> float:
-    """Wall time of a stage's runs: side by side on the workers, or one after another (a run with exact
-    sensitivities costs :data:`SENSITIVITY_COST` plain runs)."""
-    if stage.side_by_side:
-        return math.ceil(stage.runs / workers) * seconds
-    return stage.full_runs * seconds * (SENSITIVITY_COST if stage.exact else 1.0)
 
-
-def _duration(seconds: float) -> str:
-    if seconds < 90:
-        return f"{seconds:.0f} s"
-    if seconds < 5400:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
 
 
 def run_check(args) -> int:
     """``fracid check``: print the plan of the configuration; exit 2 (with the message) if it is invalid."""
-    from fracid.config import build_data, build_method, build_model, build_operator, build_parameters, build_specimen
+    from fracid.config import (build_data, build_method, build_model, build_operator, build_parameters, build_space,
+                               build_specimen)
     from fracid.runtime.executors import available_cores
     from fracid.store.outputs import check_outputs
 
@@ -205,7 +159,10 @@ def run_check(args) -> int:
     if args.no_time:
         print("time: not measured (--no-time)")
         return 0
-    seconds = _timed_run(cfg, model, build_specimen(cfg), params, operator)
+    space = build_space(cfg) if operator is not None else None
+    timing = timed_runs(cfg, model, build_specimen(cfg), params, operator, space, any(s.exact for s in plan or []))
     workers = args.workers or (1 if args.scheduler else available_cores())
-    print("\n".join(time_lines(cfg, seconds, plan, workers)))
+    cores = workers if args.scheduler else available_cores()  # a cluster's cores are its own
+    refit = refits(cfg) if operator is not None else (0, 0)
+    print("\n".join(time_lines(cfg, timing, plan, workers, cores, refit, mesh_key)))
     return 0

@@ -23,8 +23,11 @@ from fracid.inverse.core.probed import ProbedSpecimen, merge_probes
 from fracid.models.forward import model_with_regularization
 from fracid.models import ConvergenceError, StepOptions, declared
 
-__all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RunRecord"]
+__all__ = ["FieldObservation", "ForwardOperator", "Observation", "ObservationKind", "RETRY_STEP_DIVISOR", "RunRecord"]
 _control_points = check_control_points  # the old private name
+#: A run that does not converge is run again once with its step increments divided by this: the retry takes
+#: about this many times the steps of the first attempt (what a failed run costs, fracid check's estimate)
+RETRY_STEP_DIVISOR = 4
 
 
 @dataclass
@@ -260,9 +263,10 @@ class ForwardOperator:
         first = self.steps
         if first is None:
             first = obs.specimen.default_steps(target) if hasattr(obs.specimen, "default_steps") else StepOptions()
-        quarter = (lambda v: None if v is None else v / 4)  # noqa: E731
+        d = RETRY_STEP_DIVISOR
+        quarter = (lambda v: None if v is None else v / d)  # noqa: E731
         smaller = replace(first, initial=quarter(first.initial), maximum=quarter(first.maximum),
-                          max_factor=first.max_factor / 4, onset_fraction=first.onset_fraction / 4)
+                          max_factor=first.max_factor / d, onset_fraction=first.onset_fraction / d)
         return (first, smaller)
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from fracid.inverse.core.plans import StagePlan, plural, runs_per_linearisation
+from fracid.inverse.core.plans import StagePlan, likely_iterations, plural, runs_per_linearisation
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.gauss_newton import gauss_newton
@@ -105,8 +105,11 @@ class KnnGaussNewton(KnnStarted):
         runs = (self.max_iterations + 1) * per_step
         text = (f"at most {self.max_iterations} linearisations and a run at the estimate, {plural(per_step, 'run')} each "
                 f"({how}): at most {runs} full-curve runs one after another without backtracking")
-        return [population_plan(self.knn, p, "knn", "KNN"), StagePlan("gauss_newton", "Gauss-Newton", runs, False, float(runs), text,
-                                                        "[identify.gauss-newton] max_iterations", per_step == 1)]
+        likely = likely_iterations(self.max_iterations)
+        return [population_plan(self.knn, p, "knn", "KNN"),
+                StagePlan("gauss_newton", "Gauss-Newton", runs, False, float(runs), text,
+                          "[identify.gauss-newton] max_iterations", per_step == 1, likely_full_runs=(likely + 1) * per_step,
+                          likely_text=f"{likely} of {self.max_iterations} linearisations")]
 
     def fit_from(self, evaluate, y_exp, C_exp, x0, C0, *, bounds=None, executor=None, blocks=()):
         """Gauss-Newton alone from the prior (x0, C0) (a multi-start fit or a noisy replicate of the

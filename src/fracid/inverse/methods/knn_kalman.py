@@ -17,8 +17,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from fracid.inverse.core.plans import StagePlan, plural, runs_per_linearisation
 from fracid.inverse.core.fit_status import NOT_CONVERGED
+from fracid.inverse.core.plans import StagePlan, likely_iterations, plural, runs_per_linearisation
 from fracid.inverse.core.sensitivity import sensitivity_label
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.kalman import kalman_filter
@@ -104,18 +104,23 @@ class KnnKalman(KnnStarted):
     def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
         """The forward runs of both stages (:class:`~fracid.inverse.core.plans.StagePlan`): the population side by
         side; the filter's steps one after another (a step of the first pass runs up to its observations, each
-        later pass is one linearisation), at most ``max_iterations`` passes and a run at the estimate."""
+        later pass is one linearisation), at most ``max_iterations`` passes and a run at the estimate, and up to
+        ``max_starts`` starts (:func:`~fracid.inverse.methods.kalman_status.restarted`). As it usually goes: one
+        start and :func:`~fracid.inverse.core.plans.likely_iterations` passes."""
         per_step, how = runs_per_linearisation(operator, p)
         groups = named_groups(self.kalman.groups, n_y)
         steps = n_y if groups is None else len(groups)
-        passes = self.kalman.max_iterations
-        later = (passes - 1) * per_step + per_step
-        runs, full = steps * per_step + later, per_step * (steps + 1) / 2 + later
+        passes, likely = self.kalman.max_iterations, likely_iterations(self.kalman.max_iterations)
+        first = per_step * (steps + 1) / 2  # a step of the first pass runs up to its observations
+        runs, full = steps * per_step + passes * per_step, first + passes * per_step
         text = (f"{steps} steps per pass, {plural(per_step, 'run')} per step ({how}), at most {passes} passes and a run at "
                 f"the estimate: at most {runs} runs one after another without backtracking, about {full:.0f} "
                 "full-curve runs")
-        return [population_plan(self.knn, p, "knn", "KNN"), StagePlan("kalman", "Kalman filter", runs, False, full, text,
-                                                        "[identify.kalman] groups and max_iterations", per_step == 1)]
+        return [population_plan(self.knn, p, "knn", "KNN"),
+                StagePlan("kalman", "Kalman filter", runs, False, full, text, "[identify.kalman] groups and max_iterations",
+                          per_step == 1, starts=self.kalman.max_starts, starts_key="[identify.kalman] max_starts",
+                          likely_full_runs=first + likely * per_step,
+                          likely_text=f"one start, {likely} of {passes} passes")]
 
     def fit_from(self, evaluate, y_exp, C_exp, x0, C0, *, bounds=None, executor=None, blocks=()):
         """The Kalman filter alone from the prior (x0, C0), started once (a multi-start filter or a noisy
