@@ -11,7 +11,7 @@ import re
 
 import numpy as np
 
-from hostile import IDENTIFY, _clean, bar_config, case, check, run_fracid, write_csv
+from hostile import IDENTIFY, case, check, run_fracid, write_csv
 
 #: E and beta of the bar: well identified by the whole curve (measured: std 0.5 % and 1.4 %, r = 0.68)
 E_BETA = {"parameters": '["E", "beta"]', "bounds": "E = [10000.0, 40000.0]\nbeta = [100.0, 500.0]", "c": "2.0"}
