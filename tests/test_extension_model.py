@@ -97,7 +97,7 @@ def test_identify_and_compare_rank_the_new_model(registered, tmp_path, capsys):
     result = json.loads((tmp_path / "out" / "result.json").read_text(encoding="utf-8"))
     assert "thin-damage" in json.dumps(result)
     assert cli.main(["compare", config, "--models", "thin-damage", "local-damage", "--workers", "1", "--quiet",
-                     "--out", str(tmp_path / "compare")]) == 0
+                     "--samples", "40", "--rounds", "3", "--out", str(tmp_path / "compare")]) == 0
     saved = json.loads((tmp_path / "compare" / "compare.json").read_text(encoding="utf-8"))
     assert sorted(saved["ranking"]) == ["local-damage", "thin-damage"] and not saved["failures"]
     thin = next(m for m in saved["models"] if m["label"] == "thin-damage")
