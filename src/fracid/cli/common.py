@@ -129,9 +129,7 @@ def shared_store(path, inputs=()) -> Path:
     path = Path(path).expanduser()
     if path.is_dir():
         raise UsageError(f"--store {path} is a directory; give the run store's file, e.g. --store {path / 'runs.sqlite'}")
-    if not path.parent.is_dir():
-        raise UsageError(f"--store {path}: the directory {path.parent} does not exist; create it, or give a store in an "
-                         "existing directory")
+    _parent_exists(path, "--store", "a store")
     if not path.exists():
         return path
     instead = f"give the run store's own file, e.g. --store {path.parent / 'runs.sqlite'}"
@@ -170,6 +168,16 @@ def _head(path: Path) -> bytes:
         return b""
 
 
+def _parent_exists(path: Path, option: str, noun: str) -> None:
+    """:class:`~fracid.runtime.exits.UsageError` naming ``option`` when the directory of ``path`` does not exist
+    (fracid makes no directory for a file the user names)."""
+    from fracid.runtime.exits import UsageError
+
+    if not path.parent.is_dir():
+        raise UsageError(f"{option} {path}: the directory {path.parent} does not exist; create it, or give {noun} in an "
+                         "existing directory")
+
+
 def output_file(path, example="fracid.toml") -> Path:
     """The file of ``-o FILE`` (``fracid init``), ``~`` expanded; :class:`~fracid.runtime.exits.UsageError` naming
     ``-o`` for a directory or a missing directory (fracid init makes no directories)."""
@@ -178,9 +186,7 @@ def output_file(path, example="fracid.toml") -> Path:
     path = Path(path).expanduser()
     if path.is_dir():
         raise UsageError(f"-o {path}: a directory; give a file name such as {path / example}")
-    if not path.parent.is_dir():
-        raise UsageError(f"-o {path}: the directory {path.parent} does not exist; create it, or give a file in an "
-                         "existing directory")
+    _parent_exists(path, "-o", "a file")
     return path
 
 
