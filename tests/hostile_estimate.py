@@ -64,9 +64,12 @@ def _grows_with_starts(proc, d):
         in proc.stdout, proc.stdout
     five, one = estimate(proc.stdout), _again(d, bar_config(kalman="max_starts = 1"), "--workers", "1")
     upper = [e["stages"]["at most"]["Kalman filter"] / e["exact"] for e in (five, one)]
-    likely = [e["stages"]["likely"]["Kalman filter"] / e["exact"] for e in (five, one)]
+    likely = [e["stages"]["likely"]["Kalman filter"] for e in (five, one)]
     assert abs(upper[0] / upper[1] - 5) < 0.75, (upper, proc.stdout)
-    assert abs(likely[0] / likely[1] - 1) < 0.15, (likely, proc.stdout)
+    # under 10 s a stage is printed to 0.1 s: each likely time is known to +-0.05 s besides the timing's noise
+    rounding = sum(0.05 / t for t in likely if t < 10)
+    ratio = (likely[0] / five["exact"]) / (likely[1] / one["exact"])
+    assert abs(ratio - 1) < 0.15 + rounding, (likely, proc.stdout)
 
 
 def _population_shares_the_workers(proc, d):
