@@ -36,7 +36,7 @@ from fracid.inverse.sampling.mixture import (
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
-__all__ = ["ESS_ADVICE", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "floor_text", "posterior",
+__all__ = ["ESS_ADVICE", "MAX_SCREENING", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "floor_text", "posterior",
            "sample_posterior"]
 
 #: Effective sample size below which the sampling has failed: the weights sit on a few draws, and
@@ -47,6 +47,10 @@ MIN_ESS_FRACTION = 0.05
 #: What to change when the sampling failed (the status's and the configuration warning's advice)
 ESS_ADVICE = ("draw more (samples_per_round, max_rounds of [posterior]), widen the first proposal (a larger "
               "inflation), or check the identification (a poor fit, an estimate at a bound, a std too small)")
+
+
+#: the coarsest screening mesh: element sizes at most this multiple of the configured mesh's
+MAX_SCREENING = 4.0
 
 
 def ess_floor(target_ess: float) -> float:
@@ -103,6 +107,12 @@ class PosteriorSettings:
         Standard-deviation multiplier of the first proposal around the Gaussian estimate.
     seed : int
         Seed of the draws (the same seed draws the same points: a rerun reuses the stored runs).
+    screening : float
+        Element sizes of the screening mesh over the configured mesh's [-]: the draws are screened on that
+        coarse mesh and corrected by fine runs (:mod:`fracid.inverse.sampling.screened`); 1 turns screening off
+        (every draw a fine run). Used by :func:`sample_posterior` where the specimen can be coarsened.
+    fine_runs : int
+        With screening: fine runs at most (in rounds of ``samples_per_round``).
     """
 
     samples_per_round: int = 200
@@ -112,12 +122,15 @@ class PosteriorSettings:
     defensive: float = 0.1
     inflation: float = 2.0
     seed: int = 0
+    screening: float = 2.0
+    fine_runs: int = 300
 
     def __post_init__(self):
         checks = [("samples_per_round", self.samples_per_round >= 2), ("max_rounds", self.max_rounds >= 1),
                   ("target_ess", self.target_ess > 1), ("components", self.components >= 1),
                   ("defensive", 0.0 <= self.defensive < 1.0), ("inflation", self.inflation > 0),
-                  ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0)]
+                  ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0),
+                  ("screening", 1.0 <= self.screening <= MAX_SCREENING), ("fine_runs", self.fine_runs >= 2)]
         for name, ok in checks:
             if not ok:
                 raise ValueError(f"posterior setting {name} = {getattr(self, name)!r} is out of range")
@@ -277,13 +290,47 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
         control = identification.control if identification.control is not None else np.arange(data.y.size)
         C_exp, marginal = error_likelihood(identification.error_terms, data.covariance, data.y, control,
                                            identification.quantities)
-    total = settings.samples_per_round * settings.max_rounds
-    if log is not None:
-        log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of {settings.samples_per_round}), "
-            f"until the effective sample size reaches {settings.target_ess:g} ([posterior] settings)")
-    with progress_bar(total, "posterior", progress) as bar:
-        result = posterior(evaluate, data.y, C_exp, space, identification.x, identification.C, settings=settings,
-                           executor=executor, progress=batch_progress(bar), log=log, marginal=marginal)
+    setup, notes = _screening(evaluate, data, identification, C_exp, marginal, settings, executor)
+    if not isinstance(setup, str):
+        from fracid.inverse.sampling.screened import screened_posterior
+
+        coarse, shift, C_coarse, mesh = setup
+        if log is not None:
+            log(f"posterior: screened on a mesh {settings.screening:g} times coarser ({mesh}) and corrected by at most "
+                f"{settings.fine_runs} fine runs, until the posterior means are as precise as {settings.target_ess:g} "
+                "independent draws ([posterior] screening, fine_runs, target_ess)")
+        with progress_bar(settings.fine_runs, "posterior (fine runs)", progress) as bar:
+            result = screened_posterior(evaluate, coarse, data.y, C_exp, C_coarse, shift, space, identification.x,
+                                        identification.C, settings=settings, executor=executor,
+                                        progress=batch_progress(bar), log=log)
+    else:
+        total = settings.samples_per_round * settings.max_rounds
+        if log is not None:
+            log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of "
+                f"{settings.samples_per_round}), until the effective sample size reaches {settings.target_ess:g} "
+                "([posterior] settings)")
+        with progress_bar(total, "posterior", progress) as bar:
+            result = posterior(evaluate, data.y, C_exp, space, identification.x, identification.C, settings=settings,
+                               executor=executor, progress=batch_progress(bar), log=log, marginal=marginal)
+    result.notes = notes
     result.units = dict(identification.units or {})
     result.std_exp = data.covariance.std()  # the measurement's, as the identification's std_exp
     return result
+
+
+def _screening(evaluate, data, identification, C_exp, marginal, settings, executor):
+    """(the screening's setup or why not, the notes to keep): screening asked (``settings.screening`` > 1) but not
+    possible is said, never silent."""
+    if settings.screening <= 1.0:
+        return "off", []
+    if marginal is not None:
+        why = "the model error is marginalised per draw (screening does not carry it yet)"
+    else:
+        from fracid.inverse.sampling.screened import screening_setup
+
+        control = identification.control if identification.control is not None else np.arange(data.y.size)
+        why = screening_setup(evaluate, data, identification.x, control, C_exp, settings, executor=executor)
+    if not isinstance(why, str):
+        return why, []
+    return why, [f"no coarse-mesh screening ([posterior] screening = {settings.screening:g}): {why}; every draw is a "
+                 "fine run"]

@@ -60,6 +60,13 @@ class PosteriorResult:
         With the model's own error marginalised (:class:`~fracid.inverse.likelihood.marginal.MarginalLikelihood`):
         the posterior of its std per group (``group``, ``blocks``, ``mean``, ``median``, ``interval_90`` [units
         of y], ``grid``, ``probability``); empty otherwise.
+    levels : Levels or None
+        With coarse-mesh screening (:func:`~fracid.inverse.sampling.screened.screened_posterior`): the coarse draws
+        and the fine subset (:class:`~fracid.inverse.sampling.levels.Levels`). ``x``, ``weights``, ``y`` are then the
+        fine runs with their exact weights, the statistics the two-level estimator's, and ``ess`` the smallest
+        number of equivalent independent draws of a parameter's mean.
+    notes : list of str
+        What the sampler could not do as asked (screening asked where the mesh cannot be coarsened).
     """
 
     names: list
@@ -82,6 +89,8 @@ class PosteriorResult:
     log_evidence: float = float("nan")
     log_evidence_error: float = float("nan")
     model_error: list = field(default_factory=list)
+    levels: object = None
+    notes: list = field(default_factory=list)
 
     @property
     def converged(self) -> bool:
@@ -96,11 +105,20 @@ class PosteriorResult:
 
     @property
     def mean(self) -> np.ndarray:
-        return self.weights @ self.x
+        return self.weights @ self.x if self.levels is None else self.levels.mean()
 
     @property
     def cov(self) -> np.ndarray:
-        return weighted_covariance(self.x, self.weights)[1]
+        return weighted_covariance(self.x, self.weights)[1] if self.levels is None else self.levels.cov()
+
+    @property
+    def mean_error(self) -> np.ndarray:
+        """The Monte-Carlo standard error of :attr:`mean` per parameter: the delta method of self-normalised
+        importance sampling, sqrt(sum_i w_i^2 (x_i - mean)^2), or the two-level estimator's
+        (:meth:`~fracid.inverse.sampling.levels.Levels.mean_variance`)."""
+        if self.levels is not None:
+            return np.sqrt(self.levels.mean_variance())
+        return np.sqrt(np.sum(self.weights[:, None] ** 2 * (self.x - self.mean) ** 2, axis=0))
 
     @property
     def std(self) -> np.ndarray:
@@ -108,6 +126,8 @@ class PosteriorResult:
 
     def quantiles(self, q) -> np.ndarray:
         """Weighted quantiles of every parameter, shape (len(q), p)."""
+        if self.levels is not None:
+            return self.levels.quantiles(q)
         return np.column_stack([weighted_quantile(self.x[:, j], self.weights, q) for j in range(self.x.shape[1])])
 
     def credible_intervals(self, level: float = 0.9) -> np.ndarray:
@@ -122,6 +142,8 @@ class PosteriorResult:
         of the model's response over the measured points (without measurement noise)."""
         ok = self.weights > 0
         q = [(1.0 - level) / 2.0, 0.5, (1.0 + level) / 2.0]
+        if self.levels is not None:
+            return self.levels.quantiles(q, "y")
         return np.column_stack([weighted_quantile(self.y[ok, i], self.weights[ok], q) for i in range(self.y.shape[1])])
 
     def resample(self, n: int, seed: int = 0) -> np.ndarray:
@@ -134,6 +156,9 @@ class PosteriorResult:
     def summary(self) -> str:
         lines = [f"posterior: {len(self.x)} draws in {self.rounds} rounds, ESS {self.ess:.0f}, "
                  f"{self.failed} failed run{'' if self.failed == 1 else 's'}; {self.status}"]
+        if self.levels is not None:
+            lines[0] = self.levels.line(self.status, self.failed)
+        lines.extend(f"  note: {note}" for note in self.notes)
         if np.isfinite(self.log_evidence):
             lines.append(f"  log evidence {self.log_evidence:.4g} +- {self.log_evidence_error:.2g} (Monte Carlo)")
         for g in self.model_error:
@@ -143,7 +168,8 @@ class PosteriorResult:
             return "\n".join([*lines, "  no credible intervals: the effective sample size is below the floor"])
         intervals = self.credible_intervals(0.9)
         for j, name in enumerate(self.names):
-            lines.append(f"  {name}: mean {self.mean[j]:.5g}, std {self.std[j]:.3g}, 90 % interval "
+            lines.append(f"  {name}: mean {self.mean[j]:.5g} (+- {self.mean_error[j]:.2g} Monte Carlo), std "
+                         f"{self.std[j]:.3g}, 90 % interval "
                          f"[{intervals[j, 0]:.5g}, {intervals[j, 1]:.5g}] {self.units.get(name, '')}".rstrip())
         return "\n".join(lines)
 
@@ -151,14 +177,16 @@ class PosteriorResult:
         """The statistics as plain values; ``interval_90`` holds None (JSON null) when :attr:`sampling_failed`."""
         intervals = self.credible_intervals(0.9).astype(object)
         intervals[~np.isfinite(intervals.astype(float))] = None
-        return {"names": list(self.names), "mean": self.mean.tolist(), "std": self.std.tolist(),
+        return {"names": list(self.names), "mean": self.mean.tolist(), "mean_error": self.mean_error.tolist(),
+                "std": self.std.tolist(),
                 "cov": self.cov.tolist(), "interval_90": intervals.tolist(), "ess": self.ess, "draws": len(self.x),
                 "rounds": self.rounds, "failed": self.failed, "status": self.status,
                 "sampling_failed": self.sampling_failed,
                 "estimate": np.asarray(self.estimate).tolist(), "estimate_cov": np.asarray(self.estimate_cov).tolist(),
                 "units": dict(self.units), "history": self.history,
                 "log_evidence": _finite_or_none(self.log_evidence),
-                "log_evidence_error": _finite_or_none(self.log_evidence_error), "model_error": self.model_error}
+                "log_evidence_error": _finite_or_none(self.log_evidence_error), "model_error": self.model_error,
+                "screening": None if self.levels is None else self.levels.summary(), "notes": list(self.notes)}
 
     def save_csv(self, path) -> Path:
         """The draws: one row each, the parameters, the weight and the log-likelihood."""

@@ -1,0 +1,148 @@
+"""The posterior at the price of a coarse mesh: a coarse mesh screens, the fine mesh corrects.
+
+A forward run on a mesh ``screening`` times coarser costs a fraction of a fine run, and its likelihood, with the
+mesh's own error in it, is an honest screening model: the values computed on the coarse mesh are shifted by their
+difference from the fine mesh's at the identification's estimate (the bias the coarse mesh adds there) and the
+data covariance is widened by that difference (correlated along each curve, as the discretisation term of
+:mod:`fracid.inverse.likelihood.discretisation`; the coarse posterior is then wider than the fine one and covers
+it). Adaptive importance sampling (:func:`~fracid.inverse.sampling.posterior.posterior`) samples the coarse
+posterior to an effective sample size of :data:`COARSE_ESS` times the target, in rounds of :data:`COARSE_ROUND`
+times ``samples_per_round``. Then rounds of ``samples_per_round`` fine runs at draws resampled from the coarse
+weights correct it (:class:`~fracid.inverse.sampling.levels.Levels`: the ratio of the fine and coarse likelihoods
+is exact, so the estimate is the fine model's, its Monte-Carlo error stated), until the equivalent independent
+draws of every parameter's mean reach ``target_ess`` or ``fine_runs`` fine runs have run.
+
+Single-level sampling of the fine model spends one fine run per draw and gets at most one effective sample per
+run; here the fine runs only carry the correction, whose variance is small when the coarse posterior is close to
+the fine one (it is measured: the fine weights' effective sample size says how good a screen the coarse mesh was).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fracid.inverse.core.sensitivity import evaluate_points
+from fracid.inverse.sampling.levels import Levels, resample_index, subset_probabilities
+from fracid.inverse.sampling.posterior import _log_likelihood, _status, posterior
+from fracid.inverse.sampling.posterior_result import PosteriorResult
+
+__all__ = ["COARSE_ESS", "COARSE_ROUND", "POOR_SCREEN", "screened_posterior"]
+
+#: the coarse level samples to this multiple of ``target_ess`` (its error is then a small part of the total)
+COARSE_ESS = 2.0
+#: a coarse round draws this multiple of ``samples_per_round`` (coarse runs cost a fraction of a fine run)
+COARSE_ROUND = 4
+#: below this share of the fine draws, the fine weights' effective sample size says the coarse mesh screened poorly
+POOR_SCREEN = 0.3
+
+
+def _normalisation(C, m: int) -> float:
+    """1/2 log det(2 pi C) of an m x m covariance: what a Gaussian likelihood's log loses to its normalisation."""
+    return 0.5 * (m * np.log(2.0 * np.pi) + C.logdet())
+
+
+def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, C0, *, settings, executor=None,
+                       progress=None, log=None) -> PosteriorResult:
+    """The fine model's posterior by coarse-mesh screening and fine-mesh correction (module docstring).
+
+    Parameters
+    ----------
+    fine, coarse : StoredOperator or callable
+        The forward operators on the fine (the configured) and the coarse mesh.
+    y_exp : ndarray, shape (m,)
+    C_fine, C_coarse : Covariance
+        The data covariance, and the one widened by the coarse mesh's error.
+    shift : ndarray, shape (m,)
+        y_coarse - y_fine at the estimate: subtracted from every coarse run's values.
+    space, x0, C0, settings, executor, progress, log
+        As :func:`~fracid.inverse.sampling.posterior.posterior`; ``settings.fine_runs`` bounds the fine runs.
+
+    Returns
+    -------
+    PosteriorResult
+        Its draws are the fine runs with their exact weights (plots, the predictive band's runs, the CSV); its
+        statistics (mean, covariance, quantiles, predictive band) are the two-level estimator's (``levels``); its
+        ``ess`` the smallest number of equivalent independent draws.
+    """
+    y_exp, shift = np.asarray(y_exp, float), np.asarray(shift, float)
+    coarse_settings = settings.replace(target_ess=COARSE_ESS * settings.target_ess,
+                                       samples_per_round=COARSE_ROUND * settings.samples_per_round)
+    first = posterior(coarse, y_exp + shift, C_coarse, space, x0, C0, settings=coarse_settings, executor=executor,
+                      log=None if log is None else (lambda text: log(f"coarse mesh: {text}")))
+    log_c = first.log_likelihood - _normalisation(C_coarse, y_exp.size)
+    rng = np.random.default_rng(settings.seed + 1)
+    index, loglik, y_fine, history = [], [], [], list(first.history)
+    levels, pick = None, subset_probabilities(first.weights)
+    while len(index) < settings.fine_runs:
+        size = min(settings.samples_per_round, settings.fine_runs - len(index))
+        picked = resample_index(pick, size, rng)
+        records = evaluate_points(fine, first.x[picked], None, executor)
+        ll, y = _log_likelihood(records, y_exp, C_fine)
+        index.extend(picked.tolist())
+        loglik.extend(ll.tolist())
+        y_fine.extend(y.tolist())
+        log_ratio = np.array(loglik) - _normalisation(C_fine, y_exp.size) - log_c[index]
+        levels = Levels(first.x, first.weights, first.y - shift, np.array(index), log_ratio,
+                        np.array(y_fine), first.log_evidence, first.log_evidence_error, pick)
+        equivalent = float(np.min(levels.equivalent_draws()))
+        history.append({"round": len(history), "draws": size, "failed": int(np.sum(~np.isfinite(ll))),
+                        "ess": equivalent, "components": 0, "level": "fine"})
+        if progress is not None:
+            progress(len(index), settings.fine_runs)
+        if log is not None:
+            log(f"fine mesh: {len(index)} runs, equivalent draws {equivalent:.0f} (target {settings.target_ess:g}), "
+                f"fine weights' ESS {levels.fine_ess:.0f}")
+        if equivalent >= settings.target_ess or not np.any(np.isfinite(levels.log_ratio)):
+            break
+    return _result(levels, np.array(loglik), first, space, y_exp, C_fine, x0, C0, settings, history)
+
+
+def _result(levels: Levels, loglik, first, space, y_exp, C_fine, x0, C0, settings, history) -> PosteriorResult:
+    """The result: the fine runs with their weights, the two-level statistics, the status of the two levels."""
+    rho = levels.rho
+    equivalent = float(np.min(levels.equivalent_draws())) if rho.any() else 0.0
+    failed = int(np.sum(~np.isfinite(levels.log_ratio)))
+    status = _status(equivalent, settings, len(levels.index), len(history))
+    if levels.fine_ess < POOR_SCREEN * len(levels.index) and status == "converged":
+        status = (f"equivalent draws {equivalent:.0f} reached, but the coarse mesh screened poorly: the fine weights' "
+                  f"effective sample size is {levels.fine_ess:.0f} of {len(levels.index)} fine draws; the intervals "
+                  "are rough; screen on a finer mesh ([posterior] screening nearer 1) or turn screening off (1)")
+    log_z, log_z_error = levels.log_evidence()
+    result = PosteriorResult(list(space.names), levels.x[levels.index], rho, loglik, levels.y_fine, y_exp,
+                             C_fine.std(), equivalent, len(history), failed + first.failed, np.asarray(x0, float),
+                             np.asarray(C0, float), (space.lower, space.upper), log=tuple(space.log), status=status,
+                             history=history, log_evidence=float(log_z), log_evidence_error=float(log_z_error))
+    result.levels = levels
+    return result
+
+
+def screening_setup(evaluate, data, x0, control, C_exp, settings, *, executor=None):
+    """What screening needs, or why it cannot screen: (coarse operator, shift, widened covariance, the coarse
+    mesh in words), or a sentence.
+
+    The coarse operator is ``evaluate``'s with every specimen ``settings.screening`` times coarser, through the same
+    run store (label "screening"); the shift y_coarse - y_fine and the widening come from one run of each at
+    ``x0`` (the fine one is the identification's, reused from the store); ``control`` holds the control value of
+    every datum (the widening's correlation runs along it).
+    """
+    from fracid.inverse.core.runs import StoredOperator
+    from fracid.inverse.likelihood.discretisation import refined_operator
+    from fracid.inverse.likelihood.record import widened
+    from fracid.inverse.likelihood.settings import DiscretisationError
+
+    if not isinstance(evaluate, StoredOperator):
+        return "the forward operator is not a stored one (no mesh to coarsen)"
+    try:
+        coarse = StoredOperator(refined_operator(evaluate.operator, 1.0 / settings.screening), evaluate.store,
+                                study="screening", retry_failed=evaluate.retry_failed)
+    except ValueError as exc:
+        return f"the mesh cannot be coarsened ({exc})"
+    fine_run, coarse_run = (op.evaluate_many([np.asarray(x0, float)], None, executor)[0] for op in (evaluate, coarse))
+    if not (fine_run.ok and coarse_run.ok):
+        failed = fine_run if not fine_run.ok else coarse_run
+        return f"a run at the estimate failed on the {'fine' if failed is fine_run else 'coarse'} mesh: {failed.error}"
+    shift = np.asarray(coarse_run.y, float) - np.asarray(fine_run.y, float)
+    C_coarse, _ = widened(C_exp, list(data.blocks), np.asarray(control, float), error=shift,
+                          length=DiscretisationError().correlation_length)
+    text = coarse.operator.observations[0].specimen.resolution().text
+    return coarse, shift, C_coarse, text
