@@ -44,8 +44,9 @@ def run_posterior_command(args) -> int:
     written = write_posterior(out, post, data=job.data, fit=result, provenance=result.provenance,
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     say(args, post.summary())
-    say(args, f"posterior forward runs: {len(post.x)} ({evaluate.computed} computed, {evaluate.reused} reused from "
-              f"the run store, {post.failed} failed)")
+    coarse = "" if post.levels is None else f" on the fine mesh, and {len(post.levels.x)} on the screening mesh"
+    say(args, f"posterior forward runs: {len(np.unique(post.x, axis=0))}{coarse} ({evaluate.computed} fine runs "
+              f"computed, {evaluate.reused} reused from the run store, {post.failed} failed)")
     wrote(args, out, written)
     if post.sampling_failed:
         print(f"fracid: posterior {post.status}. The draws are in {out / 'posterior.csv'}, without credible "

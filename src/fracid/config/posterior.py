@@ -6,7 +6,7 @@ from __future__ import annotations
 from fracid.config.checker import Checker
 from fracid.config.schema import PosteriorConfig
 from fracid.config.vocabulary import POSTERIOR_KEYS
-from fracid.inverse.sampling.posterior import MIN_ESS, ess_floor, floor_text
+from fracid.inverse.sampling.posterior import MAX_SCREENING, MIN_ESS, ess_floor, floor_text
 
 
 def read_posterior(ck: Checker, raw) -> PosteriorConfig:
@@ -34,6 +34,12 @@ def read_posterior(ck: Checker, raw) -> PosteriorConfig:
                             "must be a number > 0 (std multiplier of the first proposal around the Kalman estimate)",
                             lambda v: v > 0),
         seed=ck.integer("posterior.seed", given("seed"), "must be an integer >= 0", lambda v: v >= 0),
+        screening=ck.number("posterior.screening", given("screening"),
+                            f"must be a number with 1 <= s <= {MAX_SCREENING:g} (element sizes of the screening mesh "
+                            "over the configured mesh's; 1: no screening, every draw a fine run)",
+                            lambda v: 1 <= v <= MAX_SCREENING),
+        fine_runs=ck.integer("posterior.fine_runs", given("fine_runs"),
+                             "must be an integer >= 2 (fine-mesh runs at most, with screening)", lambda v: v >= 2),
     )
     _warn_floor(ck, config)
     return config

@@ -27,7 +27,8 @@ IDENTIFY_KEYS = ("parameters", "method", "bounds", "discretisation_error", "mode
 OUTPUT_KEYS = ("directory", "vtk_steps")
 SIMULATE_KEYS = ("target", "stop_force_fraction", "damage_threshold")
 STUDY_KEYS = ("starts", "replicates", "seed", "tolerance", "prior", "posterior")
-POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed")
+POSTERIOR_KEYS = ("samples_per_round", "max_rounds", "target_ess", "components", "defensive", "inflation", "seed",
+                  "screening", "fine_runs")
 
 # ------------------------------------------------------------------------------------ inverse methods
 

@@ -129,6 +129,14 @@ class Levels:
         rho = self.rho
         return float(1.0 / np.sum(rho**2)) if rho.any() else 0.0
 
+    @property
+    def spread(self) -> float:
+        """E_c[r^2] / E_c[r]^2 >= 1 over the coarse posterior (estimated on the subset): 1 when the fine posterior is
+        the coarse one, large when the coarse mesh screened poorly (the coarse draws then carry the fine estimate
+        with an efficiency of 1 / spread)."""
+        rho, c = self.rho, self.coarse_subset
+        return max(float(np.sum(rho**2 / np.where(c > 0, c, np.inf))), 1.0) if rho.any() else math.inf
+
     def signed(self, values: str = "x") -> tuple[np.ndarray, np.ndarray]:
         """(values, weights) of the estimator as signed weights summing to 1: the coarse draws with w_i, the
         subset's fine values with rho_j, the subset's coarse values with -1/N. ``values`` "x" (the parameters)
@@ -156,8 +164,7 @@ class Levels:
         rho, c = self.rho, self.coarse_subset
         terms = n * (rho[:, None] * (sub - mean) - c[:, None] * (sub - c @ sub))
         # the coarse draws carry the fine estimate with weights w_i r_i: their spread costs it E_c[r^2] / E_c[r]^2
-        spread = float(np.sum(rho**2 / np.where(c > 0, c, np.inf)))
-        return coarse * max(spread, 1.0) + np.var(terms, axis=0, ddof=1) / n
+        return coarse * self.spread + np.var(terms, axis=0, ddof=1) / n
 
     def equivalent_draws(self) -> np.ndarray:
         """Per parameter: the posterior variance over :meth:`mean_variance` (independent draws as precise)."""
@@ -189,7 +196,7 @@ class Levels:
         value, error = self.log_evidence()
         return {"coarse_draws": int(len(self.x)), "coarse_ess": float(1.0 / np.sum(self.w**2)),
                 "fine_runs": int(len(np.unique(self.index))), "fine_draws": int(len(self.index)),
-                "fine_ess": self.fine_ess, "equivalent_draws": self.equivalent_draws().tolist(),
+                "fine_ess": self.fine_ess, "spread": self.spread, "equivalent_draws": self.equivalent_draws().tolist(),
                 "mean_error": np.sqrt(self.mean_variance()).tolist(),
                 "log_evidence_coarse": self.log_evidence_coarse, "log_evidence": value, "log_evidence_error": error}
 
@@ -197,5 +204,5 @@ class Levels:
         """The two levels in one line (the summary's first)."""
         worst = float(np.min(self.equivalent_draws()))
         return (f"posterior: {len(self.x)} coarse draws (ESS {1.0 / np.sum(self.w**2):.0f}) corrected by "
-                f"{len(np.unique(self.index))} fine runs (their weights' ESS {self.fine_ess:.0f}): as precise as "
+                f"{len(np.unique(self.index))} fine runs (fine/coarse likelihood ratio's spread {self.spread:.2f}): as precise as "
                 f"{worst:.0f} independent draws, {failed} failed run{'' if failed == 1 else 's'}; {status}")

@@ -292,14 +292,15 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
                                            identification.quantities)
     setup, notes = _screening(evaluate, data, identification, C_exp, marginal, settings, executor)
     if not isinstance(setup, str):
-        from fracid.inverse.sampling.screened import screened_posterior
+        from fracid.inverse.sampling.screened import COARSE_ROUND, screened_posterior
 
         coarse, shift, C_coarse, mesh = setup
         if log is not None:
             log(f"posterior: screened on a mesh {settings.screening:g} times coarser ({mesh}) and corrected by at most "
                 f"{settings.fine_runs} fine runs, until the posterior means are as precise as {settings.target_ess:g} "
                 "independent draws ([posterior] screening, fine_runs, target_ess)")
-        with progress_bar(settings.fine_runs, "posterior (fine runs)", progress) as bar:
+        most = COARSE_ROUND * settings.samples_per_round * settings.max_rounds + settings.fine_runs
+        with progress_bar(most, "posterior (coarse and fine runs)", progress) as bar:
             result = screened_posterior(evaluate, coarse, data.y, C_exp, C_coarse, shift, space, identification.x,
                                         identification.C, settings=settings, executor=executor,
                                         progress=batch_progress(bar), log=log)

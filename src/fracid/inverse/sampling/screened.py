@@ -29,11 +29,14 @@ from fracid.inverse.sampling.posterior_result import PosteriorResult
 __all__ = ["COARSE_ESS", "COARSE_ROUND", "POOR_SCREEN", "screened_posterior"]
 
 #: the coarse level samples to this multiple of ``target_ess`` (its error is then a small part of the total)
-COARSE_ESS = 2.0
+COARSE_ESS = 4.0
 #: a coarse round draws this multiple of ``samples_per_round`` (coarse runs cost a fraction of a fine run)
 COARSE_ROUND = 4
-#: below this share of the fine draws, the fine weights' effective sample size says the coarse mesh screened poorly
-POOR_SCREEN = 0.3
+#: above this spread of the fine / coarse likelihood ratio (E_c[r^2] / E_c[r]^2), the coarse mesh screened poorly:
+#: its draws carry the fine estimate with an efficiency below 1 / POOR_SCREEN
+POOR_SCREEN = 3.0
+#: the subset's draws at most, as a multiple of ``fine_runs`` (a draw picked again costs no run)
+MAX_DRAWS = 4
 
 
 def _normalisation(C, m: int) -> float:
@@ -67,14 +70,16 @@ def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, 
     y_exp, shift = np.asarray(y_exp, float), np.asarray(shift, float)
     coarse_settings = settings.replace(target_ess=COARSE_ESS * settings.target_ess,
                                        samples_per_round=COARSE_ROUND * settings.samples_per_round)
+    most = coarse_settings.samples_per_round * coarse_settings.max_rounds
     first = posterior(coarse, y_exp + shift, C_coarse, space, x0, C0, settings=coarse_settings, executor=executor,
-                      log=None if log is None else (lambda text: log(f"coarse mesh: {text}")))
+                      log=None if log is None else (lambda text: log(f"coarse mesh: {text}")),
+                      progress=None if progress is None else (lambda done, _: progress(done, most + settings.fine_runs)))
     log_c = first.log_likelihood - _normalisation(C_coarse, y_exp.size)
     rng = np.random.default_rng(settings.seed + 1)
     index, loglik, y_fine, history = [], [], [], list(first.history)
     levels, pick = None, subset_probabilities(first.weights)
-    while len(index) < settings.fine_runs:
-        size = min(settings.samples_per_round, settings.fine_runs - len(index))
+    while len(set(index)) < settings.fine_runs and len(index) < MAX_DRAWS * settings.fine_runs:
+        size = min(settings.samples_per_round, settings.fine_runs - len(set(index)))
         picked = resample_index(pick, size, rng)
         records = evaluate_points(fine, first.x[picked], None, executor)
         ll, y = _log_likelihood(records, y_exp, C_fine)
@@ -88,12 +93,14 @@ def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, 
         history.append({"round": len(history), "draws": size, "failed": int(np.sum(~np.isfinite(ll))),
                         "ess": equivalent, "components": 0, "level": "fine"})
         if progress is not None:
-            progress(len(index), settings.fine_runs)
+            progress(len(first.x) + len(set(index)), len(first.x) + settings.fine_runs)
         if log is not None:
-            log(f"fine mesh: {len(index)} runs, equivalent draws {equivalent:.0f} (target {settings.target_ess:g}), "
-                f"fine weights' ESS {levels.fine_ess:.0f}")
+            log(f"fine mesh: {len(set(index))} runs, equivalent draws {equivalent:.0f} (target "
+                f"{settings.target_ess:g}), fine/coarse likelihood ratio's spread {levels.spread:.2f}")
         if equivalent >= settings.target_ess or not np.any(np.isfinite(levels.log_ratio)):
             break
+    if progress is not None:
+        progress(len(first.x) + len(set(index)), len(first.x) + len(set(index)))
     return _result(levels, np.array(loglik), first, space, y_exp, C_fine, x0, C0, settings, history)
 
 
@@ -103,10 +110,11 @@ def _result(levels: Levels, loglik, first, space, y_exp, C_fine, x0, C0, setting
     equivalent = float(np.min(levels.equivalent_draws())) if rho.any() else 0.0
     failed = int(np.sum(~np.isfinite(levels.log_ratio)))
     status = _status(equivalent, settings, len(levels.index), len(history))
-    if levels.fine_ess < POOR_SCREEN * len(levels.index) and status == "converged":
-        status = (f"equivalent draws {equivalent:.0f} reached, but the coarse mesh screened poorly: the fine weights' "
-                  f"effective sample size is {levels.fine_ess:.0f} of {len(levels.index)} fine draws; the intervals "
-                  "are rough; screen on a finer mesh ([posterior] screening nearer 1) or turn screening off (1)")
+    if levels.spread > POOR_SCREEN and not status.startswith("failed"):
+        status = (f"equivalent draws {equivalent:.0f}, but the coarse mesh screened poorly: the spread of the fine / "
+                  f"coarse likelihood ratio is {levels.spread:.2g} (> {POOR_SCREEN:g}), so the stated errors rest on "
+                  "few fine runs and the intervals are rough; screen on a finer mesh ([posterior] screening nearer 1) "
+                  "or turn screening off (1)")
     log_z, log_z_error = levels.log_evidence()
     result = PosteriorResult(list(space.names), levels.x[levels.index], rho, loglik, levels.y_fine, y_exp,
                              C_fine.std(), equivalent, len(history), failed + first.failed, np.asarray(x0, float),
