@@ -14,7 +14,7 @@ The bar with a weak zone (60 elements), force-elongation curve at 12 points up t
    contain the truth, per parameter.
 
     python benchmarks/posterior_bar.py reference [--grid 61] [--emcee 2000] [--workers 2]
-    python benchmarks/posterior_bar.py coverage [--replicates 20] [--workers 2]
+    python benchmarks/posterior_bar.py coverage [--replicates 20] [--workers 2] [--screening 2]
 """
 
 from __future__ import annotations
@@ -22,13 +22,16 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 import fracid
 from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
+from fracid.data.covariance_matrix import as_covariance
+from fracid.inverse.core.runs import StoredOperator
+from fracid.inverse.sampling.posterior import PosteriorSettings, posterior, sample_posterior
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.methods.strategy import identify
 from fracid.runtime.executors import executor_session
@@ -52,11 +55,19 @@ def noisy_data(operator, seed):
 
 
 def identify_and_sample(operator, y, C, executor, seed=0, settings=SETTINGS):
+    """The identification and the posterior; with ``settings.screening`` > 1 the two-level posterior of
+    :func:`~fracid.inverse.sampling.posterior.sample_posterior` (the bar's mesh coarsened for screening)."""
     start = time.perf_counter()
     estimate = identify(operator, y, C, SPACE, n=16, k=4, groups=[np.arange(0, 4), np.arange(4, 8), np.arange(8, 12)], executor=executor, progress=False)
     t_kf = time.perf_counter() - start
-    result = posterior(operator, y, C, SPACE, estimate.x, estimate.C, settings=settings.replace(seed=seed),
-                       executor=executor)
+    if settings.screening > 1:
+        data = SimpleNamespace(y=y, covariance=as_covariance(C, y.size), blocks=[("global", 0, y.size)])
+        seed_of = SimpleNamespace(x=estimate.x, C=estimate.C, control=POINTS, units={}, error_terms=None)
+        result = sample_posterior(StoredOperator(operator), data, SPACE, seed_of, settings.replace(seed=seed),
+                                  executor=executor, progress=False)
+    else:
+        result = posterior(operator, y, C, SPACE, estimate.x, estimate.C, settings=settings.replace(seed=seed),
+                           executor=executor)
     return estimate, result, t_kf, time.perf_counter() - start - t_kf
 
 
@@ -175,7 +186,7 @@ def figure(result, estimate, points, p):
 def coverage(args):
     operator = bar_operator()
     inside_post, inside_kf, ess = np.zeros(2, int), np.zeros(2, int), []
-    settings = SETTINGS.replace(target_ess=400)
+    settings = SETTINGS.replace(target_ess=400, screening=args.screening, samples_per_round=100)
     with executor_session(args.workers) as executor:
         for replicate in range(args.replicates):
             y, C = noisy_data(operator, seed=100 + replicate)
@@ -184,8 +195,10 @@ def coverage(args):
             inside_post += (interval[:, 0] <= TRUTH) & (TRUTH <= interval[:, 1])
             inside_kf += np.abs(estimate.x - TRUTH) <= 1.645 * estimate.std
             ess.append(result.ess)
+            runs = len(result.x) if result.levels is None else \
+                f"{len(result.levels.x)} coarse and {len(np.unique(result.x, axis=0))} fine"
             print(f"replicate {replicate + 1}: posterior 90 % {np.array2string(interval, precision=4)} "
-                  f"(ESS {result.ess:.0f}, {len(result.x)} runs, {t_post:.0f} s); Kalman {estimate.x} +- "
+                  f"(ESS {result.ess:.0f}, {runs} runs, {t_post:.0f} s){''.join(result.notes)}; Kalman {estimate.x} +- "
                   f"{1.645 * estimate.std}; counts posterior {inside_post}, Kalman {inside_kf}", flush=True)
     print(f"coverage of the truth by the 90 % intervals over {args.replicates} replicates (c, beta): posterior "
           f"{inside_post.tolist()}, Kalman filter Gaussian {inside_kf.tolist()}; ESS median {np.median(ess):.0f}")
@@ -198,6 +211,8 @@ def main(argv=None):
     parser.add_argument("--emcee", type=int, default=0, help="emcee steps of 16 walkers (0: no emcee run)")
     parser.add_argument("--replicates", type=int, default=20)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--screening", type=float, default=1.0,
+                        help="coverage: screen on a mesh this many times coarser (1: every draw a fine run)")
     args = parser.parse_args(argv)
     reference(args) if args.what == "reference" else coverage(args)
 

@@ -93,8 +93,15 @@ def plan_lines(cfg, method, plan) -> list:
     """The stages of the identification and their forward runs; what ``fracid posterior`` adds."""
     lines = [stage.line() for stage in plan] or [f"stages of {method.name}: no plan of their forward runs"]
     post = cfg.posterior
-    lines.append(f"fracid posterior adds at most {post.samples_per_round * post.max_rounds} runs "
-                 f"([posterior] samples_per_round x max_rounds)")
+    if post.screening > 1:
+        from fracid.inverse.sampling.screened import COARSE_ROUND
+
+        lines.append(f"fracid posterior adds at most {COARSE_ROUND * post.samples_per_round * post.max_rounds} runs "
+                     f"on a mesh {post.screening:g} times coarser ({COARSE_ROUND} x [posterior] samples_per_round x "
+                     f"max_rounds) and at most {post.fine_runs} fine runs ([posterior] screening, fine_runs)")
+    else:
+        lines.append(f"fracid posterior adds at most {post.samples_per_round * post.max_rounds} runs "
+                     f"([posterior] samples_per_round x max_rounds)")
     return lines + error_terms_lines(cfg)
 
 

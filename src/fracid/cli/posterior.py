@@ -45,8 +45,8 @@ def run_posterior_command(args) -> int:
                               title=f"fracid posterior: {Path(job.cfg.path).name}")
     say(args, post.summary())
     coarse = "" if post.levels is None else f" on the fine mesh, and {len(post.levels.x)} on the screening mesh"
-    say(args, f"posterior forward runs: {len(np.unique(post.x, axis=0))}{coarse} ({evaluate.computed} fine runs "
-              f"computed, {evaluate.reused} reused from the run store, {post.failed} failed)")
+    say(args, f"posterior forward runs: {len(np.unique(post.x, axis=0))}{coarse} ({evaluate.computed} computed, "
+              f"{evaluate.reused} reused from the run store, {post.failed} failed)")
     wrote(args, out, written)
     if post.sampling_failed:
         print(f"fracid: posterior {post.status}. The draws are in {out / 'posterior.csv'}, without credible "

@@ -338,9 +338,22 @@ def statistics_table(result) -> str:
     """HTML table of the sampler's draws, rounds, effective sample size, failed runs and status."""
     from fracid.report.markup import html_table, num
 
-    return html_table(["", ""], [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
-                             ["effective sample size (ESS)", num(result.ess, 4)], ["failed runs", result.failed],
-                             ["status", result.status]], text_columns=(0, 1))
+    errors = ", ".join(f"{name} {num(e, 2)}" for name, e in zip(result.names, result.mean_error))
+    rows = [["draws (forward runs)", len(result.x)], ["rounds", result.rounds],
+            ["effective sample size (ESS)", num(result.ess, 4)],
+            ["Monte-Carlo error of the posterior means", errors], ["failed runs", result.failed]]
+    if result.levels is not None:
+        levels = result.levels.summary()
+        rows[0:3] = [["draws on the screening (coarse) mesh", levels["coarse_draws"]],
+                     ["their effective sample size", num(levels["coarse_ess"], 4)],
+                     ["fine-mesh runs (the correction)", levels["fine_runs"]],
+                     ["spread of the fine / coarse likelihood ratio (1: the coarse mesh screens perfectly)",
+                      num(levels["spread"], 3)],
+                     ["effective sample size (ESS): the fewest equivalent independent draws", num(result.ess, 4)],
+                     ["equivalent independent draws per parameter (its posterior mean as precise as that many draws)",
+                      ", ".join(f"{n} {num(v, 4)}" for n, v in zip(result.names, levels["equivalent_draws"]))]]
+    rows += [[f"note: {note}", ""] for note in result.notes] + [["status", result.status]]
+    return html_table(["", ""], rows, text_columns=(0, 1))
 
 
 def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid posterior", provenance=None) -> Path:
@@ -352,9 +365,11 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
 
     table, stats = comparison_table(result), statistics_table(result)
     status = esc(result.status) if result.converged else f'<span class="warn">{esc(result.status)}</span>'
-    history = html_table(["round", "draws", "failed", "ESS after the round", "proposal components"],
-                     [[h.get("round", k) + 1, h.get("draws", ""), h.get("failed", ""), num(h.get("ess"), 4),
-                       h.get("components", "")] for k, h in enumerate(result.history)])
+    history = html_table(["round", "mesh", "draws", "failed", "ESS after the round (fine: equivalent draws)",
+                          "proposal components"],
+                     [[k + 1, h.get("level", "coarse" if result.levels is not None else "fine"), h.get("draws", ""),
+                       h.get("failed", ""), num(h.get("ess"), 4), h.get("components", "") or ""]
+                      for k, h in enumerate(result.history)])
     names = ", ".join(str(n) for n in result.names)
     body = [
         f"<h1>{esc(title)}</h1>",

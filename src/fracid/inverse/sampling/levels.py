@@ -168,8 +168,9 @@ class Levels:
 
     def equivalent_draws(self) -> np.ndarray:
         """Per parameter: the posterior variance over :meth:`mean_variance` (independent draws as precise)."""
-        variance = np.diag(self.cov())
-        return np.where(self.mean_variance() > 0, variance / np.maximum(self.mean_variance(), 1e-300), np.inf)
+        # signed weights can give a negative variance when the correction is wild: no draw is worth anything then
+        variance, error = np.maximum(np.diag(self.cov()), 0.0), self.mean_variance()
+        return np.where(error > 0, variance / np.maximum(error, 1e-300), np.where(variance > 0, np.inf, 0.0))
 
     def log_evidence(self) -> tuple[float, float]:
         """log Z_f = log Z_c + log mean_j r_j, and its Monte-Carlo error: the coarse one and the correction's

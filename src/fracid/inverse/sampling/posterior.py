@@ -313,7 +313,7 @@ def sample_posterior(evaluate, data, space, identification, settings, *, executo
         with progress_bar(total, "posterior", progress) as bar:
             result = posterior(evaluate, data.y, C_exp, space, identification.x, identification.C, settings=settings,
                                executor=executor, progress=batch_progress(bar), log=log, marginal=marginal)
-    result.notes = notes
+    result.notes = [*notes, *getattr(result, "notes", [])]
     result.units = dict(identification.units or {})
     result.std_exp = data.covariance.std()  # the measurement's, as the identification's std_exp
     return result
@@ -329,7 +329,8 @@ def _screening(evaluate, data, identification, C_exp, marginal, settings, execut
     else:
         from fracid.inverse.sampling.screened import screening_setup
 
-        control = identification.control if identification.control is not None else np.arange(data.y.size)
+        control = getattr(identification, "control", None)
+        control = control if control is not None else np.arange(data.y.size)
         why = screening_setup(evaluate, data, identification.x, control, C_exp, settings, executor=executor)
     if not isinstance(why, str):
         return why, []

@@ -29,7 +29,7 @@ from fracid.inverse.sampling.posterior_result import PosteriorResult
 __all__ = ["COARSE_ESS", "COARSE_ROUND", "POOR_SCREEN", "screened_posterior"]
 
 #: the coarse level samples to this multiple of ``target_ess`` (its error is then a small part of the total)
-COARSE_ESS = 4.0
+COARSE_ESS = 2.5
 #: a coarse round draws this multiple of ``samples_per_round`` (coarse runs cost a fraction of a fine run)
 COARSE_ROUND = 4
 #: above this spread of the fine / coarse likelihood ratio (E_c[r^2] / E_c[r]^2), the coarse mesh screened poorly:
@@ -97,11 +97,26 @@ def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, 
         if log is not None:
             log(f"fine mesh: {len(set(index))} runs, equivalent draws {equivalent:.0f} (target "
                 f"{settings.target_ess:g}), fine/coarse likelihood ratio's spread {levels.spread:.2f}")
-        if equivalent >= settings.target_ess or not np.any(np.isfinite(levels.log_ratio)):
+        if levels.spread > POOR_SCREEN:
+            return _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels)
+        if equivalent >= settings.target_ess:
             break
     if progress is not None:
         progress(len(first.x) + len(set(index)), len(first.x) + len(set(index)))
     return _result(levels, np.array(loglik), first, space, y_exp, C_fine, x0, C0, settings, history)
+
+
+def _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels) -> PosteriorResult:
+    """Single-level sampling on the fine mesh, when the first fine runs show that the coarse mesh screens poorly
+    (the coarse posterior is far from the fine one: correcting it would cost more fine runs than sampling anew)."""
+    why = (f"the coarse mesh screened poorly (the spread of the fine / coarse likelihood ratio is {levels.spread:.3g} > "
+           f"{POOR_SCREEN:g} after {len(np.unique(levels.index))} fine runs): every draw is a fine run")
+    if log is not None:
+        log(f"posterior: {why}")
+    result = posterior(fine, y_exp, C_fine, space, x0, C0, settings=settings, executor=executor, log=log,
+                       progress=progress)
+    result.notes = [why]
+    return result
 
 
 def _result(levels: Levels, loglik, first, space, y_exp, C_fine, x0, C0, settings, history) -> PosteriorResult:
