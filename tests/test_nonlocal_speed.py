@@ -113,3 +113,36 @@ def test_coupling_is_minus_g_times_the_off_diagonal_average_times_h(damaged_stat
     np.testing.assert_allclose(coupling.toarray(), expected, rtol=0, atol=1e-12 * np.abs(expected).max())
     # the shared matrix keeps its diagonal (the coupling zeroed it in its own copy of the rows)
     np.testing.assert_array_equal(av.matrix.diagonal(), av.self_weight.ravel())
+
+
+def test_bounded_average_gives_every_row_that_reaches_the_floor_to_the_last_bit(empty_cache):
+    specimen = DogBone(size=50.0, h_fine=4.0)
+    problem = DamageModel("integral").build(specimen, fracid.DamageParameters(c=4.0))
+    av, rng = problem.averaging, np.random.default_rng(5)
+    n = av.matrix.shape[0]
+    x = np.exp(-np.sum(problem.disc.points.reshape(n, -1) ** 2, axis=1) / 50.0) + 0.01 * rng.uniform(size=n)
+    full = av.matrix @ x
+    upper = av.bound.weights @ np.maximum.reduceat(x[av.bound.order], av.bound.starts)
+    assert np.all(upper >= full * (1 - 1e-12))  # a bound
+    for level in (0.3, 0.6, 0.9):
+        floor = np.full(n, level * full.max())
+        floor[rng.choice(n, 20)] = np.inf  # points that cannot damage are never needed
+        rows, values = nonlocal_average.bounded_average(av, x, floor)
+        reached = np.flatnonzero(full >= floor)
+        assert 0 < reached.size and np.isin(reached, rows).all() and rows.size < n
+        np.testing.assert_array_equal(values, full[rows])  # the same sums in the same order
+    sliced = av.rows["matrix"]
+    nonlocal_average.bounded_average(av, x, floor * 1.01)  # needs fewer rows: the slice is kept
+    assert av.rows["matrix"] is sliced
+
+
+def test_integral_history_is_the_average_at_every_point(damaged_state):
+    problem, q, kappa_old = damaged_state
+    _, arrays, _ = problem.evaluate(q, kappa_old)
+    eps = forms.strain_of(problem.disc.strain_operator, problem.gather(q))
+    eq, _ = problem.law.equivalent_strain(problem.disc.strain_state, eps, problem.params)
+    expected, _ = update_history(kappa_old, (problem.averaging.matrix @ eq.ravel()).reshape(eq.shape))
+    np.testing.assert_array_equal(arrays.history, expected)
+    # also below the onset, where the residual did not need the average
+    below = expected < problem.params.kappa_i
+    assert below.any() and np.any(expected[below] > kappa_old[below])

@@ -145,12 +145,80 @@ class NonlocalAveraging(NamedTuple):
         (-1: eliminated dof).
     n_free : int
         Number of free dofs.
+    bound : CellBound
+        The bound of the averages by cells of points (:func:`bounded_average`).
+    rows : dict
+        The rows of A that :func:`bounded_average` sliced last (``"mask"``, ``"matrix"``).
     """
 
     matrix: sp.csr_matrix
     self_weight: np.ndarray
     point_dofs: np.ndarray
     n_free: int
+    bound: "CellBound"
+    rows: dict
+
+
+class CellBound(NamedTuple):
+    """An upper bound of the averages A x from the maxima of x over cells of points (l by l squares).
+
+    Attributes
+    ----------
+    order : ndarray of int, shape (n_pts,)
+        The points sorted by cell.
+    starts : ndarray of int, shape (n_cells,)
+        Where each cell starts in ``order``.
+    weights : scipy.sparse.csr_matrix, shape (n_pts, n_cells)
+        sum over the points j of cell c of A_ij [-]: sum_c weights_ic max_{j in c} x_j >= (A x)_i, as A >= 0.
+    """
+
+    order: np.ndarray
+    starts: np.ndarray
+    weights: sp.csr_matrix
+
+
+def cell_bound(matrix: sp.csr_matrix, points, size: float) -> CellBound:
+    """The :class:`CellBound` of an averaging matrix over ``points`` (n_pts, dim) [mm], cells of ``size`` [mm]."""
+    points = np.asarray(points, dtype=float)
+    corner = np.floor((points - points.min(axis=0)) / size).astype(np.int64)
+    _, cell = np.unique(corner, axis=0, return_inverse=True)
+    cell = cell.ravel()
+    order = np.argsort(cell, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(cell[order]) != 0])
+    members = sp.csr_matrix((np.ones(cell.size), (np.arange(cell.size), cell)), shape=(cell.size, starts.size))
+    return CellBound(order, starts, (matrix @ members).tocsr())
+
+
+def bounded_average(averaging: NonlocalAveraging, x, floor, margin: float = 0.8):
+    """The rows of A x that can reach ``floor``, exactly: (rows, (A x)[rows]).
+
+    Parameters
+    ----------
+    averaging : NonlocalAveraging
+    x : ndarray, shape (n_pts,)
+        The values averaged (the local equivalent strain) [-].
+    floor : ndarray, shape (n_pts,)
+        The value below which a point's average is not needed (inf: never) [-].
+    margin : float
+        Rows are sliced from A where the bound reaches ``margin`` times the floor, and the slice is kept
+        while it holds every row that must be computed (the next iterations of a step need about the same).
+
+    Returns
+    -------
+    rows : ndarray of int
+        A superset of the points whose average can reach the floor.
+    values : ndarray
+        (A x)[rows], equal to the full product's to the last bit (the same row sums in the same order).
+    """
+    bound = averaging.bound
+    upper = bound.weights @ np.maximum.reduceat(x[bound.order], bound.starts)
+    # the bound holds in exact arithmetic; its rounding and the product's are far below 1e-9 relative
+    needed = upper >= floor * (1.0 - 1e-9)
+    cached = averaging.rows
+    if "mask" not in cached or not np.all(cached["mask"][needed]):
+        mask = needed | (upper >= margin * floor)
+        cached.update(mask=mask, matrix=averaging.matrix[np.flatnonzero(mask)])
+    return np.flatnonzero(cached["mask"]), cached["matrix"] @ x
 
 
 #: the averaging matrices built last, by mesh and internal length (:func:`cached_averaging_matrix`)
@@ -162,9 +230,10 @@ _CACHE_LOCK = threading.Lock()
 CACHE_SIZE = 2
 
 
-def cached_averaging_matrix(points, weights, length: float, cutoff: float = 4.0, mirror=()) -> sp.csr_matrix:
+def cached_averaging_matrix(points, weights, length: float, cutoff: float = 4.0, mirror=(), with_bound=False):
     """:func:`averaging_matrix`, built once per process for the same points, weights, length, cutoff and
-    planes, then shared (read-only: the caller must not change it).
+    planes, then shared (read-only: the caller must not change it); ``with_bound``: (A, its
+    :class:`CellBound` of cells l by l).
 
     A process that runs many forward runs (a pool worker, a sampler, the finite differences of one
     run) builds it once per internal length: on the demo beam a build costs more than a gradient run.
@@ -178,13 +247,15 @@ def cached_averaging_matrix(points, weights, length: float, cutoff: float = 4.0,
     with _CACHE_LOCK:
         if key in _CACHE:
             _CACHE.move_to_end(key)
-            return _CACHE[key]
+            entry = _CACHE[key]
+            return entry if with_bound else entry[0]
     matrix = averaging_matrix(points, weights, length, cutoff, mirror)
+    entry = (matrix, cell_bound(matrix, points, length))
     with _CACHE_LOCK:
-        _CACHE[key] = matrix
+        _CACHE[key] = entry
         while len(_CACHE) > CACHE_SIZE:
             _CACHE.popitem(last=False)
-    return matrix
+    return entry if with_bound else matrix
 
 
 def nonlocal_averaging(disc, length: float, element_dofs, n_free: int, cutoff: float = 4.0, mirror=()) -> NonlocalAveraging:
@@ -204,9 +275,10 @@ def nonlocal_averaging(disc, length: float, element_dofs, n_free: int, cutoff: f
         See :func:`averaging_matrix`.
     """
     n_el, n_q = disc.weights.shape
-    A = cached_averaging_matrix(disc.points.reshape(n_el * n_q, -1), disc.weights.ravel(), length, cutoff, mirror)
+    points = disc.points.reshape(n_el * n_q, -1)
+    A, bound = cached_averaging_matrix(points, disc.weights.ravel(), length, cutoff, mirror, with_bound=True)
     return NonlocalAveraging(A, A.diagonal().reshape(n_el, n_q), np.repeat(np.asarray(element_dofs), n_q, axis=0),
-                             int(n_free))
+                             int(n_free), bound, {})
 
 
 def softening_coupling(averaging: NonlocalAveraging, g, h, active) -> sp.csc_matrix | None:
