@@ -10,6 +10,7 @@ from test_tangent import post_peak_state
 import fracid
 from fracid.fem.formulations import forms, nonlocal_average
 from fracid.fem.material.damage import update_history
+from fracid.fem.material.laws import DAMAGE_LAWS
 from fracid.fem.formulations.nonlocal_average import (averaging_length_derivative, averaging_matrix,
                                                       cached_averaging_matrix)
 from fracid.models import DamageModel
@@ -146,3 +147,14 @@ def test_integral_history_is_the_average_at_every_point(damaged_state):
     # also below the onset, where the residual did not need the average
     below = expected < problem.params.kappa_i
     assert below.any() and np.any(expected[below] > kappa_old[below])
+
+
+@pytest.mark.parametrize("name", sorted(DAMAGE_LAWS))
+def test_damage_laws_do_not_damage_below_their_onset(name):
+    """What the bounded average relies on: below onset(params) omega and d omega / d kappa are zero."""
+    law, params = DAMAGE_LAWS[name](), fracid.DamageParameters()
+    onset = law.softening.onset(params)
+    omega, d_omega = law.softening.damage(np.array([0.0, 0.5 * onset, onset * (1 - 1e-12)]), params)
+    assert np.all(omega == 0.0) and np.all(d_omega == 0.0)
+    omega, d_omega = law.softening.damage(np.array([onset * 1.01]), params)
+    assert omega[0] > 0.0 and d_omega[0] > 0.0
