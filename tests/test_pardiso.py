@@ -113,6 +113,41 @@ def test_analysis_reused_while_pattern_is_unchanged(phases):
     assert solver.n_analyses == 3
 
 
+def bordered(n, seed, coupled=(), reach=()):
+    """A random matrix bordered by a row and a column with a zero diagonal (as the path's tangents), plus a
+    dense block between the rows ``coupled`` and the columns ``reach`` (as the integral model's coupling)."""
+    rng = np.random.default_rng(seed)
+    border = np.zeros(n)
+    border[rng.choice(n, 5, replace=False)] = 1.0
+    inner = random_unsymmetric(n, 0.02, seed=seed).tolil()
+    for i in coupled:
+        inner[i, list(reach)] = 0.05 * rng.standard_normal(len(reach))
+    return sp.bmat([[inner.tocsc(), sp.csc_matrix(-border[:, None])], [sp.csc_matrix(border[None, :]), None]]).tocsc()
+
+
+def test_a_grown_pattern_keeps_the_ordering_with_the_grown_rows_moved_last(phases):
+    rng = np.random.default_rng(3)
+    solver = PardisoSolver()
+    base = bordered(300, seed=5)
+    solver.solve(base, rng.standard_normal(301))
+    ordering = solver._perm.copy()
+    assert phases == [11, -1, 11, 23] and ordering[-1] == 300  # nested dissection, then with the border last
+    coupled, reach = [4, 17, 250], range(100, 220)
+    grown = bordered(300, seed=5, coupled=coupled, reach=reach)
+    grown = grown + base * 0.0  # holds every entry of the base pattern (the coupling is added to it)
+    grown.sort_indices()
+    b = rng.standard_normal(301)
+    assert relative_error(solver.solve(grown, b), spla.spsolve(grown, b)) < 1e-10
+    assert phases[4:] == [-1, 11, 23]  # one analysis, without the nested dissection
+    # the base ordering, the 3 rows that gained entries (fewer than the 120 columns) after it, the border last
+    assert solver._perm[-1] == 300 and sorted(solver._perm[-4:-1]) == coupled
+    np.testing.assert_array_equal(solver._perm[:-4], ordering[~np.isin(ordering, coupled)][:-1])
+    # a pattern that is not a superset is ordered anew (and becomes the base)
+    other = bordered(300, seed=6)
+    assert relative_error(solver.solve(other, b), spla.spsolve(other, b)) < 1e-10
+    assert phases[7:] == [-1, 11, -1, 11, 23]
+
+
 def test_memory_released_when_the_solver_is_collected(phases):
     solver = PardisoSolver()
     solver.solve(random_unsymmetric(100, 0.05, seed=4), np.ones(100))

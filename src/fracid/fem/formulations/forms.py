@@ -8,12 +8,13 @@ equivalent strain, values and derivatives) and the history update
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
 
 from fracid.fem.material.damage import update_history
-from fracid.fem.formulations.nonlocal_average import NonlocalAveraging, softening_coupling
+from fracid.fem.formulations.nonlocal_average import NonlocalAveraging, bounded_average, softening_coupling
 
 
 class ElementArrays:
@@ -30,20 +31,24 @@ class ElementArrays:
         It fills the problem's tangent buffer, so it must be taken before the next evaluation.
     reference : dict {field: ndarray, shape (n_el, n_dof_el of the field)}
         Per field, the element vectors whose assembled norm scales that field's residual.
-    history : ndarray or dict of ndarray
+    history : ndarray or dict of ndarray, or callable
         The trial history at this state, in the layout the problem declares (its ``history_spec``):
-        the solver carries it opaquely to the next step.
-    coupling : sparse matrix (n_free, n_free), optional
-        Tangent entries between points of different elements (the integral model) [N/mm].
+        the solver carries it opaquely to the next step. A function of no argument is called at the
+        first access (the integral model's needs the average at every point, the residual only near
+        the damaged zone).
+    coupling : sparse matrix (n_free, n_free), callable or None, optional
+        Tangent entries between points of different elements (the integral model) [N/mm]; like the
+        tangent, a function of no argument is called at the first access (only the iterations that
+        factorize need it, and it costs far more than the residual).
     outputs : dict {name: ndarray}, optional
         Named point outputs the formulation derives from the state (damage, stress, ...).
     """
 
-    __slots__ = ("residual", "_tangent", "reference", "history", "outputs", "coupling")
+    __slots__ = ("residual", "_tangent", "reference", "_history", "outputs", "_coupling")
 
     def __init__(self, residual, tangent, reference, history, *, coupling=None, outputs=None):
         self.residual, self._tangent, self.reference = residual, tangent, reference
-        self.history, self.coupling = history, coupling
+        self._history, self._coupling = history, coupling
         self.outputs = dict(outputs or {})
 
     @property
@@ -51,6 +56,18 @@ class ElementArrays:
         if callable(self._tangent):
             self._tangent = self._tangent()
         return self._tangent
+
+    @property
+    def history(self):
+        if callable(self._history):
+            self._history = self._history()
+        return self._history
+
+    @property
+    def coupling(self):
+        if callable(self._coupling):
+            self._coupling = self._coupling()
+        return self._coupling
 
     @property
     def omega(self) -> np.ndarray:
@@ -61,8 +78,8 @@ class ElementArrays:
 
     def _replace(self, **changes) -> "ElementArrays":
         """A copy with some of the constructor's arguments changed."""
-        values = dict(residual=self.residual, tangent=self._tangent, reference=self.reference, history=self.history,
-                      coupling=self.coupling, outputs=self.outputs)
+        values = dict(residual=self.residual, tangent=self._tangent, reference=self.reference, history=self._history,
+                      coupling=self._coupling, outputs=self.outputs)
         values.update(changes)
         return ElementArrays(**values)
 
@@ -301,16 +318,36 @@ def integral_damage(disc, law, params, const: ModelConstants, ue, kappa_old, out
     B, w = disc.strain_operator, disc.weights
     eps = strain_of(B, ue)
     eq, d_eq = law.equivalent_strain(disc.strain_state, eps, params)
-    ebar = (averaging.matrix @ eq.ravel()).reshape(eq.shape)
-    kappa, loading = update_history(kappa_old, ebar)
+    # the damage needs the average only where it can reach the history and the onset (elsewhere kappa
+    # stays and omega with it); the history itself, at every point, is built once the step converged
+    floor = np.where(const.damageable > 0.0, np.maximum(kappa_old, law.softening.onset(params)), np.inf)
+    rows, ebar = bounded_average(averaging, eq.ravel(), floor.ravel())
+    kappa, loading = kappa_old.copy(), np.zeros(kappa_old.shape, dtype=bool)
+    kappa.flat[rows], loading.flat[rows] = update_history(kappa_old.ravel()[rows], ebar)
     omega, d_omega = masked_damage(law, params, const, kappa)
     sigma_eff, f_u, w_sec = _secant_equilibrium(B, const, w, ue, omega)
-    secant = _secant(B, const, w_sec)
-    g = bt(sigma_eff, B) * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
-    h = bt(d_eq, B)  # d eps_eq / d u at each point
-    out_tangent[:] = secant - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
-    coupling = softening_coupling(averaging, g, h, loading & (d_omega > 0.0))
-    return ElementArrays(f_u, out_tangent, {"u": f_u}, kappa, coupling=coupling, outputs={"omega": omega})
+
+    @functools.cache  # shared by the element tangent and the coupling (and a copy of these arrays)
+    def softening():
+        g = bt(sigma_eff, B) * (w * const.E * d_omega * loading)[..., None]  # d f_u / d ebar at each point
+        return g, bt(d_eq, B)  # and d eps_eq / d u at each point
+
+    def tangent():
+        g, h = softening()
+        out_tangent[:] = _secant(B, const, w_sec) - np.matmul((g * averaging.self_weight[..., None]).transpose(0, 2, 1), h)
+        return out_tangent
+
+    @functools.cache
+    def coupling():
+        return softening_coupling(averaging, *softening(), loading & (d_omega > 0.0))
+
+    # both tangent parts are built only when an iteration factorizes (most iterations of modified
+    # Newton need the residual alone)
+    @functools.cache
+    def history():
+        return update_history(kappa_old, (averaging.matrix @ eq.ravel()).reshape(eq.shape))[0]
+
+    return ElementArrays(f_u, tangent, {"u": f_u}, history, coupling=coupling, outputs={"omega": omega})
 
 
 def elastic_energy(disc, const: ModelConstants, ue, omega) -> float:

@@ -32,7 +32,9 @@ class SofteningLaw(Protocol):
     """Damage omega(kappa) of the history variable kappa.
 
     ``damage(kappa, params) -> (omega, d omega / d kappa)`` at every point; ``kappa_at_damage(omega,
-    params)`` its inverse (the FPZ width's level); ``onset(params)`` the kappa at which damage starts;
+    params)`` its inverse (the FPZ width's level); ``onset(params)`` the kappa at which damage starts
+    (omega and its derivative are zero below it: the integral model averages only where the average can
+    reach it, :func:`fracid.fem.formulations.nonlocal_average.bounded_average`);
     ``parameter_derivatives(kappa, params) -> {name: d omega / d name}`` at fixed kappa, for the
     parameters it depends on (the direct differentiation of :mod:`fracid.fem.path.ddm`).
     """
