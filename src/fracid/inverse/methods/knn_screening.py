@@ -69,7 +69,7 @@ def screened(operator, screening: float, space) -> Screening:
         return _fallback(operator, f"{asked} would mesh it with {_size(h_coarse)}, and {unresolved}")
     factor = h_coarse.h / h.h
     return Screening(coarse, factor, f"on a screening mesh {factor:.3g} times coarser ({_size(h_coarse)}, the "
-                                     f"configured {h.h:g} mm; {asked}{partly}); the fit runs on the configured mesh")
+                                     f"configured {h.h:.3g} mm; {asked}{partly}); the fit runs on the configured mesh")
 
 
 def _fallback(operator, why: str) -> Screening:
