@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -55,14 +56,16 @@ def screened_config(directory: Path, screening: float) -> Path:
     return path
 
 
-def timed(args, cwd: Path, env) -> float:
-    start = time.perf_counter()
+def timed(args, cwd: Path, env) -> tuple[float, float]:
+    """(wall, CPU) seconds of ``fracid ARGS``: the CPU time (user + system) of the command and its workers, which a
+    busy machine stretches less than the wall time."""
+    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "fracid", *map(str, args)], cwd=cwd, env=env, capture_output=True,
                           text=True)
-    seconds = time.perf_counter() - start
+    seconds, after = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
         raise SystemExit(f"fracid {' '.join(map(str, args))} exited {proc.returncode}:\n{proc.stderr[-3000:]}")
-    return seconds
+    return seconds, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def estimate(result: Path):
@@ -98,11 +101,11 @@ def main(argv=None) -> int:
                       f"s{f:g}_{i}") for f in factors]
             for name, command, out in jobs:
                 before = load()
-                seconds = timed(command, tmp, env)
-                rows.append((i, name, seconds, before))
+                seconds, cpu = timed(command, tmp, env)
+                rows.append((i, name, seconds, before, cpu))
                 if out is not None:
                     results.setdefault(name, []).append(estimate(tmp / out / "result.json"))
-                print(f"repeat {i + 1}: {name:24s} {seconds:7.1f} s (load {before})", flush=True)
+                print(f"repeat {i + 1}: {name:24s} {seconds:7.1f} s, CPU {cpu:7.1f} s (load {before})", flush=True)
     lines = table(rows, results, args, factors)
     print("\n".join(lines))
     if args.markdown is not None:
@@ -120,23 +123,26 @@ def table(rows, results, args, factors) -> list[str]:
         first = f"identify screening {factors[0]:g}" if factors else "demo"
         ref_x, ref_std, names = results[first][0]
         ref_name = first
-    best_sim = min(s for _, name, s, _ in rows if name == "simulate")
+    best_sim = min(s for _, name, s, *_ in rows if name == "simulate")
+    best_sim_cpu = min(c for _, name, _, _, c in rows if name == "simulate")
     threads = ", ".join(f"{n}={os.environ.get(n, 'unset')}" for n in THREADS)
     lines = [f"`python benchmarks/demo_speed.py --repeats {args.repeats} --screening {args.screening}"
              f"{' --one-thread' if args.one_thread else ''}` ({'one BLAS thread' if args.one_thread else threads}; "
              f"Python {sys.version.split()[0]}; reference estimate: {ref_name})", "",
-             "| command | wall times [s] | best [s] | best / best simulate | estimate change [std of the reference] |",
-             "|---|---|---|---|---|"]
-    for name in dict.fromkeys(name for _, name, _, _ in rows):
-        times = [s for _, n, s, _ in rows if n == name]
+             "| command | wall times [s] | best [s] | best / best simulate | CPU [s] (best) | CPU / simulate's CPU "
+             "| estimate change [std of the reference] |",
+             "|---|---|---|---|---|---|---|"]
+    for name in dict.fromkeys(name for _, name, *_ in rows):
+        times = [s for _, n, s, *_ in rows if n == name]
+        cpu = min(c for _, n, _, _, c in rows if n == name)
         change = ""
         if name in results:
             shifts = [np.abs(x - ref_x) / ref_std for x, _, _ in results[name]]
             worst = np.max(shifts, axis=0)
             change = ", ".join(f"{n} {v:.3f}" for n, v in zip(names, worst))
         lines.append(f"| {name} | {', '.join(f'{t:.1f}' for t in times)} | {min(times):.1f} | "
-                     f"{min(times) / best_sim:.1f} | {change} |")
-    lines.append(f"\nload (1-min average) before each command: {', '.join(load for *_, load in rows)}")
+                     f"{min(times) / best_sim:.1f} | {cpu:.1f} | {cpu / best_sim_cpu:.1f} | {change} |")
+    lines.append(f"\nload (1-min average) before each command: {', '.join(load for _, _, _, load, _ in rows)}")
     return lines
 
 

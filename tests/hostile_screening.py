@@ -44,7 +44,7 @@ def _fallback_recorded(proc, d):
     out = _stdout(proc, d)
     assert out.count("on the configured mesh: [identify.knn] screening = 2") == 1, out  # said once, in the plan
     result = json.loads((d / "out" / "result.json").read_text())
-    assert result["knn"]["mesh"].startswith("on the configured mesh: [identify.knn] screening = 2"), result["knn"]
+    assert result["knn"]["screening"].startswith("on the configured mesh: [identify.knn] screening = 2"), result["knn"]
     assert any("on the configured mesh: [identify.knn] screening = 2" in n for n in result["notes"]), result["notes"]
     report = (d / "out" / "report.html").read_text()
     assert "The population ran on the configured mesh: [identify.knn] screening = 2" in report
@@ -54,7 +54,7 @@ def _coarse_recorded(proc, d):
     out = _stdout(proc, d)
     assert "on a screening mesh 2 times coarser" in out, out
     result = json.loads((d / "out" / "result.json").read_text())
-    assert "screening mesh 2 times coarser" in result["knn"]["mesh"], result["knn"]
+    assert "screening mesh 2 times coarser" in result["knn"]["screening"], result["knn"]
     assert "The population ran on a screening mesh 2 times coarser" in (d / "out" / "report.html").read_text()
 
 

@@ -143,7 +143,7 @@ def test_the_estimate_with_screening_equals_the_one_without_within_a_tenth_of_it
         method = KnnKalman(KnnSettings(n=16, k=4, screening=screening), KalmanSettings(groups=[np.arange(6), np.arange(6, 12)]))
         results[screening] = method(op, y, C, space)
     fine, coarse = results[1.0], results[2.0]
-    assert "screening mesh 2 times coarser" in coarse.knn["mesh"] and fine.knn["mesh"] == "on the configured mesh"
+    assert "screening mesh 2 times coarser" in coarse.knn["screening"] and fine.knn["screening"] == "on the configured mesh"
     assert any("screening mesh" in note for note in coarse.notes), coarse.notes
     std = np.sqrt(np.diag(fine.C))
     shift = np.abs(coarse.x - fine.x) / std

@@ -57,8 +57,8 @@ def population_arrays(result, stage: str | None = None):
 
 def population_mesh(result, stage: str | None) -> str:
     """``" on a screening mesh 2 times coarser"`` for a population that ran on a screening mesh (its record's
-    ``mesh``, :mod:`fracid.inverse.methods.knn_screening`), else "": the figures' titles say which mesh ranked it."""
-    mesh = str(((result.record(stage) if stage is not None else None) or {}).get("mesh") or "")
+    ``screening``, :mod:`fracid.inverse.methods.knn_screening`), else "": the figures' titles say which mesh ranked it."""
+    mesh = str(((result.record(stage) if stage is not None else None) or {}).get("screening") or "")
     if "screening mesh" not in mesh:
         return ""
     return " " + mesh.split(" (")[0]

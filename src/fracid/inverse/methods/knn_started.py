@@ -199,9 +199,9 @@ def population_plan(knn: KnnSettings, p: int, stage: str, label: str, operator=N
 
 def knn_record(knn, method, seed, mesh="") -> dict:
     """What a result keeps of the search (its population record): population, objective, statuses, ranking, k,
-    prior, design and the mesh it ran on in words (``mesh``, "" when not said)."""
+    prior, design and the mesh it ran on in words (``mesh``, kept as ``screening``; "" when not said)."""
     return {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors, "order": knn.order,
-            "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed, "mesh": mesh}
+            "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed, "screening": mesh}
 
 
 def knn_output(knn, index, size):
