@@ -18,7 +18,7 @@ factorization measured for that case): how far the run is from the sparse-solver
 history and records), with the ratio to the factorizations written over the bar.
 
 ``superlu`` is SciPy's SuperLU in a METIS ordering when pymetis (the ``metis`` extra) is installed;
-``superlu-own`` is SuperLU in its own ordering (a plain ``pip install fracid``).
+``superlu-own`` is SuperLU in its own ordering (``pip install fracid`` where pymetis has no wheel, e.g. Windows).
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def run(name, solver_name, newton="modified"):
     """One forward run; returns (wall [s], factorizations, time per factorization [s]) or None."""
     specimen, params, target, stop = CASES[name]
     try:
-        # superlu-own: SuperLU in its own ordering, what `pip install fracid` gives without the metis extra
+        # superlu-own: SuperLU in its own ordering, what `pip install fracid` gives where pymetis has no wheel (Windows)
         solver = SuperLUSolver(ordering="superlu") if solver_name == "superlu-own" else linear_solver(solver_name)
     except (ValueError, ImportError) as err:
         print(f"{name:8s} {solver_name:8s} unavailable: {err}")

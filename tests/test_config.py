@@ -24,7 +24,7 @@ from fracid.config import (
 )
 from fracid.inverse.core.forward_operator import ForwardOperator
 from fracid.inverse.core.space import ParameterSpace
-from fracid.inverse.methods.knn_settings import KnnSettings
+from fracid.inverse.methods.knn_settings import DEFAULT_SCREENING, KnnSettings
 from fracid.fem.material.parameters import DamageParameters
 from fracid.models import DamageModel
 from fracid.specimens.bar import BarWithWeakZone
@@ -155,7 +155,8 @@ def test_valid_beam_config_loads_and_builds_everything(tmp_path):
     assert space.log == (False, True, False)
 
     method = build_method(cfg)
-    assert method.knn == KnnSettings(n=64, method="sobol", seed=0, k=5)
+    # the configuration's default population runs on a screening mesh; KnnSettings() (the library's) does not
+    assert method.knn == KnnSettings(n=64, method="sobol", seed=0, k=5, screening=DEFAULT_SCREENING)
     assert (method.kalman.max_iterations, method.kalman.tol, method.kalman.restart) == (10, 0.01, "linearize")
     groups = method.kalman.groups
     assert len(groups) == 4  # DEFAULT_GROUPS consecutive steps

@@ -38,6 +38,7 @@ import hostile_fit
 import hostile_mesh
 import hostile_paths
 import hostile_plausibility
+import hostile_screening
 import hostile_status
 from fracid.runtime.locks import directory_lock
 from hostile import (ENV, FRACID, IDENTIFY, IS_ROOT, JOBS, OUT, REACHES_OUTPUT, _cells, _clean, _config_bytes,
@@ -152,7 +153,7 @@ CASES = {
 
 #: the other cases, one module per class of defect (files and signals, data files, meshes, plausibility and API)
 for _module in (hostile_files, hostile_data, hostile_mesh, hostile_checks, hostile_plausibility, hostile_fit,
-                hostile_dic, hostile_paths, hostile_compare, hostile_estimate, hostile_status):
+                hostile_dic, hostile_paths, hostile_compare, hostile_estimate, hostile_status, hostile_screening):
     assert not set(_module.CASES) & set(CASES), set(_module.CASES) & set(CASES)
     CASES.update(_module.CASES)
 

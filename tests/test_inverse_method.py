@@ -104,7 +104,7 @@ def test_default_method_settings_belong_to_the_default_method(problem):
     with pytest.raises(TypeError, match="unknown setting.s. groups, n: the method 'least-squares' has no settings"):
         identify(op, data.y, data.covariance, SPACE, method=LeastSquares(), n=8, groups="all")
     with pytest.raises(TypeError, match="unknown setting.s. population of the method 'knn-gauss-newton'; known: k, "
-                                        "knn, max_iterations, n, seed, start, tol"):
+                                        "knn, max_iterations, n, screening, seed, start, tol"):
         identify(op, data.y, data.covariance, SPACE, method="knn-gauss-newton", population=8)
     with pytest.raises(ValueError, match="method = 'simplex': not a registered inverse method"):
         identify(op, data.y, data.covariance, SPACE, method="simplex")

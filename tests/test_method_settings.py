@@ -20,7 +20,7 @@ from fracid.inverse.methods.knn_settings import MAX_POPULATION
 from fracid.config.checker import Checker
 from fracid.settings import checks as settings
 from fracid.settings.checks import SettingError, SettingsContext
-from fracid.inverse.methods.knn_settings import KnnSettings, knn_from_table
+from fracid.inverse.methods.knn_settings import DEFAULT_SCREENING, KnnSettings, knn_from_table
 from fracid.inverse.methods.registry import METHODS, config_tables, known_tables, method_from_tables, table_readers
 from fracid.inverse.methods.kalman_settings import KalmanSettings
 from fracid.inverse.methods.knn_gauss_newton import KnnGaussNewton
@@ -106,12 +106,14 @@ def test_knn_kalman_from_its_tables():
     method = KnnKalman.from_config({"knn": {"n": 16, "method": "lhs", "k": 4, "seed": 2},
                                     "kalman": {"groups": 3, "max_iterations": 5, "tol": 0.1, "restart": "prior-mean",
                                                "max_starts": 2}}, CONTEXT)
-    assert method.knn == KnnSettings(n=16, method="lhs", seed=2, k=4)
+    assert method.knn == KnnSettings(n=16, method="lhs", seed=2, k=4, screening=DEFAULT_SCREENING)
     assert (method.kalman.max_iterations, method.kalman.tol, method.kalman.restart, method.kalman.max_starts) == \
         (5, 0.1, "prior-mean", 2)
     assert [g.tolist() for g in method.kalman.groups] == [[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]]
     default = KnnKalman.from_config({"knn": {}, "kalman": {}}, SettingsContext(n_y=3, parameters=("c",)))
-    assert default.knn == KnnSettings() and [g.tolist() for g in default.kalman.groups] == [[0], [1], [2]]
+    # the configuration's population runs on a screening mesh by default, the library's (KnnSettings()) does not
+    assert default.knn == KnnSettings(screening=DEFAULT_SCREENING)
+    assert [g.tolist() for g in default.kalman.groups] == [[0], [1], [2]]
     assert default.kalman.max_starts == KalmanSettings().max_starts
 
 
@@ -233,7 +235,7 @@ def test_the_configuration_keeps_the_tables_and_the_method_is_built_from_them(tm
                               tail="[identify.gauss-newton]\nmax_iterations = 7"))
     assert cfg.identify.tables == {"knn": {"n": 8, "k": 2}, "kalman": {"groups": 2, "max_iterations": 3},
                                    "gauss-newton": {"max_iterations": 7}}
-    assert build_method(cfg) == KnnGaussNewton(KnnSettings(n=8, k=2), max_iterations=7)
+    assert build_method(cfg) == KnnGaussNewton(KnnSettings(n=8, k=2, screening=DEFAULT_SCREENING), max_iterations=7)
     assert ("[identify.kalman] is given but identify.method = 'knn-gauss-newton': its settings are not used (set "
             'method = "knn-kalman" to use them)') in cfg.warnings
     # an unread table is checked too (by a method that reads it)

@@ -82,11 +82,12 @@ def identify_lines(cfg) -> list:
     return [f"identified: {bounds}; the others fixed at [model.parameters]"]
 
 
-def identify_plan(method, operator, n_y: int, p: int) -> list:
+def identify_plan(method, operator, n_y: int, p: int, space=None) -> list:
     """The stages of the configured inverse method and their forward runs (its ``plan``:
     :class:`~fracid.inverse.core.plans.StagePlan` per stage; empty for a method without one)."""
-    plan = getattr(method, "plan", None)  # an optional capability of an inverse method
-    return [] if plan is None else list(plan(operator, n_y, p))
+    from fracid.inverse.core.plans import method_plan
+
+    return method_plan(method, operator, n_y, p, space)
 
 
 def plan_lines(cfg, method, plan) -> list:
@@ -158,7 +159,7 @@ def run_check(args) -> int:
         data = build_data(cfg)
         operator = build_operator(cfg, data)
         method = build_method(cfg)
-        plan = identify_plan(method, operator, data.n_y, len(cfg.identify.parameters))
+        plan = identify_plan(method, operator, data.n_y, len(cfg.identify.parameters), build_space(cfg))
         lines += data_lines(data) + identify_lines(cfg) + plan_lines(cfg, method, plan)
     else:
         lines.append("plan: fracid simulate, one forward run (no [[experiments]] and [identify]: nothing to identify)")
@@ -167,7 +168,9 @@ def run_check(args) -> int:
         print("time: not measured (--no-time)")
         return 0
     space = build_space(cfg) if operator is not None else None
-    timing = timed_runs(cfg, model, build_specimen(cfg), params, operator, space, any(s.exact for s in plan or []))
+    screening = next((s.operator for s in plan or [] if s.operator is not None), None)  # a population's coarse mesh
+    timing = timed_runs(cfg, model, build_specimen(cfg), params, operator, space, any(s.exact for s in plan or []),
+                        screening)
     workers = args.workers or (1 if args.scheduler else available_cores())
     cores = workers if args.scheduler else available_cores()  # a cluster's cores are its own
     refit = refits(cfg) if operator is not None else (0, 0)

@@ -4,7 +4,8 @@ a likely value and an upper one, with the assumptions they rest on (:func:`time_
 The runs: the first at ``[model.parameters]`` (it carries the first call's warm-up: imports, caches; not
 counted unless it is the only one), two across the bounds (at 1/4 and 3/4 of the ranges: runs differ across the
 box the population covers) and, for a plan with exact sensitivities, one with them at ``[model.parameters]``
-(its cost against a plain run is measured, not assumed). A first run over :data:`SLOW_RUN` seconds is the only
+(its cost against a plain run is measured, not assumed) and, for a population on a screening mesh
+(``[identify.knn] screening``), one on that mesh at ``[model.parameters]``. A first run over :data:`SLOW_RUN` seconds is the only
 one. The stages' counts are the method's plan (:class:`~fracid.inverse.core.plans.StagePlan`); the arithmetic
 is :func:`~fracid.inverse.core.plans.plan_seconds`.
 """
@@ -47,6 +48,8 @@ class Timing:
         The run with exact sensitivities at ``[model.parameters]`` (None: not timed).
     load : float
         The machine's 1-min load average before the runs (``os.getloadavg()``; NaN where unknown).
+    screened : float or None
+        A plain run on the population's screening mesh at ``[model.parameters]`` (None: not timed).
     """
 
     first: float
@@ -54,6 +57,7 @@ class Timing:
     failed: int = 0
     exact: float | None = None
     load: float = float("nan")
+    screened: float | None = None
 
     @property
     def plain(self) -> float:
@@ -89,10 +93,11 @@ def across_points(space) -> np.ndarray:
     return space.from_unit(unit)
 
 
-def timed_runs(cfg, model, specimen, params, operator, space=None, exact=False) -> Timing:
+def timed_runs(cfg, model, specimen, params, operator, space=None, exact=False, screening=None) -> Timing:
     """:class:`Timing` of the forward runs: the identification's (``operator``, with ``space`` its bounds;
-    ``exact``: its plan has runs with exact sensitivities) or, without one, the simulation's one run. A failed
-    run at ``[model.parameters]`` exits 2 (a usage error); a failed run across the bounds is counted.
+    ``exact``: its plan has runs with exact sensitivities; ``screening``: the operator of a population on a
+    screening mesh, timed too) or, without one, the simulation's one run. A failed run at ``[model.parameters]``
+    exits 2 (a usage error); a failed run across the bounds is counted.
     """
     from fracid.config import simulate_settings
     from fracid.runtime.exits import UsageError
@@ -115,7 +120,8 @@ def timed_runs(cfg, model, specimen, params, operator, space=None, exact=False) 
     if exact:
         differentiated = operator.differentiated()
         with_s, _ = _seconds(lambda: differentiated(x).ok)
-    return Timing(first, tuple(t for t, _ in across), sum(not ok for _, ok in across), with_s, load)
+    coarse = _seconds(lambda: screening(x).ok)[0] if screening is not None else None
+    return Timing(first, tuple(t for t, _ in across), sum(not ok for _, ok in across), with_s, load, coarse)
 
 
 def timing_line(timing: Timing) -> str:
@@ -131,6 +137,9 @@ def timing_line(timing: Timing) -> str:
     if timing.exact is not None:
         text += (f"; with exact sensitivities {_secs(timing.exact)} s at [model.parameters] "
                  f"({timing.exact / timing.plain:.2f} times a plain run)")
+    if timing.screened is not None:
+        text += (f"; on the population's screening mesh {_secs(timing.screened)} s at [model.parameters] "
+                 f"({timing.screened / timing.plain:.2f} times a plain run on the configured mesh)")
     return text
 
 
@@ -145,7 +154,7 @@ def time_lines(cfg, timing: Timing, plan, workers: int, cores: int, refits=(0, 0
              f"({mesh_key(cfg)}); a coarser mesh runs faster, if it still resolves the process zone")
     if not plan:
         return lines
-    times = RunTimes(timing.plain, timing.with_sensitivities, workers, cores)
+    times = RunTimes(timing.plain, timing.with_sensitivities, workers, cores, timing.screened)
     likely, upper = (t + REPORT_SECONDS for t in plan_seconds(plan, times, refits))
     lines.append(f"estimate for fracid identify on {workers} worker(s): about {_duration(likely)}, "
                  f"at most {_duration(upper)}")

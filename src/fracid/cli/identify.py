@@ -53,7 +53,7 @@ def identification(args, job, store, executor):
     from fracid.config import error_terms
     from fracid.inverse.methods.strategy import identify_data
 
-    for line in stage_plans(job.method, job.operator, job.data.n_y, len(job.space.names)):
+    for line in stage_plans(job.method, job.operator, job.data.n_y, len(job.space.names), job.space):
         say(args, line)
     start = time.perf_counter()
     result = identify_data(job.operator, job.data, job.space, method=job.method, executor=executor, store=store,
@@ -108,13 +108,14 @@ def run_identify(args, config_path=None) -> int:
     return 0
 
 
-def stage_plans(method, operator, n_y: int, p: int) -> list[str]:
-    """What the method's stages will cost (its ``plan``, :class:`~fracid.inverse.core.plans.StagePlan`), said before
-    the work starts; its stages' names for a method that has no plan."""
-    plan = getattr(method, "plan", None)  # an optional capability of an inverse method
-    if plan is None:
+def stage_plans(method, operator, n_y: int, p: int, space=None) -> list[str]:
+    """What the method's stages will cost (its ``plan``, :class:`~fracid.inverse.core.plans.StagePlan`; ``space``:
+    the identification's bounds), said before the work starts; its stages' names for a method that has no plan."""
+    from fracid.inverse.core.plans import method_plan
+
+    if getattr(method, "plan", None) is None:  # an optional capability of an inverse method
         return [f"{method.name}: stages {', '.join(dict(getattr(method, 'stages', {}) or {}).values()) or method.name}"]
-    return [stage.line() for stage in plan(operator, n_y, p)]
+    return [stage.line() for stage in method_plan(method, operator, n_y, p, space)]
 
 
 def write_figures(directory: Path, result, control, fields=None, views=None) -> None:

@@ -159,6 +159,12 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     method = "sobol"                    # "sobol" (default) | "lhs" | "grid"
     k = 5                               # neighbours, 1 <= k <= population (n, or n**p for grid), default 5
     seed = 0                            # integer >= 0, default 0
+    screening = 2.0                     # 1 <= screening <= 4, default 2: the population runs on a mesh this many
+                                        #   times coarser (element sizes x screening), the fit on the configured
+                                        #   one; 1: the configured mesh. A mesh file, or a screening mesh resolving
+                                        #   the internal length over less than half its range, runs it on the
+                                        #   configured mesh (the stage line says so). The studies' populations
+                                        #   stay on the configured mesh
     [identify.kalman]                   # optional
     groups = 4                          # consecutive observation groups, 1 <= groups <= n_y (total
                                         #   n_points); default 4 (n_y if fewer)

@@ -55,6 +55,15 @@ def population_arrays(result, stage: str | None = None):
     return points, f, failed, order, k
 
 
+def population_mesh(result, stage: str | None) -> str:
+    """``" on a screening mesh 2 times coarser"`` for a population that ran on a screening mesh (its record's
+    ``screening``, :mod:`fracid.inverse.methods.knn_screening`), else "": the figures' titles say which mesh ranked it."""
+    mesh = str(((result.record(stage) if stage is not None else None) or {}).get("screening") or "")
+    if "screening mesh" not in mesh:
+        return ""
+    return " " + mesh.split(" (")[0]
+
+
 def _objective_for_log(f: np.ndarray, failed: np.ndarray):
     """Objective values safe for a log axis (zeros raised to a floor) and the height of failed runs."""
     good = f[~failed & np.isfinite(f)]
@@ -168,8 +177,9 @@ def population_objective_figure(result, stage: str | None = None) -> Figure | No
     axes[0].legend(fontsize="x-small", loc="best")
     for ax in axes[p:]:
         ax.set_visible(False)
-    fig.suptitle(f"{stage_label(result, stage)} population: {len(points)} runs, objective f = (y_exp - y)^T C_exp^-1 (y_exp - y)",
-                 fontsize="medium")
+    mesh = population_mesh(result, stage)
+    fig.suptitle(f"{stage_label(result, stage)} population: {len(points)} runs{mesh}, objective f = (y_exp - y)^T "
+                 "C_exp^-1 (y_exp - y)", fontsize="medium")
     return fig
 
 
@@ -214,7 +224,7 @@ def population_map_figure(result, stage: str | None = None) -> Figure | None:
     parameter_axis(ax, "x", points[:, i])
     parameter_axis(ax, "y", points[:, j])
     corr = float(np.asarray(result.correlation, float)[i, j])
-    ax.set_title(f"{names[i]} - {names[j]} (correlation {corr:+.3f})")
+    ax.set_title(f"{names[i]} - {names[j]} (correlation {corr:+.3f}){population_mesh(result, stage)}")
     ax.set_xlabel(parameter_label(names[i]))
     ax.set_ylabel(parameter_label(names[j]))
     ax.grid(True, alpha=0.3)
@@ -247,5 +257,5 @@ def stage_figures(result) -> dict:
     return out
 
 
-__all__ = ["RECORD_FIGURES", "history_figure", "population_arrays", "population_map_figure",
+__all__ = ["RECORD_FIGURES", "history_figure", "population_arrays", "population_map_figure", "population_mesh",
            "population_objective_figure", "stage_figures", "stage_label", "stage_of_kind", "strongest_pair"]

@@ -47,6 +47,9 @@ def population_section(result, name, figures) -> str:
         return f"<h2>{esc(label)} population</h2>\n<p>No {esc(label)} population in this result.</p>"
     points, f, failed, order, k = arrays
     parts = [f"<h2>{esc(label)} population</h2>"]
+    mesh = (result.record(name) or {}).get("screening")
+    if mesh:  # a population on a screening mesh ranks the start only: its objective is not the estimate's mesh's
+        parts.append(f"<p>The population ran {esc(mesh)}.</p>")
     parts.append(html_image(figures.to_png(population_objective_figure(result, name), stem=f"{name}_objective"),
                             f"{label} objective",
                             "Objective of every population point against each parameter (log scale); circles: the "

@@ -32,7 +32,7 @@ class SuperLUSolver:
         (6149 unknowns) 0.001 gives 1.0e6 factor entries in 0.03 s against 2.4e6 in 0.13 s with
         partial pivoting (1.0), at the same residual (1e-15).
     ordering : {"auto", "metis", "superlu"}
-        ``"metis"``: a nested-dissection ordering of A + A^T by METIS (the ``metis`` extra, pymetis),
+        ``"metis"``: a nested-dissection ordering of A + A^T by METIS (pymetis, a dependency where it has wheels),
         computed once per sparsity pattern and applied symmetrically; SuperLU then keeps it. On the
         damage tangents of the notched beam it factorizes 1.35 (10k unknowns) to 1.8 (48k) times
         faster than ``permc_spec``, with less fill (docs/speed/linear_solvers.md). ``"superlu"``:
@@ -134,7 +134,8 @@ def _pymetis():
     try:
         import pymetis
     except ImportError as err:
-        raise ImportError(f"the METIS ordering needs pymetis: pip install 'fracid[metis]' ({err})") from err
+        raise ImportError(f"the METIS ordering needs pymetis (installed with fracid where it has wheels: Linux and "
+                          f"macOS on x86_64, macOS arm64; elsewhere pip install pymetis builds it) ({err})") from err
     return pymetis
 
 

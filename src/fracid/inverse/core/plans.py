@@ -48,6 +48,9 @@ class StagePlan:
         The full-curve runs of one start as they usually go (fewer passes than the most); None: ``full_runs``.
     likely_text : str
         How ``likely_full_runs`` comes about, in words (``"5 passes: half the most"``).
+    operator : ForwardOperator or None
+        The operator of the stage's runs when it is not the identification's (a KNN population on a screening
+        mesh, :mod:`fracid.inverse.methods.knn_screening`): its runs cost :attr:`RunTimes.screened` each.
     """
 
     stage: str
@@ -62,6 +65,7 @@ class StagePlan:
     starts_key: str = ""
     likely_full_runs: float | None = None
     likely_text: str = ""
+    operator: object = None
 
     def line(self) -> str:
         """``"stage <label>: <text> (<keys>)"``, and its starts when it may start more than once."""
@@ -84,15 +88,21 @@ class RunTimes:
         Workers sharing the side-by-side runs.
     cores : int
         Cores of the machine: more workers than cores do not run faster.
+    screened : float or None
+        Seconds of a plain run of a stage's own operator (a population on a screening mesh, timed); None: as
+        ``plain``.
     """
 
     plain: float
     exact: float
     workers: int
     cores: int
+    screened: float | None = None
 
     def run(self, stage: StagePlan) -> float:
         """Seconds of one full-curve run of ``stage``."""
+        if stage.operator is not None and self.screened is not None:
+            return self.screened
         return self.exact if stage.exact else self.plain
 
 
@@ -126,6 +136,18 @@ def plan_seconds(plan, times: RunTimes, refits: tuple = (0, 0)) -> tuple[float, 
     return likely, upper
 
 
+def method_plan(method, operator, n_y: int, p: int, space=None) -> list:
+    """The stages of ``method`` and their forward runs (its ``plan``, a :class:`StagePlan` per stage; empty for a
+    method without one), given ``space`` (the identification's bounds) when its ``plan`` takes it."""
+    import inspect
+
+    plan = getattr(method, "plan", None)  # an optional capability of an inverse method
+    if plan is None:
+        return []
+    takes_space = "space" in inspect.signature(plan).parameters
+    return list(plan(operator, n_y, p, space=space) if takes_space else plan(operator, n_y, p))
+
+
 def plural(count, noun: str) -> str:
     """``"1 run"``, ``"2 runs"``."""
     return f"{count} {noun}{'' if count == 1 else 's'}"
@@ -149,5 +171,5 @@ def runs_per_linearisation(operator, p: int) -> tuple[int, str]:
     return 2 * p + 1, "the run and 2 per parameter: central differences"
 
 
-__all__ = ["FAILED_RUN_COST", "FAILED_SHARE", "RunTimes", "StagePlan", "likely_iterations", "plan_seconds", "plural", "runs_per_linearisation",
+__all__ = ["FAILED_RUN_COST", "FAILED_SHARE", "RunTimes", "StagePlan", "likely_iterations", "method_plan", "plan_seconds", "plural", "runs_per_linearisation",
            "stage_seconds"]

@@ -98,7 +98,7 @@ class KnnGaussNewton(KnnStarted):
             toml_line("max_iterations", gn.get("max_iterations", 20), "linearisations at most"),
             toml_line("tol", gn.get("tol", 0.01), "convergence: the largest step in standard deviations")]
 
-    def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
+    def plan(self, operator, n_y: int, p: int, space=None) -> list[StagePlan]:
         """The forward runs of both stages: the population side by side, then at most ``max_iterations``
         linearisations one after another (each a full-curve run, or 2 p + 1 without exact sensitivities)."""
         per_step, how = runs_per_linearisation(operator, p)
@@ -106,7 +106,7 @@ class KnnGaussNewton(KnnStarted):
         text = (f"at most {self.max_iterations} linearisations and a run at the estimate, {plural(per_step, 'run')} each "
                 f"({how}): at most {runs} full-curve runs one after another without backtracking")
         likely = likely_iterations(self.max_iterations)
-        return [population_plan(self.knn, p, "knn", "KNN"),
+        return [population_plan(self.knn, p, "knn", "KNN", operator, space),
                 StagePlan("gauss_newton", "Gauss-Newton", runs, False, float(runs), text,
                           "[identify.gauss-newton] max_iterations", per_step == 1, likely_full_runs=(likely + 1) * per_step,
                           likely_text=f"{likely} of {self.max_iterations} linearisations")]

@@ -101,7 +101,7 @@ class KnnKalman(KnnStarted):
                                            "filter steps per pass (one run each with exact sensitivities)"),
             toml_line("max_iterations", kalman.get("max_iterations", 10), "passes at most")]
 
-    def plan(self, operator, n_y: int, p: int) -> list[StagePlan]:
+    def plan(self, operator, n_y: int, p: int, space=None) -> list[StagePlan]:
         """The forward runs of both stages (:class:`~fracid.inverse.core.plans.StagePlan`): the population side by
         side; the filter's steps one after another (a step of the first pass runs up to its observations, each
         later pass is one linearisation), at most ``max_iterations`` passes and a run at the estimate, and up to
@@ -116,7 +116,7 @@ class KnnKalman(KnnStarted):
         text = (f"{steps} steps per pass, {plural(per_step, 'run')} per step ({how}), at most {passes} passes and a run at "
                 f"the estimate: at most {runs} runs one after another without backtracking, about {full:.0f} "
                 "full-curve runs")
-        return [population_plan(self.knn, p, "knn", "KNN"),
+        return [population_plan(self.knn, p, "knn", "KNN", operator, space),
                 StagePlan("kalman", "Kalman filter", runs, False, full, text, "[identify.kalman] groups and max_iterations",
                           per_step == 1, starts=self.kalman.max_starts, starts_key="[identify.kalman] max_starts",
                           likely_full_runs=first + likely * per_step,

@@ -28,6 +28,14 @@ class KnnSettings:
         The prior mean of the local fit instead of the neighbours' mean (units of the parameters; the
         neighbours' spread stays its covariance): the error terms' loops start from the last estimate
         (:mod:`fracid.inverse.likelihood.terms`). Not a key of the configuration.
+    screening : float
+        The element-size factor of the population's mesh (>= 1): the identification's population runs on a mesh
+        this many times coarser where the specimen localises (a screening mesh: each run costs less), the local
+        fit then on the configured mesh from the population's prior, so that the estimate is the configured
+        mesh's. 1: the population on the configured mesh. Where the specimen cannot be coarsened or the
+        screening mesh would not resolve the model's internal length, the population runs on the configured mesh
+        and the stage says so (:mod:`fracid.inverse.methods.knn_screening`). The studies' populations (the
+        uniqueness maps) stay on the configured mesh: they map the objective, not only rank a start.
     """
 
     n: int = 64
@@ -35,6 +43,7 @@ class KnnSettings:
     seed: int = 0
     k: int = 5
     start: tuple | None = None
+    screening: float = 1.0
 
     def population(self, p: int) -> int:
         """Number of forward runs of the population for ``p`` parameters (``n``, or ``n**p`` for a grid)."""
@@ -47,7 +56,11 @@ MAX_POPULATION = 100_000
 
 #: the table of the population's settings in ``[identify]``, and its keys
 KNN_TABLE = "knn"
-KNN_KEYS = ("n", "method", "k", "seed")
+KNN_KEYS = ("n", "method", "k", "seed", "screening")
+#: ``[identify.knn] screening``: the default element-size factor of the population's mesh (benchmarks/demo_speed.py,
+#: docs/speed/install.md) and the largest allowed (a coarser mesh resolves too little of a process zone to rank)
+DEFAULT_SCREENING = 2.0
+MAX_SCREENING = 4.0
 #: ``[identify.knn] method``: how the KNN population is sampled (:func:`~fracid.inverse.methods.knn.design`)
 KNN_METHODS = ("sobol", "lhs", "grid")
 
@@ -59,7 +72,9 @@ def knn_from_table(raw, context: SettingsContext) -> KnnSettings:
     ----------
     raw : dict
         The table as given: ``n`` (integer >= 2, default 64), ``method`` (:data:`KNN_METHODS`, default
-        ``"sobol"``), ``seed`` (integer >= 0, default 0), ``k`` (1 <= k <= the population, default 5).
+        ``"sobol"``), ``seed`` (integer >= 0, default 0), ``k`` (1 <= k <= the population, default 5),
+        ``screening`` (a number in [1, :data:`MAX_SCREENING`], default :data:`DEFAULT_SCREENING`: the element-size
+        factor of the population's mesh, see :class:`KnnSettings`).
     context : SettingsContext
         ``parameters`` (their count p sets a grid's population n**p) and ``n_y`` (the data values, for the
         memory of the population in the message of the limit).
@@ -83,7 +98,11 @@ def knn_from_table(raw, context: SettingsContext) -> KnnSettings:
     k = settings.integer("knn.k" + ("" if "k" in raw else " (default)"), raw.get("k", 5),
                          f"must be an integer with 1 <= k <= the population size {population} ({how}, method "
                          f"{method!r})", lambda v: 1 <= v <= population)
-    return KnnSettings(n=n, method=method, seed=seed, k=k)
+    screening = settings.number("knn.screening", raw.get("screening", DEFAULT_SCREENING),
+                                f"must be a number with 1 <= screening <= {MAX_SCREENING:g} (the element-size factor "
+                                "of the population's mesh; 1: the configured mesh)",
+                                lambda v: 1.0 <= v <= MAX_SCREENING)
+    return KnnSettings(n=n, method=method, seed=seed, k=k, screening=screening)
 
 
 def _population_text(population: int, how: str, method: str, p: int, n_y: int) -> str:
@@ -104,4 +123,4 @@ def knn_template(raw: dict, prior: str = "the prior") -> list[str]:
             toml_line("k", raw.get("k", 5), f"neighbours giving {prior}")]
 
 
-__all__ = ["KNN_KEYS", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]
+__all__ = ["DEFAULT_SCREENING", "KNN_KEYS", "MAX_SCREENING", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]

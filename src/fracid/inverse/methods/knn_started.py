@@ -25,6 +25,7 @@ from fracid.inverse.core.sensitivity import exact_sensitivity
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.knn import knn_search
+from fracid.inverse.methods.knn_screening import screened
 from fracid.inverse.methods.knn_settings import KnnSettings
 from fracid.runtime.batch import BatchStats
 
@@ -120,9 +121,10 @@ class KnnStarted:
         raise NotImplementedError
 
     def refine(self, operator, y_exp, C_exp, knn, *, C0=None, executor=None, blocks=(), notes=(), started=None,
-               progress=False) -> KnnStartedResult:
+               progress=False, mesh="") -> KnnStartedResult:
         """The local stage from the prior of ``knn`` (``C0`` replaces its covariance when given, e.g. the
-        bounds', so that the posterior holds the information of the data alone). ``operator`` may be a
+        bounds', so that the posterior holds the information of the data alone; ``mesh``: the population's mesh
+        in words, :class:`~fracid.inverse.methods.knn_screening.Screening`, "" when not said). ``operator`` may be a
         :class:`~fracid.inverse.core.runs.StoredOperator` (its runs are then stored and counted); the stage
         stays inside the space's bounds and does not raise on failed forward runs."""
         start = time.perf_counter() if started is None else started
@@ -141,9 +143,11 @@ class KnnStarted:
         if after is not None:
             runs.update({f"{local}_computed": after[0] - before[0], f"{local}_reused": after[1] - before[1]})
         runs["wall_seconds"] = time.perf_counter() - start
-        notes = list(notes) + [f"KNN: {self.knn.method} population of {len(knn.points)}, k = {knn.k}", fit.note]
+        notes = list(notes) + [f"KNN: {self.knn.method} population of {len(knn.points)}, k = {knn.k}"
+                               + (f", {mesh}" if mesh else ""), fit.note]
         return self.result_class(
-            x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history, knn=knn_record(knn, self.knn.method, self.knn.seed),
+            x=fit.x, C=fit.C, y_fit=fit.y, history=fit.history,
+            knn=knn_record(knn, self.knn.method, self.knn.seed, mesh),
             runs=runs, converged=fit.converged, status=fit.status, method=self.name, stages=dict(self.stages),
             stage_records=dict(self.stage_records), curves=curves,
             **result_fields(operator, knn.space, fit.x, y_exp, C_exp, blocks=blocks, notes=notes))
@@ -162,11 +166,12 @@ class KnnStarted:
         start = time.perf_counter()
         y_exp, C_exp = check_problem(operator, y_exp, C_exp, space)
         stats = BatchStats()
-        knn = self.search(operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
+        mesh = screened(operator, self.knn.screening, space)  # the population on a screening mesh, or said why not
+        knn = self.search(mesh.operator, y_exp, C_exp, space, executor=executor, store=store, progress=progress,
                           stats=stats, retry_failed=retry_failed)
         evaluate = StoredOperator(operator, store, retry_failed=retry_failed)
         result = self.refine(evaluate, y_exp, C_exp, knn, executor=executor, blocks=blocks, notes=notes,
-                             started=start, progress=progress)
+                             started=start, progress=progress, mesh=mesh.text)
         search = next(iter(self.stages))
         result.runs.update({f"{search}_computed": stats.computed, f"{search}_reused": stats.reused})
         return result
@@ -180,19 +185,23 @@ def population_search(knn: KnnSettings, operator, y_exp, C_exp, space: Parameter
                       executor=executor, store=store, progress=progress, stats=stats, retry_failed=retry_failed)
 
 
-def population_plan(knn: KnnSettings, p: int, stage: str, label: str) -> StagePlan:
-    """The forward runs of a KNN search with the settings ``knn`` (n, method, k) for ``p`` parameters, as the
-    stage ``stage`` (its ``label``)."""
+def population_plan(knn: KnnSettings, p: int, stage: str, label: str, operator=None, space=None) -> StagePlan:
+    """The forward runs of a KNN search with the settings ``knn`` (n, method, k, screening) for ``p`` parameters,
+    as the stage ``stage`` (its ``label``); with ``operator`` and ``space``, on the mesh :func:`screened` gives
+    (its operator is the plan's when it is a screening one, so that ``fracid check`` times a run of it)."""
     runs = knn.population(p)
-    return StagePlan(stage, label, runs, True, float(runs), f"{runs} forward runs side by side ({knn.method}, k = {knn.k})",
-                     f"[identify.knn] n = {knn.n}")
+    mesh = screened(operator, knn.screening, space) if operator is not None and space is not None else None
+    where = f" {mesh.text}" if mesh is not None and (mesh.coarse or mesh.fallback) else ""
+    return StagePlan(stage, label, runs, True, float(runs), f"{runs} forward runs side by side ({knn.method}, "
+                     f"k = {knn.k}){where}", f"[identify.knn] n = {knn.n}",
+                     operator=mesh.operator if mesh is not None and mesh.coarse else None)
 
 
-def knn_record(knn, method, seed) -> dict:
+def knn_record(knn, method, seed, mesh="") -> dict:
     """What a result keeps of the search (its population record): population, objective, statuses, ranking, k,
-    prior and design."""
+    prior, design and the mesh it ran on in words (``mesh``, kept as ``screening``; "" when not said)."""
     return {"points": knn.points, "f": knn.f, "status": knn.status, "errors": knn.errors, "order": knn.order,
-            "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed}
+            "k": knn.k, "x0": knn.x0, "C0": knn.C0, "method": method, "seed": seed, "screening": mesh}
 
 
 def knn_output(knn, index, size):
