@@ -166,6 +166,24 @@ class Levels:
         # the coarse draws carry the fine estimate with weights w_i r_i: their spread costs it E_c[r^2] / E_c[r]^2
         return coarse * self.spread + np.var(terms, axis=0, ddof=1) / n
 
+    @property
+    def fine_runs(self) -> int:
+        """The distinct fine runs of the subset."""
+        return int(len(np.unique(self.index)))
+
+    @property
+    def coarse_ess(self) -> float:
+        """Kish's effective sample size of the coarse weights."""
+        return float(1.0 / np.sum(self.w**2))
+
+    def coarse_equivalent_draws(self) -> np.ndarray:
+        """Per parameter: the equivalent draws if the correction were exact (the coarse level's error alone): the
+        bound that more fine runs cannot pass."""
+        coarse_mean = self.w @ self.x
+        coarse = np.sum(self.w[:, None] ** 2 * (self.x - coarse_mean) ** 2, axis=0) * self.spread
+        variance = np.maximum(np.diag(self.cov()), 0.0)
+        return variance / np.maximum(coarse, 1e-300)
+
     def equivalent_draws(self) -> np.ndarray:
         """Per parameter: the posterior variance over :meth:`mean_variance` (independent draws as precise)."""
         # signed weights can give a negative variance when the correction is wild: no draw is worth anything then

@@ -19,6 +19,8 @@ the fine one (it is measured: the fine weights' effective sample size says how g
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fracid.inverse.core.sensitivity import evaluate_points
@@ -26,7 +28,7 @@ from fracid.inverse.sampling.levels import Levels, resample_index, subset_probab
 from fracid.inverse.sampling.posterior import _log_likelihood, _status, posterior
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
-__all__ = ["COARSE_ESS", "COARSE_ROUND", "POOR_SCREEN", "screened_posterior"]
+__all__ = ["COARSE_ESS", "COARSE_ROUND", "COARSE_SHARE", "MAX_DRAWS", "POOR_SCREEN", "screened_posterior"]
 
 #: the coarse level samples to this multiple of ``target_ess`` (its error is then a small part of the total)
 COARSE_ESS = 2.5
@@ -37,6 +39,9 @@ COARSE_ROUND = 4
 POOR_SCREEN = 3.0
 #: the subset's draws at most, as a multiple of ``fine_runs`` (a draw picked again costs no run)
 MAX_DRAWS = 4
+#: the coarse level's own error may take at most 1 / COARSE_SHARE of the target's variance: after the first fine
+#: round, a coarse level that would take more is sampled further (once), to the effective sample size it needs
+COARSE_SHARE = 2.0
 
 
 def _normalisation(C, m: int) -> float:
@@ -68,42 +73,81 @@ def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, 
         ``ess`` the smallest number of equivalent independent draws.
     """
     y_exp, shift = np.asarray(y_exp, float), np.asarray(shift, float)
-    coarse_settings = settings.replace(target_ess=COARSE_ESS * settings.target_ess,
-                                       samples_per_round=COARSE_ROUND * settings.samples_per_round)
-    most = coarse_settings.samples_per_round * coarse_settings.max_rounds
-    first = posterior(coarse, y_exp + shift, C_coarse, space, x0, C0, settings=coarse_settings, executor=executor,
-                      log=None if log is None else (lambda text: log(f"coarse mesh: {text}")),
-                      progress=None if progress is None else (lambda done, _: progress(done, most + settings.fine_runs)))
-    log_c = first.log_likelihood - _normalisation(C_coarse, y_exp.size)
-    rng = np.random.default_rng(settings.seed + 1)
-    index, loglik, y_fine, history = [], [], [], list(first.history)
-    levels, pick = None, subset_probabilities(first.weights)
-    while len(set(index)) < settings.fine_runs and len(index) < MAX_DRAWS * settings.fine_runs:
-        size = min(settings.samples_per_round, settings.fine_runs - len(set(index)))
-        picked = resample_index(pick, size, rng)
-        records = evaluate_points(fine, first.x[picked], None, executor)
-        ll, y = _log_likelihood(records, y_exp, C_fine)
-        index.extend(picked.tolist())
-        loglik.extend(ll.tolist())
-        y_fine.extend(y.tolist())
-        log_ratio = np.array(loglik) - _normalisation(C_fine, y_exp.size) - log_c[index]
-        levels = Levels(first.x, first.weights, first.y - shift, np.array(index), log_ratio,
-                        np.array(y_fine), first.log_evidence, first.log_evidence_error, pick)
-        equivalent = float(np.min(levels.equivalent_draws()))
-        history.append({"round": len(history), "draws": size, "failed": int(np.sum(~np.isfinite(ll))),
-                        "ess": equivalent, "components": 0, "level": "fine"})
-        if progress is not None:
-            progress(len(first.x) + len(set(index)), len(first.x) + settings.fine_runs)
-        if log is not None:
-            log(f"fine mesh: {len(set(index))} runs, equivalent draws {equivalent:.0f} (target "
-                f"{settings.target_ess:g}), fine/coarse likelihood ratio's spread {levels.spread:.2f}")
-        if levels.spread > POOR_SCREEN:
-            return _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels)
-        if equivalent >= settings.target_ess:
-            break
+    most = COARSE_ROUND * settings.samples_per_round * settings.max_rounds
+    report = None if progress is None else (lambda done, _: progress(done, most + settings.fine_runs))
+    coarse_log = None if log is None else (lambda text: log(f"coarse mesh: {text}"))
+
+    def coarse_level(target):
+        # the same seed draws the same first rounds: a larger target replays them from the store and goes on
+        coarse_settings = settings.replace(target_ess=target, samples_per_round=COARSE_ROUND * settings.samples_per_round)
+        return posterior(coarse, y_exp + shift, C_coarse, space, x0, C0, settings=coarse_settings, executor=executor,
+                         log=coarse_log, progress=report)
+
+    first = coarse_level(COARSE_ESS * settings.target_ess)
+    fine_level = _FineLevel(fine, y_exp, C_fine, C_coarse, shift, settings, executor, progress, log)
+    outcome = fine_level.run(first, extend=True)
+    if outcome == "extend":  # the coarse level limits the precision: more coarse draws, a new subset
+        first = coarse_level(fine_level.needed_coarse_ess)
+        outcome = fine_level.run(first, extend=False)
+    if outcome == "poor":
+        return _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, fine_level.levels)
+    levels = fine_level.levels
     if progress is not None:
-        progress(len(first.x) + len(set(index)), len(first.x) + len(set(index)))
-    return _result(levels, np.array(loglik), first, space, y_exp, C_fine, x0, C0, settings, history)
+        progress(len(first.x) + levels.fine_runs, len(first.x) + levels.fine_runs)
+    return _result(levels, fine_level.loglik, first, space, y_exp, C_fine, x0, C0, settings,
+                   [*first.history, *fine_level.history])
+
+
+class _FineLevel:
+    """The fine runs at a subset of the coarse draws, in rounds, and the two-level estimator they give."""
+
+    def __init__(self, fine, y_exp, C_fine, C_coarse, shift, settings, executor, progress, log):
+        self.fine, self.y_exp, self.C_fine, self.C_coarse, self.shift = fine, y_exp, C_fine, C_coarse, shift
+        self.settings, self.executor, self.progress, self.log = settings, executor, progress, log
+        self.levels, self.loglik, self.history, self.needed_coarse_ess = None, np.empty(0), [], 0.0
+
+    def run(self, first, *, extend: bool) -> str:
+        """Fine rounds on the coarse level ``first``: "done", "poor" (the coarse mesh screens poorly) or "extend"
+        (after the first round, when the coarse level's own error would keep the target out of reach)."""
+        settings, m = self.settings, self.y_exp.size
+        log_c = first.log_likelihood - _normalisation(self.C_coarse, m)
+        rng = np.random.default_rng(settings.seed + 1)
+        pick = subset_probabilities(first.weights)
+        index, loglik, y_fine, self.history = [], [], [], []
+        while len(set(index)) < settings.fine_runs and len(index) < MAX_DRAWS * settings.fine_runs:
+            picked = resample_index(pick, min(settings.samples_per_round, settings.fine_runs - len(set(index))), rng)
+            ll, y = _log_likelihood(evaluate_points(self.fine, first.x[picked], None, self.executor), self.y_exp,
+                                    self.C_fine)
+            index.extend(picked.tolist())
+            loglik.extend(ll.tolist())
+            y_fine.extend(y.tolist())
+            log_ratio = np.array(loglik) - _normalisation(self.C_fine, m) - log_c[index]
+            levels = Levels(first.x, first.weights, first.y - self.shift, np.array(index), log_ratio, np.array(y_fine),
+                            first.log_evidence, first.log_evidence_error, pick)
+            self.levels, self.loglik = levels, np.array(loglik)
+            equivalent = float(np.min(levels.equivalent_draws()))
+            self.history.append({"round": 0, "draws": len(picked), "failed": int(np.sum(~np.isfinite(ll))),
+                                 "ess": equivalent, "components": 0, "level": "fine"})
+            self._said(first, levels, equivalent)
+            if levels.spread > POOR_SCREEN:
+                return "poor"
+            if equivalent >= settings.target_ess:
+                return "done"
+            coarse_bound = float(np.min(levels.coarse_equivalent_draws()))
+            if coarse_bound < COARSE_SHARE * settings.target_ess:
+                if extend:
+                    self.needed_coarse_ess = math.ceil(levels.coarse_ess * COARSE_SHARE * settings.target_ess \
+                        / max(coarse_bound, 1e-9))
+                    return "extend"
+                return "done"  # more fine runs cannot reach the target: the coarse level's error dominates
+        return "done"
+
+    def _said(self, first, levels, equivalent):
+        if self.progress is not None:
+            self.progress(len(first.x) + levels.fine_runs, len(first.x) + self.settings.fine_runs)
+        if self.log is not None:
+            self.log(f"fine mesh: {levels.fine_runs} runs, equivalent draws {equivalent:.0f} (target "
+                     f"{self.settings.target_ess:g}), fine/coarse likelihood ratio's spread {levels.spread:.2f}")
 
 
 def _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels) -> PosteriorResult:
