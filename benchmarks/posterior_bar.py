@@ -186,7 +186,8 @@ def figure(result, estimate, points, p):
 def coverage(args):
     operator = bar_operator()
     inside_post, inside_kf, ess = np.zeros(2, int), np.zeros(2, int), []
-    settings = SETTINGS.replace(target_ess=400, screening=args.screening, samples_per_round=100)
+    settings = SETTINGS.replace(target_ess=args.target, screening=args.screening,
+                                samples_per_round=100 if args.screening > 1 else 200)
     with executor_session(args.workers) as executor:
         for replicate in range(args.replicates):
             y, C = noisy_data(operator, seed=100 + replicate)
@@ -211,6 +212,7 @@ def main(argv=None):
     parser.add_argument("--emcee", type=int, default=0, help="emcee steps of 16 walkers (0: no emcee run)")
     parser.add_argument("--replicates", type=int, default=20)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--target", type=float, default=400.0, help="coverage: the posterior's target_ess")
     parser.add_argument("--screening", type=float, default=1.0,
                         help="coverage: screen on a mesh this many times coarser (1: every draw a fine run)")
     args = parser.parse_args(argv)
