@@ -365,7 +365,7 @@ def write_posterior_page(path, result, pngs: dict, *, title: str = "fracid poste
 
     table, stats = comparison_table(result), statistics_table(result)
     status = esc(result.status) if result.converged else f'<span class="warn">{esc(result.status)}</span>'
-    history = html_table(["round", "mesh", "draws", "failed", "ESS after the round (fine: equivalent draws)",
+    history = html_table(["round", "level (coarse: the screening)", "draws", "failed", "ESS after the round (fine: equivalent draws)",
                           "proposal components"],
                      [[k + 1, h.get("level", "coarse" if result.levels is not None else "fine"), h.get("draws", ""),
                        h.get("failed", ""), num(h.get("ess"), 4), h.get("components", "") or ""]
