@@ -31,7 +31,8 @@ from fracid.inverse.core.forward_operator import ForwardOperator, Observation
 from fracid.inverse.core.space import ParameterSpace
 from fracid.data.covariance_matrix import as_covariance
 from fracid.inverse.core.runs import StoredOperator
-from fracid.inverse.sampling.posterior import PosteriorSettings, posterior, sample_posterior
+from fracid.inverse.sampling.posterior import PosteriorSettings, posterior
+from fracid.inverse.sampling.sample import sample_posterior
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.methods.strategy import identify
 from fracid.runtime.executors import executor_session
@@ -56,7 +57,7 @@ def noisy_data(operator, seed):
 
 def identify_and_sample(operator, y, C, executor, seed=0, settings=SETTINGS):
     """The identification and the posterior; with ``settings.screening`` > 1 the two-level posterior of
-    :func:`~fracid.inverse.sampling.posterior.sample_posterior` (the bar's mesh coarsened for screening)."""
+    :func:`~fracid.inverse.sampling.sample.sample_posterior` (the bar's mesh coarsened for screening)."""
     start = time.perf_counter()
     estimate = identify(operator, y, C, SPACE, n=16, k=4, groups=[np.arange(0, 4), np.arange(4, 8), np.arange(8, 12)], executor=executor, progress=False)
     t_kf = time.perf_counter() - start

@@ -124,7 +124,8 @@ def test_posterior_with_the_model_error_marginalised(cohesive_fitted_by_gradient
     [331, 571] N holds the identified 431 N."""
     from types import SimpleNamespace
 
-    from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
+    from fracid.inverse.sampling.posterior import PosteriorSettings
+    from fracid.inverse.sampling.sample import sample_posterior
 
     y, C, without, with_error = cohesive_fitted_by_gradient_damage
     gradient = ForwardOperator([Observation(DOGBONE, DOGBONE_POINTS)], DamageParameters(E=30000.0, c=10.0),

@@ -124,7 +124,7 @@ def test_all_runs_failed_is_a_computation_failure():
     from fracid.inverse.core.forward_operator import RunRecord
     from fracid.inverse.core.space import ParameterSpace
     from fracid.inverse.core.sensitivity import ForwardRunError
-    from fracid.inverse.sampling.posterior import sample_posterior
+    from fracid.inverse.sampling.sample import sample_posterior
 
     def failing(x, needed=None):
         return RunRecord(np.asarray(x), np.full(2, np.nan), status="failed", error="diverged")

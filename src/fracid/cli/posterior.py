@@ -25,7 +25,7 @@ def run_posterior_command(args) -> int:
     from fracid.config import posterior_settings
     from fracid.runtime.exits import FAILED
     from fracid.inverse.core.runs import StoredOperator
-    from fracid.inverse.sampling.posterior import sample_posterior
+    from fracid.inverse.sampling.sample import sample_posterior
     from fracid.report.posterior import write_posterior
 
     job = identify_job(args, args.config)

@@ -3,7 +3,7 @@ plot, posterior predictive band), its JSON, and a self-contained HTML page setti
 Gaussian beside the sampled posterior.
 
 The sampler itself is :func:`fracid.inverse.sampling.posterior.posterior`; here it is only started from an
-identification (:func:`fracid.inverse.sampling.posterior.sample_posterior`) and written out (:func:`write_posterior`).
+identification (:func:`fracid.inverse.sampling.sample.sample_posterior`) and written out (:func:`write_posterior`).
 
 Units: control [mm], force [N], parameters in the units of the result (``PosteriorResult.units``).
 """

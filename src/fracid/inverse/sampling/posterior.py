@@ -36,8 +36,8 @@ from fracid.inverse.sampling.mixture import (
 from fracid.inverse.core.sensitivity import ForwardRunError, evaluate_points
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
-__all__ = ["ESS_ADVICE", "MAX_SCREENING", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "floor_text", "posterior",
-           "sample_posterior"]
+__all__ = ["ESS_ADVICE", "MAX_SCREENING", "MIN_ESS", "MIN_ESS_FRACTION", "PosteriorSettings", "ess_floor", "ess_status",
+           "floor_text", "log_likelihood", "posterior"]
 
 #: Effective sample size below which the sampling has failed: the weights sit on a few draws, and
 #: quantiles of a few points are not credible intervals (at ESS 1 the interval is a point)
@@ -139,7 +139,7 @@ class PosteriorSettings:
         return replace(self, **changes)
 
 
-def _log_likelihood(records, y_exp, C_exp, marginal=None):
+def log_likelihood(records, y_exp, C_exp, marginal=None):
     """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs;
     chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`), or
     ``marginal(residuals)``: the model error's std integrated out (relative to C_exp's normalisation)."""
@@ -210,7 +210,7 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
     for round_ in range(settings.max_rounds):
         u = proposal.sample(rng, settings.samples_per_round)
         records = evaluate_points(evaluate, space.from_unit(u), None, executor)
-        ll, y = _log_likelihood(records, y_exp, C_exp, marginal)
+        ll, y = log_likelihood(records, y_exp, C_exp, marginal)
         # every proposal's log density at every draw: the earlier ones at the new draws, the new one at all
         densities = [np.concatenate([row, q.logpdf(u)]) for row, q in zip(densities, proposals)]
         proposals.append(proposal)
@@ -232,7 +232,7 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
         raise ForwardRunError(f"posterior: all {len(u_all)} forward runs failed or lacked outputs; nothing to weigh. "
                               "Check the bounds of [identify.bounds] (the prior) and the forward runs of the "
                               "identification; failed runs are stored: --retry-failed runs them again")
-    status = _status(ess, settings, len(u_all), len(proposals))
+    status = ess_status(ess, settings, len(u_all), len(proposals))
     lower, upper = space.lower, space.upper
     log_z, log_z_error = amis_log_evidence(np.vstack(densities), loglik, sizes)
     log_z -= 0.5 * (y_exp.size * np.log(2.0 * np.pi) + C_exp.logdet())
@@ -244,7 +244,7 @@ def posterior(evaluate, y_exp, C_exp, space, x0, C0, *, settings: PosteriorSetti
                            log_evidence=float(log_z), log_evidence_error=log_z_error, model_error=sigma)
 
 
-def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
+def ess_status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) -> str:
     """The sampler's verdict on its weights: converged, rough (below the target) or failed (below the floor)."""
     if ess >= settings.target_ess:
         return "converged"
@@ -255,84 +255,3 @@ def _status(ess: float, settings: PosteriorSettings, draws: int, rounds: int) ->
                 f"intervals; {ESS_ADVICE}")
     return (f"ESS {ess:.0f} below the target {settings.target_ess:g} after {rounds} rounds: the intervals are "
             "rough; raise max_rounds or samples_per_round")
-
-
-def sample_posterior(evaluate, data, space, identification, settings, *, executor=None, progress=None, log=None):
-    """The posterior of the identified parameters given ``data``, started from the identification's Gaussian.
-
-    Parameters
-    ----------
-    evaluate : StoredOperator or callable
-        The forward operator (through the run store: every draw is stored and reused by a rerun).
-    data : ExperimentalData
-        Measured values ``y`` and their ``covariance``.
-    space : ParameterSpace
-        Names and bounds: the prior is uniform (log-uniform where configured) between the bounds.
-    identification : IdentificationResult
-        Its ``x`` and ``C`` seed the sampler; its ``units`` label the result.
-    settings : PosteriorSettings
-    executor : Executor, optional
-    progress : bool or None
-        Progress bar: None on a terminal only, False never.
-    log : callable, optional
-        ``log(text)``: a line before the sampler starts and one per round.
-
-    Returns and raises as :func:`posterior`; the result carries the identification's units. With the
-    identification's error terms (``error_terms``), the likelihood is theirs: the data covariance with the mesh's
-    error, and the model error's std integrated out per draw (:func:`~fracid.inverse.likelihood.record.
-    error_likelihood`).
-    """
-    from fracid.inverse.likelihood.record import error_likelihood
-    from fracid.runtime.progress import batch_progress, progress_bar
-
-    C_exp, marginal = data.covariance, None
-    if getattr(identification, "error_terms", None):
-        control = identification.control if identification.control is not None else np.arange(data.y.size)
-        C_exp, marginal = error_likelihood(identification.error_terms, data.covariance, data.y, control,
-                                           identification.quantities)
-    setup, notes = _screening(evaluate, data, identification, C_exp, marginal, settings, executor)
-    if not isinstance(setup, str):
-        from fracid.inverse.sampling.screened import COARSE_ROUND, screened_posterior
-
-        coarse, shift, C_coarse, mesh = setup
-        if log is not None:
-            log(f"posterior: screened on a mesh {settings.screening:g} times coarser ({mesh}) and corrected by at most "
-                f"{settings.fine_runs} fine runs, until the posterior means are as precise as {settings.target_ess:g} "
-                "independent draws ([posterior] screening, fine_runs, target_ess)")
-        most = COARSE_ROUND * settings.samples_per_round * settings.max_rounds + settings.fine_runs
-        with progress_bar(most, "posterior (coarse and fine runs)", progress) as bar:
-            result = screened_posterior(evaluate, coarse, data.y, C_exp, C_coarse, shift, space, identification.x,
-                                        identification.C, settings=settings, executor=executor,
-                                        progress=batch_progress(bar), log=log)
-    else:
-        total = settings.samples_per_round * settings.max_rounds
-        if log is not None:
-            log(f"posterior: at most {total} forward runs ({settings.max_rounds} rounds of "
-                f"{settings.samples_per_round}), until the effective sample size reaches {settings.target_ess:g} "
-                "([posterior] settings)")
-        with progress_bar(total, "posterior", progress) as bar:
-            result = posterior(evaluate, data.y, C_exp, space, identification.x, identification.C, settings=settings,
-                               executor=executor, progress=batch_progress(bar), log=log, marginal=marginal)
-    result.notes = [*notes, *getattr(result, "notes", [])]
-    result.units = dict(identification.units or {})
-    result.std_exp = data.covariance.std()  # the measurement's, as the identification's std_exp
-    return result
-
-
-def _screening(evaluate, data, identification, C_exp, marginal, settings, executor):
-    """(the screening's setup or why not, the notes to keep): screening asked (``settings.screening`` > 1) but not
-    possible is said, never silent."""
-    if settings.screening <= 1.0:
-        return "off", []
-    if marginal is not None:
-        why = "the model error is marginalised per draw (screening does not carry it yet)"
-    else:
-        from fracid.inverse.sampling.screened import screening_setup
-
-        control = getattr(identification, "control", None)
-        control = control if control is not None else np.arange(data.y.size)
-        why = screening_setup(evaluate, data, identification.x, control, C_exp, settings, executor=executor)
-    if not isinstance(why, str):
-        return why, []
-    return why, [f"no coarse-mesh screening ([posterior] screening = {settings.screening:g}): {why}; every draw is a "
-                 "fine run"]

@@ -25,7 +25,7 @@ import numpy as np
 
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.sampling.levels import Levels, resample_index, subset_probabilities
-from fracid.inverse.sampling.posterior import _log_likelihood, _status, posterior
+from fracid.inverse.sampling.posterior import ess_status, log_likelihood, posterior
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
 __all__ = ["COARSE_ESS", "COARSE_ROUND", "COARSE_SHARE", "MAX_DRAWS", "POOR_SCREEN", "screened_posterior"]
@@ -116,7 +116,7 @@ class _FineLevel:
         index, loglik, y_fine, self.history = [], [], [], []
         while len(set(index)) < settings.fine_runs and len(index) < MAX_DRAWS * settings.fine_runs:
             picked = resample_index(pick, min(settings.samples_per_round, settings.fine_runs - len(set(index))), rng)
-            ll, y = _log_likelihood(evaluate_points(self.fine, first.x[picked], None, self.executor), self.y_exp,
+            ll, y = log_likelihood(evaluate_points(self.fine, first.x[picked], None, self.executor), self.y_exp,
                                     self.C_fine)
             index.extend(picked.tolist())
             loglik.extend(ll.tolist())
@@ -168,7 +168,7 @@ def _result(levels: Levels, loglik, first, space, y_exp, C_fine, x0, C0, setting
     rho = levels.rho
     equivalent = float(np.min(levels.equivalent_draws())) if rho.any() else 0.0
     failed = int(np.sum(~np.isfinite(levels.log_ratio)))
-    status = _status(equivalent, settings, len(levels.index), len(history))
+    status = ess_status(equivalent, settings, len(levels.index), len(history))
     if levels.spread > POOR_SCREEN and not status.startswith("failed"):
         status = (f"equivalent draws {equivalent:.0f}, but the coarse mesh screened poorly: the spread of the fine / "
                   f"coarse likelihood ratio is {levels.spread:.2g} (> {POOR_SCREEN:g}), so the stated errors rest on "

@@ -8,7 +8,7 @@ space):
 2. the sensitivities at the estimate (one run with exact derivatives, or central differences): the Laplace
    approximation of the log evidence (:mod:`fracid.inverse.studies.evidence`);
 3. the posterior by adaptive importance sampling from the identification's Gaussian
-   (:func:`fracid.inverse.sampling.posterior.sample_posterior`): the log evidence and its Monte-Carlo error from
+   (:func:`fracid.inverse.sampling.sample.sample_posterior`): the log evidence and its Monte-Carlo error from
    the importance weights, and the verdict per parameter on its credible intervals
    (:func:`fracid.inverse.studies.verdict.parameter_verdicts`; on the Gaussian when the sampling failed).
 
@@ -48,7 +48,8 @@ from fracid.inverse.core.sensitivity import exact_sensitivity
 from fracid.inverse.core.space import ParameterSpace
 from fracid.inverse.methods.registry import DEFAULT_METHOD
 from fracid.inverse.methods.strategy import identify_data
-from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
+from fracid.inverse.sampling.posterior import PosteriorSettings
+from fracid.inverse.sampling.sample import sample_posterior
 from fracid.inverse.studies import evidence
 from fracid.inverse.studies.comparison_result import ComparisonResult, ModelScore, map_objective
 from fracid.inverse.studies.model_fit import candidate_operator

@@ -28,7 +28,8 @@ import numpy as np
 from fracid.inverse.core.method import check_problem, identification_bounds
 from fracid.inverse.core.method_settings import with_settings
 from fracid.inverse.methods.registry import DEFAULT_METHOD, METHODS, StudyMethod
-from fracid.inverse.sampling.posterior import PosteriorSettings, sample_posterior
+from fracid.inverse.sampling.posterior import PosteriorSettings
+from fracid.inverse.sampling.sample import sample_posterior
 from fracid.inverse.core.runs import StoredOperator
 from fracid.inverse.likelihood.terms import Problem, with_error_terms
 from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_history
