@@ -209,7 +209,7 @@ def test_compare_command_end_to_end(bar_config):
     assert run.returncode == 0, run.stderr
     out = bar_config.parent / "out"
     saved = json.loads((out / "compare.json").read_text(encoding="utf-8"))
-    assert sorted(saved["ranking"]) == ["gradient-damage", "local-damage"] and not saved["failures"]
+    assert sorted(saved["ranking"]) == ["gradient-damage", "local-damage"] and not saved["failures"], run.stdout
     local = next(m for m in saved["models"] if m["label"] == "local-damage")
     assert list(local["parameters"]) == ["kappa_i", "beta"]  # fracid init's: bounds a factor 3 around the values
     assert local["bounds"] == [[pytest.approx(3.33e-5), 100.0], [pytest.approx(3e-4), 900.0]]

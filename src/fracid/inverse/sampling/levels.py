@@ -181,13 +181,17 @@ class Levels:
         bound that more fine runs cannot pass."""
         coarse_mean = self.w @ self.x
         coarse = np.sum(self.w[:, None] ** 2 * (self.x - coarse_mean) ** 2, axis=0) * self.spread
-        variance = np.maximum(np.diag(self.cov()), 0.0)
-        return variance / np.maximum(coarse, 1e-300)
+        return self.fine_variance() / np.maximum(coarse, 1e-300)
+
+    def fine_variance(self) -> np.ndarray:
+        """The posterior variance per parameter from the fine runs' own weights (non-negative, unlike the signed
+        weights' on a small subset): the scale of the equivalent draws."""
+        sub, rho = self.x[self.index], self.rho
+        return rho @ (sub - rho @ sub) ** 2
 
     def equivalent_draws(self) -> np.ndarray:
         """Per parameter: the posterior variance over :meth:`mean_variance` (independent draws as precise)."""
-        # signed weights can give a negative variance when the correction is wild: no draw is worth anything then
-        variance, error = np.maximum(np.diag(self.cov()), 0.0), self.mean_variance()
+        variance, error = self.fine_variance(), self.mean_variance()
         return np.where(error > 0, variance / np.maximum(error, 1e-300), np.where(variance > 0, np.inf, 0.0))
 
     def log_evidence(self) -> tuple[float, float]:

@@ -25,10 +25,10 @@ import numpy as np
 
 from fracid.inverse.core.sensitivity import evaluate_points
 from fracid.inverse.sampling.levels import Levels, resample_index, subset_probabilities
-from fracid.inverse.sampling.posterior import ess_status, log_likelihood, posterior
+from fracid.inverse.sampling.posterior import ess_floor, ess_status, log_likelihood, posterior
 from fracid.inverse.sampling.posterior_result import PosteriorResult
 
-__all__ = ["COARSE_ESS", "COARSE_ROUND", "COARSE_SHARE", "MAX_DRAWS", "POOR_SCREEN", "screened_posterior"]
+__all__ = ["COARSE_ESS", "COARSE_ROUND", "COARSE_SHARE", "MAX_COARSE_ESS", "MAX_DRAWS", "POOR_SCREEN", "screened_posterior"]
 
 #: the coarse level samples to this multiple of ``target_ess`` (its error is then a small part of the total)
 COARSE_ESS = 2.5
@@ -42,6 +42,8 @@ MAX_DRAWS = 4
 #: the coarse level's own error may take at most 1 / COARSE_SHARE of the target's variance: after the first fine
 #: round, a coarse level that would take more is sampled further (once), to the effective sample size it needs
 COARSE_SHARE = 2.0
+#: ... to at most this multiple of ``target_ess``
+MAX_COARSE_ESS = 20.0
 
 
 def _normalisation(C, m: int) -> float:
@@ -89,9 +91,9 @@ def screened_posterior(fine, coarse, y_exp, C_fine, C_coarse, shift, space, x0, 
     if outcome == "extend":  # the coarse level limits the precision: more coarse draws, a new subset
         first = coarse_level(fine_level.needed_coarse_ess)
         outcome = fine_level.run(first, extend=False)
-    if outcome == "poor":
-        return _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, fine_level.levels)
     levels = fine_level.levels
+    if outcome == "poor" or float(np.min(levels.equivalent_draws())) < ess_floor(settings.target_ess):
+        return _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels)
     if progress is not None:
         progress(len(first.x) + levels.fine_runs, len(first.x) + levels.fine_runs)
     return _result(levels, fine_level.loglik, first, space, y_exp, C_fine, x0, C0, settings,
@@ -136,8 +138,8 @@ class _FineLevel:
             coarse_bound = float(np.min(levels.coarse_equivalent_draws()))
             if coarse_bound < COARSE_SHARE * settings.target_ess:
                 if extend:
-                    self.needed_coarse_ess = math.ceil(levels.coarse_ess * COARSE_SHARE * settings.target_ess \
-                        / max(coarse_bound, 1e-9))
+                    needed = levels.coarse_ess * COARSE_SHARE * settings.target_ess / max(coarse_bound, 1e-9)
+                    self.needed_coarse_ess = math.ceil(min(needed, MAX_COARSE_ESS * settings.target_ess))
                     return "extend"
                 return "done"  # more fine runs cannot reach the target: the coarse level's error dominates
         return "done"
@@ -153,8 +155,13 @@ class _FineLevel:
 def _fine_alone(fine, y_exp, C_fine, space, x0, C0, settings, executor, progress, log, levels) -> PosteriorResult:
     """Single-level sampling on the fine mesh, when the first fine runs show that the coarse mesh screens poorly
     (the coarse posterior is far from the fine one: correcting it would cost more fine runs than sampling anew)."""
-    why = (f"the coarse mesh screened poorly (the spread of the fine / coarse likelihood ratio is {levels.spread:.3g} > "
-           f"{POOR_SCREEN:g} after {len(np.unique(levels.index))} fine runs): every draw is a fine run")
+    if levels.spread > POOR_SCREEN:
+        why = (f"the coarse mesh screened poorly (the spread of the fine / coarse likelihood ratio is "
+               f"{levels.spread:.3g} > {POOR_SCREEN:g} after {levels.fine_runs} fine runs): every draw is a fine run")
+    else:
+        why = (f"the two levels gave only {float(np.min(levels.equivalent_draws())):.0f} equivalent draws after "
+               f"{levels.fine_runs} fine runs, below the floor {ess_floor(settings.target_ess):g}: every draw is a "
+               "fine run")
     if log is not None:
         log(f"posterior: {why}")
     result = posterior(fine, y_exp, C_fine, space, x0, C0, settings=settings, executor=executor, log=log,
