@@ -19,33 +19,16 @@ from fracid.models import DamageModel
 from fracid.fem.formulations import forms
 from fracid.fem.formulations import nonlocal_average
 from fracid.fem.formulations.nonlocal_average import internal_length, nonlocal_averaging
-
-
-class _Timed:
-    """Wraps a function and sums its wall time [s]."""
-
-    def __init__(self, fn):
-        self.fn, self.seconds = fn, 0.0
-
-    def __call__(self, *args, **kwargs):
-        t0 = time.perf_counter()
-        try:
-            return self.fn(*args, **kwargs)
-        finally:
-            self.seconds += time.perf_counter() - t0
+from timing import Timed
 
 
 def run(bar, params, regularization, target):
     """Wall time [s], Newton iterations and seconds in the coupling of one analysis."""
-    coupling = _Timed(forms.softening_coupling)
-    forms.softening_coupling = coupling  # integral_damage looks it up in its module at every call
-    try:
+    with Timed(forms, "softening_coupling") as coupling:
         t0 = time.perf_counter()
         result = fracid.simulate(bar, params, model=DamageModel(regularization), control="end_displacement",
                                  target=target, stop_force_fraction=None, field_steps=None)
         seconds = time.perf_counter() - t0
-    finally:
-        forms.softening_coupling = coupling.fn
     if result.status != "target reached":
         raise RuntimeError(f"{regularization}: {result.status}")
     return seconds, result.stats.iterations, coupling.seconds

@@ -30,32 +30,10 @@ from fracid.fem.formulations import forms, nonlocal_average, problem as problems
 from fracid.fem.path import path_following
 from fracid.models import DamageModel
 from demo_setup import demo_config
+from timing import Timed
 
 ESTIMATE = {"kappa_i": 4.798e-5, "beta": 1086.5, "c": 21.46}  # docs/demo/result.json (rounded)
 MODELS = ("gradient", "integral")
-
-
-class _Timed:
-    """Wraps a function of a module and sums its wall time [s] and its calls."""
-
-    def __init__(self, module, name):
-        self.module, self.name, self.fn = module, name, getattr(module, name)
-        self.seconds, self.calls = 0.0, 0
-
-    def __call__(self, *args, **kwargs):
-        t0 = time.perf_counter()
-        try:
-            return self.fn(*args, **kwargs)
-        finally:
-            self.seconds += time.perf_counter() - t0
-            self.calls += 1
-
-    def __enter__(self):
-        setattr(self.module, self.name, self)
-        return self
-
-    def __exit__(self, *exc):
-        setattr(self.module, self.name, self.fn)
 
 
 class _Stats:
@@ -118,8 +96,8 @@ def measure(runs, repeats):
     best = {model: (np.inf, None) for model in runs}
     for _ in range(repeats):
         for model, run in runs.items():
-            with _Timed(problems, "integral_damage") as evaluations, \
-                    _Timed(forms, "softening_coupling") as coupling, _Stats() as stats:
+            with Timed(problems, "integral_damage") as evaluations, \
+                    Timed(forms, "softening_coupling") as coupling, _Stats() as stats:
                 t0 = time.perf_counter()
                 run()
                 seconds = time.perf_counter() - t0

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.special import logsumexp
@@ -65,7 +66,7 @@ def signed_quantile(values, weights, q) -> np.ndarray:
     return np.interp(np.atleast_1d(q), cdf, v)
 
 
-@dataclass
+@dataclass(frozen=True)
 class Levels:
     """The coarse draws, the fine subset and what the two-level estimator makes of them.
 
@@ -89,6 +90,8 @@ class Levels:
         The probabilities with which the subset was drawn from the coarse draws (default: ``w``). A flatter
         choice (w^alpha, :func:`subset_probabilities`) reaches into the coarse posterior's tails, where the fine
         posterior may hold more mass than the coarse one; the weights below divide by it.
+
+    Immutable: the weights derived from these arrays are computed once (cached properties).
     """
 
     x: np.ndarray
@@ -101,19 +104,19 @@ class Levels:
     log_evidence_coarse_error: float = float("nan")
     pick: np.ndarray | None = None
 
-    @property
+    @cached_property
     def _log_pick_ratio(self) -> np.ndarray:
         """log(w_j / pick_j) of the subset: the coarse posterior's weight over the subset's draw probability."""
         pick = self.w if self.pick is None else self.pick
         with np.errstate(divide="ignore"):
             return np.log(self.w[self.index]) - np.log(pick[self.index])
 
-    @property
+    @cached_property
     def coarse_subset(self) -> np.ndarray:
         """The coarse posterior's weights of the subset, sum 1 (1/N when drawn from ``w`` itself)."""
         return np.exp(self._log_pick_ratio - logsumexp(self._log_pick_ratio))
 
-    @property
+    @cached_property
     def rho(self) -> np.ndarray:
         """The fine weights of the subset, sum 1 (the exact fine posterior's importance weights against the
         subset's draw); zeros when every fine run failed."""
@@ -129,7 +132,7 @@ class Levels:
         rho = self.rho
         return float(1.0 / np.sum(rho**2)) if rho.any() else 0.0
 
-    @property
+    @cached_property
     def spread(self) -> float:
         """E_c[r^2] / E_c[r]^2 >= 1 over the coarse posterior (estimated on the subset): 1 when the fine posterior is
         the coarse one, large when the coarse mesh screened poorly (the coarse draws then carry the fine estimate
@@ -217,8 +220,8 @@ class Levels:
     def summary(self) -> dict:
         """What the result records of the two levels (JSON-ready)."""
         value, error = self.log_evidence()
-        return {"coarse_draws": int(len(self.x)), "coarse_ess": float(1.0 / np.sum(self.w**2)),
-                "fine_runs": int(len(np.unique(self.index))), "fine_draws": int(len(self.index)),
+        return {"coarse_draws": int(len(self.x)), "coarse_ess": self.coarse_ess,
+                "fine_runs": self.fine_runs, "fine_draws": int(len(self.index)),
                 "fine_ess": self.fine_ess, "spread": self.spread, "equivalent_draws": self.equivalent_draws().tolist(),
                 "mean_error": np.sqrt(self.mean_variance()).tolist(),
                 "log_evidence_coarse": self.log_evidence_coarse, "log_evidence": value, "log_evidence_error": error}
@@ -226,6 +229,6 @@ class Levels:
     def line(self, status: str, failed: int) -> str:
         """The two levels in one line (the summary's first)."""
         worst = float(np.min(self.equivalent_draws()))
-        return (f"posterior: {len(self.x)} coarse draws (ESS {1.0 / np.sum(self.w**2):.0f}) corrected by "
-                f"{len(np.unique(self.index))} fine runs (fine/coarse likelihood ratio's spread {self.spread:.2f}): as precise as "
+        return (f"posterior: {len(self.x)} coarse draws (ESS {self.coarse_ess:.0f}) corrected by "
+                f"{self.fine_runs} fine runs (fine/coarse likelihood ratio's spread {self.spread:.2f}): as precise as "
                 f"{worst:.0f} independent draws, {failed} failed run{'' if failed == 1 else 's'}; {status}")
