@@ -116,11 +116,13 @@ def _population_text(population: int, how: str, method: str, p: int, n_y: int) -
 
 def knn_template(raw: dict, prior: str = "the prior") -> list[str]:
     """The lines of ``[identify.knn]`` in a generated configuration: ``n`` (default 32, a first run's),
-    ``method`` and ``k`` of ``raw`` (the values to write), each with its comment; ``prior`` names what the
-    neighbours give."""
+    ``method``, ``k`` and ``screening`` of ``raw`` (the values to write), each with its comment; ``prior`` names
+    what the neighbours give."""
     return [f"[identify.{KNN_TABLE}]", toml_line("n", raw.get("n", 32), "population of forward runs (the bulk of the cost)"),
             toml_line("method", raw.get("method", "sobol"), " | ".join(f'"{m}"' for m in KNN_METHODS)),
-            toml_line("k", raw.get("k", 5), f"neighbours giving {prior}")]
+            toml_line("k", raw.get("k", 5), f"neighbours giving {prior}"),
+            toml_line("screening", raw.get("screening", DEFAULT_SCREENING),
+                      "population on a mesh this many times coarser (1: the configured mesh)")]
 
 
 __all__ = ["DEFAULT_SCREENING", "KNN_KEYS", "MAX_SCREENING", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]
