@@ -65,8 +65,11 @@ def stored_rows(path) -> int:
         return 0
 
 
-#: a [posterior] section small enough for tests (3 rounds of 40 runs)
-SMALL_POSTERIOR = "\n[posterior]\nsamples_per_round = 40\nmax_rounds = 3\ntarget_ess = 30\n"
+#: a [posterior] section small enough for tests (3 rounds of 40 runs), sampled on the bar's own mesh (single level:
+#: the coarse-mesh screening costs more than it saves on a 60-element bar; SCREENED_POSTERIOR tests it)
+SMALL_POSTERIOR = "\n[posterior]\nsamples_per_round = 40\nmax_rounds = 3\ntarget_ess = 30\nscreening = 1\n"
+#: the same with the default coarse-mesh screening (two levels)
+SCREENED_POSTERIOR = SMALL_POSTERIOR.replace("screening = 1", "screening = 2")
 
 
 def run_bar_command(directory, command, extra="", workers="1"):

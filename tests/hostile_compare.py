@@ -15,9 +15,9 @@ from hostile import _clean, case, check, fracid_wrote
 
 #: a posterior whose second round reaches ESS 15 on the bar (measured 19.5 with c at its lower bound), the floor
 #: min(15, 50) = 15
-ESTIMATED = "[posterior]\nsamples_per_round = 40\nmax_rounds = 2\ntarget_ess = 15\n"
+ESTIMATED = "[posterior]\nsamples_per_round = 40\nmax_rounds = 2\ntarget_ess = 15\nscreening = 1\n"
 #: 10 draws: ESS <= 10, below the floor of 20 whatever the weights
-BELOW_FLOOR = "[posterior]\nsamples_per_round = 10\nmax_rounds = 1\ntarget_ess = 20\n"
+BELOW_FLOOR = "[posterior]\nsamples_per_round = 10\nmax_rounds = 1\ntarget_ess = 20\nscreening = 1\n"
 #: c = 6 mm^2 on 50 elements: the rule's c in [2, 18] is resolved everywhere (l = 2 mm >= h = 2 mm)
 FINE = {"c": "6.0", "n_elements": "50", "bounds": "c = [2.0, 18.0]\nbeta = [100.0, 900.0]"}
 TWO = ("--models", "gradient-damage", "local-damage")

@@ -44,7 +44,7 @@ CANDIDATES = (Candidate("cohesive crack", CohesiveCrackModel(), CohesiveParamete
                         ("kappa_i", "beta"), ParameterSpace(("kappa_i", "beta"), [3e-5, 200.0], [1.2e-4, 3000.0],
                                                             log=(False, True))))
 SETTINGS = {"n": 8, "k": 3, "groups": np.array_split(np.arange(CMOD.size), 3), "max_iterations": 2, "max_starts": 1}
-SAMPLER = PosteriorSettings(samples_per_round=24, max_rounds=2, target_ess=25.0)
+SAMPLER = PosteriorSettings(samples_per_round=24, max_rounds=2, target_ess=25.0, screening=1.0)  # single level
 
 
 # ------------------------------------------------------------------------------------------ arithmetic
@@ -177,6 +177,7 @@ max_starts = 1
 samples_per_round = 40
 max_rounds = 3
 target_ess = 20
+screening = 1
 [output]
 directory = "out"
 """
@@ -254,7 +255,7 @@ def test_a_failing_model_is_recorded_and_the_others_go_on(bar_config):
     operator, space = build_operator(cfg, data), build_space(cfg)
     wrong = ParameterSpace(("kappa_i", "c"), space.lower, space.upper)
     result = compare(data, [Contender("bar", operator, space), Contender("broken", operator, wrong)],
-                     posterior=PosteriorSettings(samples_per_round=40, max_rounds=2, target_ess=15.0), n=12, k=3,
+                     posterior=PosteriorSettings(samples_per_round=40, max_rounds=2, target_ess=15.0, screening=1.0), n=12, k=3,
                      groups=np.array_split(np.arange(data.y.size), 2), max_iterations=3, max_starts=1)
     assert [s.label for s in result.scores] == ["bar"] and result.best.label == "bar"
     assert "broken" in result.failures and "ValueError" in result.failures["broken"]

@@ -69,7 +69,7 @@ def _written(tmp_path, capsys) -> str:
     np.savetxt(tmp_path / "bar.csv", np.column_stack([u, noisy]), delimiter=",", header="u_mm,F_N", comments="")
     text += ('\n[[experiments]]\nfile = "bar.csv"\ncontrol_column = "u_mm"\ncontrol_unit = "mm"\nforce_unit = "N"\n'
              f'kind = "single"\nforce_columns = ["F_N"]\nstd = {std}\nn_points = 8\n'
-             "[posterior]\nsamples_per_round = 10\nmax_rounds = 1\ntarget_ess = 5\n")
+             "[posterior]\nsamples_per_round = 10\nmax_rounds = 1\ntarget_ess = 5\nscreening = 1\n")
     path.write_text(text, encoding="utf-8")
     capsys.readouterr()
     return text

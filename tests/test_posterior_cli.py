@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from _bar_study import SMALL_POSTERIOR, run_bar_command, write_bar_study
+from _bar_study import SCREENED_POSTERIOR, run_bar_command, write_bar_study
 from fracid import cli
 from fracid.runtime import exits
 from fracid.inverse.sampling.mixture import weighted_quantile
@@ -22,8 +22,8 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    """The bar study with a small [posterior] section, run once: (config, output directory)."""
-    return run_bar_command(tmp_path_factory.mktemp("posterior"), "posterior", SMALL_POSTERIOR)
+    """The bar study with a small [posterior] section (two levels), run once: (config, output directory)."""
+    return run_bar_command(tmp_path_factory.mktemp("posterior"), "posterior", SCREENED_POSTERIOR)
 
 
 def _draws(out):
@@ -38,6 +38,8 @@ def test_posterior_writes_draws_json_figures_and_page(run):
     assert table.shape[0] >= 40 and np.isclose(table[:, 2].sum(), 1.0, atol=1e-6)
     info = json.loads((out / "posterior.json").read_text())
     assert info["ess"] >= 30 and info["status"] == "converged"
+    levels = info["screening"]  # two levels: coarse draws corrected by fewer fine runs (or the fallback, said)
+    assert (levels is not None and levels["fine_runs"] < levels["coarse_draws"]) or info["notes"], info["notes"]
     assert np.shape(info["interval_90"]) == (2, 2) and np.shape(info["gaussian"]["interval_90"]) == (2, 2)
     c = info["parameters"]["c"]
     assert c["unit"] == "mm^2" and set(c) == {"unit", "gaussian", "posterior"}
