@@ -10,8 +10,9 @@ from hostile import IDENTIFY, OUT, REACHES_OUTPUT, _clean, _out_is_file, case, c
 #: [identify] of the bar's gradient-damage model with kappa_i identified too
 KAPPA_I = '["c", "beta", "kappa_i"]'
 BOUNDS = "c = [0.5, 4.0]\nbeta = [100.0, 500.0]\n"
-#: a [posterior] whose 8 draws can never reach the floor of 50 effective samples (the validator's minima: 2 and 1)
-TINY_POSTERIOR = "[posterior]\nsamples_per_round = 8\nmax_rounds = 1\n"
+#: a [posterior] whose 8 draws can never reach the floor of 50 effective samples (the validator's minima: 2 and 1),
+#: on one level (the floor is the subject, not the screening)
+TINY_POSTERIOR = "[posterior]\nsamples_per_round = 8\nmax_rounds = 1\nscreening = 1\n"
 
 
 def _misfit_csv(d, curve):
