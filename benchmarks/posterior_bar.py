@@ -14,7 +14,7 @@ The bar with a weak zone (60 elements), force-elongation curve at 12 points up t
    contain the truth, per parameter.
 
     python benchmarks/posterior_bar.py reference [--grid 61] [--emcee 2000] [--workers 2]
-    python benchmarks/posterior_bar.py coverage [--replicates 20] [--workers 2] [--screening 2]
+    python benchmarks/posterior_bar.py coverage [--replicates 20] [--first 0] [--workers 2] [--screening 2]
 """
 
 from __future__ import annotations
@@ -190,7 +190,7 @@ def coverage(args):
     settings = SETTINGS.replace(target_ess=args.target, screening=args.screening,
                                 samples_per_round=100 if args.screening > 1 else 200)
     with executor_session(args.workers) as executor:
-        for replicate in range(args.replicates):
+        for replicate in range(args.first, args.first + args.replicates):
             y, C = noisy_data(operator, seed=100 + replicate)
             estimate, result, _, t_post = identify_and_sample(operator, y, C, executor, seed=replicate, settings=settings)
             interval = result.credible_intervals(0.9)
@@ -212,6 +212,8 @@ def main(argv=None):
     parser.add_argument("--grid", type=int, default=61)
     parser.add_argument("--emcee", type=int, default=0, help="emcee steps of 16 walkers (0: no emcee run)")
     parser.add_argument("--replicates", type=int, default=20)
+    parser.add_argument("--first", type=int, default=0,
+                        help="coverage: the first replicate's index (its noise seed is 100 + index; to go on later)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--target", type=float, default=400.0, help="coverage: the posterior's target_ess")
     parser.add_argument("--screening", type=float, default=1.0,
