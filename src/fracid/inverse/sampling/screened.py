@@ -136,12 +136,11 @@ class _FineLevel:
             if equivalent >= settings.target_ess:
                 return "done"
             coarse_bound = float(np.min(levels.coarse_equivalent_draws()))
-            if coarse_bound < COARSE_SHARE * settings.target_ess:
-                if extend:
-                    needed = levels.coarse_ess * COARSE_SHARE * settings.target_ess / max(coarse_bound, 1e-9)
-                    self.needed_coarse_ess = math.ceil(min(needed, MAX_COARSE_ESS * settings.target_ess))
-                    return "extend"
-                return "done"  # more fine runs cannot reach the target: the coarse level's error dominates
+            if extend and coarse_bound < COARSE_SHARE * settings.target_ess:
+                needed = levels.coarse_ess * COARSE_SHARE * settings.target_ess / max(coarse_bound, 1e-9)
+                self.needed_coarse_ess = math.ceil(min(needed, MAX_COARSE_ESS * settings.target_ess))
+                return "extend"
+            # after the extension, more fine runs still shrink the correction's error: go on to fine_runs
         return "done"
 
     def _said(self, first, levels, equivalent):
