@@ -219,9 +219,9 @@ values allowed are named in :mod:`fracid.config.vocabulary`.
     inflation = 2.0                     # > 0: std multiplier of the first proposal around the Kalman
                                         #   estimate, default 2
     seed = 0                            # integer >= 0: seed of the draws (same seed: same runs, reused)
-    screening = 2.0                     # 1 <= s <= 4: screen the draws on a mesh s times coarser and correct
+    screening = 1.0                     # 1 <= s <= 4: screen the draws on a mesh s times coarser and correct
                                         #   them by fine runs (the fine model's posterior, its Monte-Carlo
-                                        #   error stated); 1: every draw a fine run. Default 2; where the
+                                        #   error stated); 1: every draw a fine run. Default 1; where the
                                         #   mesh cannot be coarsened (a mesh file), every draw is a fine run
                                         #   and the results say so
     fine_runs = 300                     # integer >= 2: with screening, fine runs at most, default 300
