@@ -148,7 +148,7 @@ def main(argv=None) -> int:
         "wall_seconds": {"total": wall, **times},
     }
     (args.out / "results.json").write_text(json.dumps(results, indent=1))
-    tables = ["## Cross-calibration", "", markdown_table(*cross_rows(crosses)), "", f"## {label_c}", "",
+    tables = ["# Calibration across models: the tables", "", "## Cross-calibration", "", markdown_table(*cross_rows(crosses)), "", f"## {label_c}", "",
               markdown_table(*comparison_rows(comparison)), "",
               *(f"{label}: not fitted ({reason})" for label, reason in comparison.failures.items()), "",
               f"Wall time: {wall:.0f} s in all ((a) {times['a']:.0f} s, (b) {times['b']:.0f} s, (c) {times['c']:.0f} s) "

@@ -62,7 +62,8 @@ def summary_figure(outcomes):
 
 
 def markdown(rows, seconds):
-    lines = ["| case | values | corr(c, beta) | c: estimate, error, std | beta: estimate, error, std | "
+    lines = ["# Twin matrix: every parameter subset and data set, identified back from synthetic data", "",
+             "| case | values | corr(c, beta) | c: estimate, error, std | beta: estimate, error, std | "
              "scatter c, beta (replicates) | verdict c / beta | wall |",
              "|---|---|---|---|---|---|---|---|"]
     for row in rows:

@@ -64,7 +64,8 @@ def _parents() -> SimpleNamespace:
     return SimpleNamespace(common=common, stored=stored)
 
 
-def _parser() -> argparse.ArgumentParser:
+def parser() -> argparse.ArgumentParser:
+    """The ``fracid`` command's argument parser, with every command's sub-parser."""
     parser = argparse.ArgumentParser(prog="fracid", description="Parameter identification for localized-failure models.")
     parser.add_argument("--version", action="version", version=f"fracid {version()}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -97,7 +98,7 @@ def main(argv=None) -> int:
     args = None
     with exits.stop_signals():
         try:
-            args = _parser().parse_args(argv)
+            args = parser().parse_args(argv)
             args.argv = ["fracid", *(sys.argv[1:] if argv is None else argv)]
             if getattr(args, "workers", None) is not None and args.workers < 1:
                 print(f"fracid: --workers = {args.workers}: it must be at least 1", file=sys.stderr)
