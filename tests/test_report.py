@@ -3,13 +3,14 @@ self-containment, and (if a Chromium is installed) that every image decodes in a
 
 import base64
 import re
-import shutil
 import struct
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+
+from _browser import render
 
 from fracid.inverse.methods.knn_kalman import IdentificationResult
 from fracid.report import fit_metrics, write_report
@@ -211,32 +212,6 @@ def test_minimal_result_from_json_lists(tmp_path):
 def test_importing_the_report_package_does_not_import_matplotlib():
     code = "import sys, fracid.report; assert 'matplotlib' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
-
-
-def find_browser():
-    for name in ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable"):
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
-
-
-def render(path, tmp_path):
-    """The DOM of ``path`` after a headless Chromium loaded it (its load script run), and the browser's log;
-    skips without a browser."""
-    browser = find_browser()
-    if browser is None:
-        pytest.skip("no browser (.ci/run installs chromium where apt-get can)")
-    command = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
-               "--disable-background-networking", "--disable-component-update", "--disable-sync",
-               "--enable-logging=stderr", "--v=0", f"--user-data-dir={tmp_path / 'profile'}",
-               "--virtual-time-budget=5000", "--dump-dom", path.resolve().as_uri()]
-    try:
-        done = subprocess.run(command, check=False, capture_output=True, text=True, timeout=90)
-    except subprocess.TimeoutExpired:
-        pytest.fail(f"{browser} did not finish within 90 s")
-    assert done.returncode == 0, done.stderr[-2000:]
-    return done.stdout, done.stderr
 
 
 def check_rendered(dom, log, images, cells=()):

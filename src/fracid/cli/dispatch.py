@@ -1,6 +1,8 @@
 """The ``fracid`` command's parser and dispatch: a thin layer over the Python API, one module per command
 (:data:`COMMANDS`), each adding its subparser and the function that runs it.
 
+.. code-block:: text
+
     fracid simulate CONFIG    forward analysis: curve (CSV), plot (PNG), fields (VTK)
     fracid identify CONFIG    the inverse method of [identify] method: result (JSON), fitted curves (CSV), figures,
                               HTML report

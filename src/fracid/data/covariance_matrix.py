@@ -1,7 +1,7 @@
 """Covariance matrices of the data, C_exp, that never form an n x n array unless they are one.
 
 Every inverse method and the posterior use C_exp only through ``solve`` (C^-1 b), ``logdet``
-(log det C), ``whiten`` (L^-1 r with C = L L^T, so that |whiten(r)|^2 = r^T C^-1 r), ``color``
+(log det C), ``whiten`` (L^-1 r with C = L L^T, so that ``|whiten(r)|^2 = r^T C^-1 r``), ``color``
 (L z: a draw of N(0, C) from a standard normal z), ``diag`` (the variances) and ``take`` (the
 covariance of a subset of the entries). Four kinds implement them:
 

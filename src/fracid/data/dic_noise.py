@@ -18,7 +18,7 @@ International DIC Society, 2018, section 5.3: the spatial resolution is of the o
 size and the measurements at a step smaller than the subset are correlated).
 
 The dense kernel is n x n; :func:`dic_covariance` returns it as a
-:class:`~fracid.data.covariance_matrix.LowRankPlusDiagonal` (U U^T + diag(d)) from its leading
+:class:`~fracid.data.covariance_low_rank.LowRankPlusDiagonal` (U U^T + diag(d)) from its leading
 eigenpairs (exact eigen-decomposition up to :data:`EXACT_LIMIT` points, Nystrom's approximation on
 :data:`NYSTROM_LANDMARKS` landmark points beyond), the variance the low-rank part leaves out on the
 diagonal, so that the diagonal is std^2 exactly. :func:`dic_frames_covariance` stacks it over frames

@@ -10,8 +10,7 @@ A forward model declares
     (name -> (lower, upper) of quasi-brittle materials; may be empty) and ``replace(**changes)`` on instances,
     returning a validated copy (ValueError for bad values); :class:`~fracid.fem.material.ranges.ParameterSet`
     gives them all.
-``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints,
-damage_threshold, observables, sensitivities)``
+``simulate(specimen, params, *, control, target, stop_force_fraction, steps, field_steps, checkpoints, damage_threshold, observables, sensitivities)``
     One forward run, returning an object with ``control`` [mm], ``force`` [N] and ``observables``
     (dict of arrays, e.g. ``fpz_width`` [mm]) along the path, raising
     :class:`~fracid.fem.path.path_following.ConvergenceError` (with ``.partial``) when it cannot go on.

@@ -1,6 +1,6 @@
 """Figures of an identification result (matplotlib, Agg canvas; no pyplot global state).
 
-Every ``*_figure`` function takes an :class:`~fracid.inverse.methods.strategy.IdentificationResult` (or any
+Every ``*_figure`` function takes an :class:`~fracid.inverse.methods.knn_kalman.IdentificationResult` (or any
 object with the same attributes; lists from a JSON file are accepted) and returns a
 :class:`matplotlib.figure.Figure`, or ``None`` when the result holds nothing to draw (no Kalman
 history, no KNN population, a single parameter for the map). :func:`to_png` renders a figure to PNG
