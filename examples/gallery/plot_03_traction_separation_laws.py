@@ -20,7 +20,7 @@ import numpy as np
 from fracid.fem.material.laws import TRACTION_SEPARATION_LAWS
 
 ft, Gf = 3.0, 0.1  # MPa, N/mm
-fig, ax = plt.subplots(figsize=(6, 3.8))
+curves = {}
 for name, law_class in TRACTION_SEPARATION_LAWS.items():
     law = law_class()
     params = law.parameters(E=30000.0, ft=ft, Gf=Gf)
@@ -28,7 +28,7 @@ for name, law_class in TRACTION_SEPARATION_LAWS.items():
     w = np.linspace(0.0, wc, 2001)
     sigma, _ = law.traction(w, params)  # traction [MPa] and its slope d sigma / d w [MPa/mm]
     area = np.trapezoid(sigma, w)
-    ax.plot(w, sigma, label=f"{name}: $w_c$ = {wc:.3f} mm, area = {area:.4f} N/mm")
+    curves[name] = w, sigma, area
     print(f"{name:9s} strength {law.strength(params):.2f} MPa, w_c {wc:.4f} mm, area under the law {area:.5f} N/mm")
 
 # %%
@@ -37,6 +37,9 @@ for name, law_class in TRACTION_SEPARATION_LAWS.items():
 # = 0.067 mm), Hordijk's latest (:math:`w_c = 5.14\, G_f / f_t` = 0.17 mm). Below a
 # third of the strength (1 MPa) Hordijk's and the bilinear law still dissipate 47 % of :math:`G_f`, the linear
 # law 11 %: the tail of a test's curve informs :math:`G_f` and the shape of the law, the peak :math:`f_t`.
+fig, ax = plt.subplots(figsize=(6, 3.8))
+for name, (w, sigma, area) in curves.items():
+    ax.plot(w, sigma, label=f"{name}: $w_c$ = {w[-1]:.3f} mm, area = {area:.4f} N/mm")
 ax.set(xlabel="crack opening w [mm]", ylabel="traction σ [MPa]", title=f"$f_t$ = {ft} MPa, $G_f$ = {Gf} N/mm")
 ax.legend(fontsize="small")
 fig.tight_layout()

@@ -29,19 +29,15 @@ length, h, weak = 50.0, 0.4, 0.99
 bar = fracid.BarWithWeakZone(length=length, n_elements=int(length / h), weakening="area", weak_zone_factor=weak,
                              weak_zone_width=2 * h)
 elastic_length = length - 2 * h + 2 * h / weak
-fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), sharey=True)
-for ax, shape in zip(axes, ("cornelissen", "linear")):
+runs = {}
+for shape in ("cornelissen", "linear"):
     model = model_from_type("pf-czm", shape)
     params = model.parameters(E=E, ft=ft, Gf=Gf, l=l)
     result = fracid.simulate(bar, params, model=model, control="end_displacement", target=0.5,
                              stop_force_fraction=0.02)
     opening = result.control - result.force * elastic_length / E  # [mm]; force / section = stress [MPa]
     w_exact, sigma_exact = localized_cohesive_law(E, ft, Gf, l, *SHAPES[shape])
-    grid = np.linspace(0.0, w_exact.max(), 400)
-    ax.plot(grid, target_law(shape, grid, ft, Gf), "k--", label=f"nominal {shape} law")
-    ax.plot(w_exact, sigma_exact, color="C1", label="PF-CZM band's exact law")
-    ax.plot(opening[::3], result.force[::3], "o", markersize=3, color="C0", label=f"bar run, {result.n_steps} steps")
-    ax.set(xlabel="band opening w [mm]", title=f"{shape} shape, l = {l:g} mm", xlim=(0.0, w_exact.max()))
+    runs[shape] = opening, result, w_exact, sigma_exact
     nominal_gap = np.abs(sigma_exact - target_law(shape, w_exact, ft, Gf)).max() / ft
     softening = (np.arange(opening.size) > result.force.argmax()) & (result.force > 0.2 * ft)
     run_gap = np.abs(result.force[softening] - np.interp(opening[softening], w_exact, sigma_exact)).max() / ft
@@ -49,8 +45,6 @@ for ax, shape in zip(axes, ("cornelissen", "linear")):
           f"nominal one by {100 * nominal_gap:.1f} %")
     print(f"{shape:11s}: peak stress {result.peak_force:.3f} MPa, dissipated energy "
           f"{result.observables['dissipated_energy'][-1]:.4f} N mm (Gf x section = {Gf:.4f})")
-axes[0].set_ylabel("stress σ [MPa]")
-axes[0].legend(fontsize="small")
 
 # %%
 # What to see: the run's points lie on the band's exact law (the model's own closed form; the printed departure
@@ -59,5 +53,14 @@ axes[0].legend(fontsize="small")
 # peak stress is :math:`f_t` less the weak elements' 1 %, and the dissipated energy approaches :math:`G_f`
 # times the section as the tail vanishes (the run stops at 2 % of the peak). Changing :math:`l` (try 1 or 4 mm,
 # with h = l / 5) changes the band's width, not the law.
+fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), sharey=True)
+for ax, (shape, (opening, result, w_exact, sigma_exact)) in zip(axes, runs.items()):
+    grid = np.linspace(0.0, w_exact.max(), 400)
+    ax.plot(grid, target_law(shape, grid, ft, Gf), "k--", label=f"nominal {shape} law")
+    ax.plot(w_exact, sigma_exact, color="C1", label="PF-CZM band's exact law")
+    ax.plot(opening[::3], result.force[::3], "o", markersize=3, color="C0", label=f"bar run, {result.n_steps} steps")
+    ax.set(xlabel="band opening w [mm]", title=f"{shape} shape, l = {l:g} mm", xlim=(0.0, w_exact.max()))
+axes[0].set_ylabel("stress σ [MPa]")
+axes[0].legend(fontsize="small")
 fig.tight_layout()
 plt.show()
