@@ -12,8 +12,8 @@ identifies the parameters of regularised models: the parameters of a local model
 
 # %%
 # A bar of 100 mm whose weak zone has a "hat" profile (its modulus is lowest at the centre), so that a local
-# model localises at mid-length; 50, 100 and 200 elements (h = 2, 1, 0.5 mm outside the weak zone). The runs follow the weak zone's
-# elongation up to 0.01 mm, through any snap-back.
+# model localises at mid-length; 50, 100 and 200 elements (h = 2, 1, 0.5 mm outside the weak zone). The runs
+# follow the weak zone's elongation up to 0.01 mm, through any snap-back.
 import matplotlib.pyplot as plt
 
 import fracid

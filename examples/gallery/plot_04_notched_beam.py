@@ -32,8 +32,8 @@ print(f"peak {result.peak_force:.0f} N at CMOD {cmod[force.argmax()]:.4f} mm, {r
 # %%
 # Left: the half mesh, coloured by the damage at the last step (the largest value in each element): the
 # process zone has risen from the notch tip (y = 25 mm) up the ligament (x = 0) towards the loading plate; some
-# damage also appears above the support (x = 62.5 mm), where the plate's edges concentrate the strains. Right: the force against the CMOD, and the
-# deflection under the loading plate against the force, the other control the beam offers
+# damage also appears above the support (x = 62.5 mm), where the plate's edges concentrate the strains. Right: the
+# force against the CMOD, and against the deflection under the loading plate, the other control the beam offers
 # (``control="deflection"``). The peak (about 1.3 kN) comes at a CMOD of about 0.03 mm; the run stops when the
 # force has fallen to 30 % of it.
 omega = result.fields[result.n_steps]["omega"].max(axis=1)
