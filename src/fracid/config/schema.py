@@ -243,7 +243,7 @@ from pathlib import Path
 
 from fracid.config.registry import model_of
 from fracid.models.registry import DEFAULT_MODEL_TYPE
-from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD
+from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD, SIMULATE, STUDY
 from fracid.inverse.sampling.posterior import PosteriorSettings
 
 
@@ -320,8 +320,8 @@ class SimulateConfig:
     """``[simulate]``: target [mm] (None: the specimen's), stop_force_fraction, damage_threshold."""
 
     target: float | None = None
-    stop_force_fraction: float = 0.1
-    damage_threshold: float = 0.0
+    stop_force_fraction: float = SIMULATE["stop_force_fraction"].default
+    damage_threshold: float = SIMULATE["damage_threshold"].default
 
 
 @dataclass(frozen=True)
@@ -329,12 +329,13 @@ class StudyConfig:
     """``[study]``: multi-start points, noisy replicates, their seed, the tolerance of the verdict, the
     Kalman prior, and whether ``fracid study`` samples the posterior (its verdict then reads it)."""
 
-    starts: int = 3
-    replicates: int = 5
-    seed: int = 0
-    tolerance: float = 0.1
-    prior: str = "search"
-    posterior: bool = False
+    # the defaults are the vocabulary's (fracid.config.vocabulary.STUDY), where each key is described
+    starts: int = STUDY["starts"].default
+    replicates: int = STUDY["replicates"].default
+    seed: int = STUDY["seed"].default
+    tolerance: float = STUDY["tolerance"].default
+    prior: str = STUDY["prior"].default
+    posterior: bool = STUDY["posterior"].default
 
 
 #: ``[posterior]``: the sampler's own settings object (its defaults are the section's; the section's checker
