@@ -179,10 +179,10 @@ def entries() -> tuple:
 
 
 def comment(key: Key) -> str:
-    """The comment of a key in a written configuration (``fracid init``): its allowed values and its meaning,
+    """The comment of a key in a written configuration (``fracid init``): its allowed values, unit and meaning,
     in plain text."""
-    allowed, meaning = key.allowed_text(), plain(key.meaning)
-    return f"{allowed}: {meaning}" if allowed else meaning
+    allowed = key.allowed_text() + (f" [{key.unit}]" if key.unit else "")
+    return f"{allowed} - {plain(key.meaning)}" if allowed else plain(key.meaning)
 
 
 __all__ = ["Entry", "TOP_TABLE", "comment", "entries", "experiment_keys", "identify_tables", "parameter_keys",
