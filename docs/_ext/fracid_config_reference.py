@@ -20,8 +20,8 @@ from sphinx.util.docutils import SphinxDirective
 
 from fracid.settings.keys import REQUIRED, UNSET
 
-#: a ``literal``, or a reST role with its target (``:func:`~a.b.c```, ``:class:`words <a.b>```)
-_MARK = re.compile(r"``(.+?)``|:[a-z]+(?::[a-z]+)?:`(~?)([^`<]*?)(?:\s*<[^`>]*>)?`")
+#: a ``literal``, a reST role with its target (``:func:`~a.b.c```, ``:class:`words <a.b>```), or a `command`
+_MARK = re.compile(r"``(.+?)``|:[a-z]+(?::[a-z]+)?:`(~?)([^`<]*?)(?:\s*<[^`>]*>)?`|`([^`]+)`")
 
 
 def inline(text: str) -> list:
@@ -29,8 +29,8 @@ def inline(text: str) -> list:
     out, last = [], 0
     for match in _MARK.finditer(text):
         out.append(nodes.Text(text[last:match.start()]))
-        if match.group(1) is not None:
-            out.append(nodes.literal(text=match.group(1)))
+        if match.group(1) is not None or match.group(4) is not None:
+            out.append(nodes.literal(text=match.group(1) or match.group(4)))
         else:
             target = match.group(3).strip()
             out.append(nodes.literal(text=target.rsplit(".", 1)[-1] if match.group(2) else target))

@@ -59,7 +59,11 @@ class Key:
 
     def default_text(self) -> str:
         """``default`` as written in a configuration (TOML), or its words (:class:`Said`)."""
-        return str(self.default) if isinstance(self.default, Said) else toml_value(self.default)
+        if isinstance(self.default, Said):
+            return str(self.default)
+        if isinstance(self.default, float) and len(repr(self.default)) > 10:  # 1/3: 0.333333, still a TOML float
+            return f"{self.default:.6g}"
+        return toml_value(self.default)
 
     def allowed_text(self) -> str:
         """``allowed`` in words (a callable asked now)."""
