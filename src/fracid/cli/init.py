@@ -115,11 +115,12 @@ def _specimen_lines(kind: str, given: dict) -> list:
 def _experiment_lines(experiment: dict | None, commented: bool) -> list:
     """One ``[[experiments]]`` block: the demo's (active, or commented out when its file is not beside) or a
     template (commented out)."""
-    from fracid.config.reference import comment
-    from fracid.inverse.experiments.registry import EXPERIMENTS
+    from fracid.config.reference import comment, experiment_keys
+    from fracid.inverse.experiments.registry import EXPERIMENTS, kind_names
 
     block = _EXPERIMENT_TEMPLATE if experiment is None else experiment
-    docs = EXPERIMENTS[block["kind"]].key_docs
+    docs = experiment_keys(EXPERIMENTS[block["kind"]])
+    docs["kind"] = dataclasses.replace(docs["kind"], allowed=" | ".join(f'"{name}"' for name in kind_names()))
 
     def text(key: str) -> str:
         said = comment(docs[key]) if key in docs else ""
@@ -173,11 +174,14 @@ def _identify_lines(model_type: str, demo: dict | None, params) -> list:
         log = demo["bounds"].get("log", [])
     else:
         names, bounds, log = default_identification(model_type, params)
+    from fracid.config.reference import comment
+    from fracid.config.vocabulary import BOUNDS, IDENTIFY
+
     return ["[identify]                          # for `fracid identify` (needs [[experiments]])",
-            _line("parameters", names, "identified; the others keep their [model.parameters] value"),
+            _line("parameters", names, comment(IDENTIFY["parameters"])),
             "[identify.bounds]                   # [lower, upper], inside the valid range of each"] + [
         _line(name, bounds[name], f"valid: {type(params).ranges[name].describe(name)}") for name in names] + [
-        _line("log", log, "sampled uniformly in log(x)")] + _method_lines(demo or {})
+        _line("log", log, comment(BOUNDS["log"]))] + _method_lines(demo or {})
 
 
 def _method_lines(tables: dict) -> list:
