@@ -195,14 +195,36 @@ def test_a_registered_kind_appears_without_editing_the_reference(monkeypatch):
     assert found[("specimen (bar-2)", "weak_zone_width")].unit == "mm"
 
 
+def undescribed(found) -> list:
+    """(table, key) of the entries without a meaning or a default."""
+    return [(e.table, e.key) for e in found if not (e.meaning.strip() and e.default.strip())]
+
+
 def test_every_entry_has_a_meaning_a_default_and_is_immutable():
     found = entries()
     assert isinstance(found, tuple) and len(found) > 200
-    empty = [(e.table, e.key) for e in found if not (e.meaning.strip() and e.default.strip())]
-    assert empty == []
+    assert undescribed(found) == []
     with pytest.raises(dataclasses.FrozenInstanceError):
         found[0].meaning = "changed"
     assert len({(e.table, e.key) for e in found}) == len(found)
+
+
+@dataclasses.dataclass(frozen=True)
+class _BareKind:
+    """An experiment kind registered later that declares its keys but describes none."""
+
+    name: str = "bare"
+    keys: tuple = ("kind", "file", "gain")
+    column_keys: tuple = ()
+    source: str | None = None
+    view: str | None = None
+
+
+def test_a_kind_without_descriptions_is_reported(monkeypatch):
+    from fracid.inverse.experiments.registry import EXPERIMENTS
+
+    monkeypatch.setitem(EXPERIMENTS, "bare", _BareKind())
+    assert undescribed(entries()) == [("[[experiments]] (kind bare)", key) for key in ("kind", "file", "gain")]
 
 
 def test_entries_read_the_classes_defaults_units_and_ranges():

@@ -95,7 +95,7 @@ def specimen_keys(kind: str) -> dict:
                                                 allowed=" | ".join(f'"{c}"' for c in controls))
     section = cls.config_section
     if section is not None:
-        return {**common, **described(section.keys, cls)}
+        return {**common, **described(getattr(section, "keys", None) or {}, cls)}
     docs = documented(cls)
     own = {}
     for field in dataclasses.fields(cls):
