@@ -27,20 +27,9 @@ DEMO_PAIR = ("notched-beam", "gradient-damage")
 #: comment column of the written ``key = value`` lines
 _COLUMN = COMMENT_COLUMN
 
-_EXPERIMENT_COMMENTS = {
-    "file": "REPLACE with your data file (CSV with a header row; relative paths start from this file)",
-    "control_column": "the column of the control (CMOD, displacement ...)",
-    "control_unit": '"mm" | "um" | "m"',
-    "force_unit": '"N" | "kN" | "MN"',
-    "kind": '"repeats" (force_columns, >= 2) | "envelope" (mean/lower/upper columns) | "single" (one force column)',
-    "mean_column": "envelope: the mean force",
-    "lower_column": "envelope: the lowest force of the repeats (std = (upper - lower) / 4)",
-    "upper_column": "envelope: the highest force of the repeats",
-    "force_columns": 'repeats: >= 2 columns; single: one column and std = ... or relative_std = ...',
-    "std": "single: the standard deviation of every force value, in force_unit",
-    "n_points": "equally spaced control values taken from the curve (>= 3)",
-    "control_range": "[start, stop] in control_unit, 0 < start < stop",
-}
+#: what the user must do about a key of the data block, before its comment (the key's allowed values and
+#: meaning, read from its kind: :func:`fracid.config.reference.comment`)
+_EXPERIMENT_PROMPTS = {"file": "REPLACE with your data file"}
 #: the commented-out data block of the pairs without bundled data
 _EXPERIMENT_TEMPLATE = {"file": "my_test.csv", "control_column": "u_mm", "control_unit": "mm", "force_unit": "N",
                         "kind": "single", "force_columns": ["F_N"], "std": 10.0, "n_points": 24}
@@ -126,11 +115,21 @@ def _specimen_lines(kind: str, given: dict) -> list:
 def _experiment_lines(experiment: dict | None, commented: bool) -> list:
     """One ``[[experiments]]`` block: the demo's (active, or commented out when its file is not beside) or a
     template (commented out)."""
+    from fracid.config.reference import comment, experiment_keys
+    from fracid.inverse.experiments.registry import EXPERIMENTS, kind_names
+
     block = _EXPERIMENT_TEMPLATE if experiment is None else experiment
+    docs = experiment_keys(EXPERIMENTS[block["kind"]])
+    docs["kind"] = dataclasses.replace(docs["kind"], allowed=" | ".join(f'"{name}"' for name in kind_names()))
+
+    def text(key: str) -> str:
+        said = comment(docs[key]) if key in docs else ""
+        return f"{_EXPERIMENT_PROMPTS[key]}: {said}" if key in _EXPERIMENT_PROMPTS else said
+
     lines = ["# the measured curve: without it only `fracid simulate` runs; uncomment and fill in to identify"
-             if commented else "# the measured curve (README, Configuration: the other keys of a data block)",
+             if commented else "# the measured curve (the configuration reference: the other keys of a data block)",
              ("# " if commented else "") + "[[experiments]]"]
-    return lines + [_line(key, value, _EXPERIMENT_COMMENTS.get(key, ""), commented) for key, value in block.items()]
+    return lines + [_line(key, value, text(key), commented) for key, value in block.items()]
 
 
 def default_identification(model_type: str, params) -> tuple:
@@ -175,11 +174,14 @@ def _identify_lines(model_type: str, demo: dict | None, params) -> list:
         log = demo["bounds"].get("log", [])
     else:
         names, bounds, log = default_identification(model_type, params)
+    from fracid.config.reference import comment
+    from fracid.config.vocabulary import BOUNDS, IDENTIFY
+
     return ["[identify]                          # for `fracid identify` (needs [[experiments]])",
-            _line("parameters", names, "identified; the others keep their [model.parameters] value"),
+            _line("parameters", names, comment(IDENTIFY["parameters"])),
             "[identify.bounds]                   # [lower, upper], inside the valid range of each"] + [
         _line(name, bounds[name], f"valid: {type(params).ranges[name].describe(name)}") for name in names] + [
-        _line("log", log, "sampled uniformly in log(x)")] + _method_lines(demo or {})
+        _line("log", log, comment(BOUNDS["log"]))] + _method_lines(demo or {})
 
 
 def _method_lines(tables: dict) -> list:
@@ -195,13 +197,17 @@ def _method_lines(tables: dict) -> list:
 
 
 def _tail_lines() -> list:
+    """``[simulate]`` and ``[output]``, each key commented from its description (:mod:`fracid.config.vocabulary`)."""
+    from fracid.config.reference import comment
+    from fracid.config.vocabulary import OUTPUT, SIMULATE
+
     return ["[simulate]                          # optional",
-            _line("target", 0.3, "final control value [mm]; omit for the specimen's default", commented=True),
-            _line("stop_force_fraction", 0.1, "stop below this fraction of the peak force"),
-            _line("damage_threshold", 0.0, "damage counted in the zone widths (fpz_width ...)"),
+            _line("target", 0.3, comment(SIMULATE["target"]) + " Omit it for the specimen's default.", commented=True),
+            _line("stop_force_fraction", SIMULATE["stop_force_fraction"].default, comment(SIMULATE["stop_force_fraction"])),
+            _line("damage_threshold", SIMULATE["damage_threshold"].default, comment(SIMULATE["damage_threshold"])),
             "", "[output]",
-            _line("directory", "results", "relative to this file (or --out DIR)"),
-            _line("vtk_steps", [], "simulate: steps whose fields go to VTK (with meshio), the last one always")]
+            _line("directory", OUTPUT["directory"].default, comment(OUTPUT["directory"]) + " (or --out DIR)"),
+            _line("vtk_steps", OUTPUT["vtk_steps"].default, comment(OUTPUT["vtk_steps"]))]
 
 
 def _start_values(specimen: str, model: str) -> tuple:
@@ -297,7 +303,8 @@ def config_text(specimen: str, model: str, beside: bool = False) -> str:
     head = [f"# fracid configuration: {model} on the {specimen} (written by `fracid init`).",
             f"# Check it: fracid check FILE; run it: fracid simulate FILE, fracid identify FILE.",
             "# Units: N, mm, MPa. Every key is shown with its value; the comment gives the default,",
-            "# the unit and the allowed values. README, Configuration, documents every section.", ""]
+            "# the unit and the allowed values. The configuration reference (docs/reference/configuration.md)",
+            "# documents every key.", ""]
     head[-1:] = [line for note in notes for line in _comments(note)] + [""]
     sections = [_model_lines(model, given), _specimen_lines(specimen, shape),
                 _experiment_lines(experiment, commented=experiment is None or not beside), _identify_lines(model, demo and demo["identify"], params),

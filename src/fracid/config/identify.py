@@ -10,7 +10,7 @@ from fracid.config.checker import Checker
 from fracid.config.registry import model_of, specimen_class
 from fracid.config.schema import IdentifyConfig, ModelConfig, SpecimenConfig
 from fracid.config.sections import range_text, valid_parameter
-from fracid.config.vocabulary import DEFAULT_INVERSE_METHOD, IDENTIFY_KEYS
+from fracid.config.vocabulary import BOUNDS_KEYS, DEFAULT_INVERSE_METHOD, IDENTIFY_KEYS
 from fracid.settings.checks import SettingError, SettingsContext
 from fracid.inverse.methods import registry
 
@@ -132,7 +132,7 @@ def _bounds(ck: Checker, raw, cls, names: tuple) -> tuple[tuple, tuple, tuple]:
     """``[identify.bounds]``: (lower, upper, log) of the identified parameters."""
     if "bounds" not in raw:
         ck.missing("identify.bounds", "a table with [lower, upper] for " + ", ".join(names))
-    bounds = ck.table("identify.bounds", raw["bounds"], (*names, "log"))
+    bounds = ck.table("identify.bounds", raw["bounds"], (*names, *BOUNDS_KEYS))
     lower, upper = [], []
     for name in names:
         lo, hi = _bound_pair(ck, bounds, cls, name)

@@ -26,8 +26,10 @@ from fracid.config.schema import (
 )
 from fracid.config.vocabulary import (
     MODEL_KEYS,
+    OUTPUT,
     OUTPUT_KEYS,
     SIMULATE_KEYS,
+    SPECIMEN_KEYS,
     STUDY_KEYS,
 )
 from fracid.models.protocol import declared
@@ -227,8 +229,8 @@ def read_specimen(ck: Checker, raw, base=None) -> SpecimenConfig:
             raise ConfigError(f"{ck.path}: {err}") from None
         return SpecimenConfig(type=kind, control=control, options=tuple(options.items()))
     fields = {f.name: f for f in dataclasses.fields(cls)}
-    ck.table("specimen", raw, ("type", "control", *fields))
-    options = specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in ("type", "control")}, cls)
+    ck.table("specimen", raw, (*SPECIMEN_KEYS, *fields))
+    options = specimen_options(ck, "specimen", {k: v for k, v in raw.items() if k not in SPECIMEN_KEYS}, cls)
     check_specimen(ck, "specimen", kind, cls, options, options)
     controls = cls(**options).control_names
     control = ck.choice("specimen.control", raw.get("control", controls[0]), controls)
@@ -255,7 +257,7 @@ def check_specimen_section(ck: Checker, model: ModelConfig, specimen: SpecimenCo
 
 def read_output(ck: Checker, raw, base: Path) -> OutputConfig:
     raw = ck.table("output", {} if raw is None else raw, OUTPUT_KEYS)
-    path = ck.location("output.directory", raw.get("directory", "results"), base, "must be a directory path (string)")
+    path = ck.location("output.directory", raw.get("directory", OUTPUT["directory"].default), base, "must be a directory path (string)")
     steps = raw.get("vtk_steps", [])
     allowed = "must be a list of step numbers (integers >= 0)"
     if not isinstance(steps, list) or not all(is_integer(step) and step >= 0 for step in steps):
@@ -265,35 +267,42 @@ def read_output(ck: Checker, raw, base: Path) -> OutputConfig:
 
 def read_simulate(ck: Checker, raw) -> SimulateConfig:
     raw = ck.table("simulate", {} if raw is None else raw, SIMULATE_KEYS)
+    default = SimulateConfig()
     target = None
     if "target" in raw:
         target = ck.number("simulate.target", raw["target"], "must be a number > 0 [mm] (final control value)",
                            lambda v: v > 0)
     return SimulateConfig(
         target=target,
-        stop_force_fraction=ck.number("simulate.stop_force_fraction", raw.get("stop_force_fraction", 0.1),
+        stop_force_fraction=ck.number("simulate.stop_force_fraction",
+                                      raw.get("stop_force_fraction", default.stop_force_fraction),
                                       "must be a number with 0 < f < 1 (fraction of the peak force)",
                                       lambda v: 0 < v < 1),
-        damage_threshold=ck.number("simulate.damage_threshold", raw.get("damage_threshold", 0.0),
+        damage_threshold=ck.number("simulate.damage_threshold", raw.get("damage_threshold", default.damage_threshold),
                                    "must be a number with 0 <= t < 1 (damage)", lambda v: 0 <= v < 1),
     )
 
 
 def read_study(ck: Checker, raw) -> StudyConfig:
     raw = ck.table("study", {} if raw is None else raw, STUDY_KEYS)
+    default = StudyConfig()
+
+    def given(name):
+        return raw.get(name, getattr(default, name))
+
     return StudyConfig(
-        starts=ck.integer("study.starts", raw.get("starts", 3), "must be an integer >= 0 (0 or 1: no multi-start check)",
+        starts=ck.integer("study.starts", given("starts"), "must be an integer >= 0 (0 or 1: no multi-start check)",
                           lambda v: v >= 0),
-        replicates=ck.integer("study.replicates", raw.get("replicates", 5),
+        replicates=ck.integer("study.replicates", given("replicates"),
                               "must be 0 (no stability check) or an integer >= 2", lambda v: v == 0 or v >= 2),
-        seed=ck.integer("study.seed", raw.get("seed", 0), "must be an integer >= 0", lambda v: v >= 0),
-        tolerance=ck.number("study.tolerance", raw.get("tolerance", 0.1),
+        seed=ck.integer("study.seed", given("seed"), "must be an integer >= 0", lambda v: v >= 0),
+        tolerance=ck.number("study.tolerance", given("tolerance"),
                             "must be a number with 0 < t < 1 (largest relative std called identified)",
                             lambda v: 0 < v < 1),
         # "knn" is the former name of "search", still read
-        prior="search" if raw.get("prior") == "knn" else ck.choice("study.prior", raw.get("prior", "search"),
+        prior="search" if raw.get("prior") == "knn" else ck.choice("study.prior", given("prior"),
                                                                    ("search", "bounds")),
-        posterior=_flag(ck, "study.posterior", raw.get("posterior", False),
+        posterior=_flag(ck, "study.posterior", given("posterior"),
                         "must be true (fracid study also samples the posterior with the [posterior] settings, and "
                         "the verdict reads its credible intervals) or false (the default: the Gaussian std only)"),
     )

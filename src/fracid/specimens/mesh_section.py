@@ -30,12 +30,28 @@ from pathlib import Path
 import numpy as np
 
 from fracid.settings.checks import bytes_text
+from fracid.settings.keys import REQUIRED, UNSET, Key
 from fracid.specimens import protocol
 from fracid.specimens.mesh_reading import MeshError, mesh_size, mesh_unknowns
 from fracid.specimens.protocol import SectionError, SpecimenSection, element_sides
 
-_KEYS = ("type", "file", "thickness", "scale", "symmetry_factor", "control", "supports", "loads", "symmetry", "controls",
-         "crack", "regions")
+_GROUPS = "a list of {group, component}"
+#: the keys of the section besides ``type`` and ``control`` (the configuration's), described; an empty meaning is
+#: that of the :class:`~fracid.specimens.mesh.MeshSpecimen` field of the same name
+KEYS = {
+    "file": Key(REQUIRED, "", "a Gmsh .msh file with physical groups", "The mesh file, relative to the "
+                "configuration file unless absolute (any format meshio reads with physical groups)."),
+    "thickness": Key(REQUIRED, "mm", "> 0"),
+    "scale": Key(1.0, "mm per mesh unit", "> 0"),
+    "symmetry_factor": Key(1.0, "-", ">= 1"),
+    "supports": Key(REQUIRED, "", _GROUPS),
+    "loads": Key(REQUIRED, "", "a list of {group, component, force = 1.0, rigid = true}"),
+    "symmetry": Key([], "", _GROUPS),
+    "controls": Key(REQUIRED, "", "a table of named lists of {group, component, weight = 1.0} (e.g. cmod = [...])"),
+    "crack": Key(UNSET, "", "{group, component, element_size}"),
+    "regions": Key([], "", "a list of {group, stiffness_factor, damageable}"),
+}
+_KEYS = ("type", "control", *KEYS)
 _COMPONENT = "must be 'x' or 'y'"
 #: an element side this many times the largest length the mesh must resolve is taken for a unit mistake
 _COARSEST = 100.0
@@ -86,9 +102,9 @@ def mesh_specimen(ck, raw: dict, base: Path, cls) -> tuple:
 _ALLOWED = {
     "file": "a Gmsh .msh file with physical groups, relative to the config file",
     "thickness": "the out-of-plane thickness [mm]",
-    "supports": "a list of {group, component}: the nodes held at zero",
-    "loads": "a list of {group, component, force = 1.0, rigid = true}",
-    "controls": "a table of named lists of {group, component, weight = 1.0} (e.g. cmod = [...])",
+    "supports": f"{_GROUPS}: the nodes held at zero",
+    "loads": KEYS["loads"].allowed,
+    "controls": KEYS["controls"].allowed,
 }
 
 
@@ -246,4 +262,4 @@ def check_mesh_units(specimen, mesh_length, extremes) -> None:
 
 
 #: the ``[specimen]`` table of :class:`~fracid.specimens.mesh.MeshSpecimen` (its ``config_section``)
-SECTION = SpecimenSection(read=mesh_specimen, check=check_mesh_units)
+SECTION = SpecimenSection(read=mesh_specimen, check=check_mesh_units, keys=KEYS)

@@ -15,7 +15,8 @@ The memory limits live here (measured on forward runs) and are re-exported by :m
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import Callable, ClassVar, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
@@ -114,10 +115,15 @@ class SpecimenSection:
         The check joining the table with the model and the identification: ``mesh length`` is the model's
         :class:`~fracid.models.protocol.MeshLength` (when it has one), ``extremes`` ((smallest value, where),
         (largest value, where)) of its parameter; raises :class:`SectionError` (e.g. a mesh drawn in metres).
+    keys : mapping
+        The keys ``read`` accepts besides ``type`` and ``control``, each described (key ->
+        :class:`~fracid.settings.keys.Key`; an empty meaning is the specimen class's field of the same name), for
+        the configuration reference (:mod:`fracid.config.reference`).
     """
 
     read: Callable
     check: Callable
+    keys: Mapping = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -13,15 +13,58 @@ from pathlib import Path
 
 from fracid.data.sampling import SAMPLINGS
 from fracid.inverse.core.observations import FORCE
-from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE_UNITS, LOCAL_UNITS, ROLES
+from fracid.inverse.experiments.vocabulary import (BLOCK_KEYS, CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE_UNITS,
+                                                   LOCAL_UNITS, ROLES)
 from fracid.settings.checks import show
+from fracid.settings.keys import REQUIRED, UNSET, Key, Said
 
-#: the keys of a curve block's table (the column keys of every curve kind among them: a block refuses another
-#: kind's with a message naming its own)
-CURVE_KEYS = ("file", "control_column", "control_unit", "force_unit", "kind", "force_columns", "mean_column",
-              "lower_column", "upper_column", "std", "relative_std", "n_points", "control_range", "quantity",
-              "name", "specimen", "weight", "damage_threshold", "role", "delimiter", "decimal",
-              "backtrack_tolerance", "negate", "sampling")
+def _words(values) -> str:
+    return " | ".join(f'"{value}"' for value in values)
+
+
+#: the keys of a curve block's table, each described (the column keys of every curve kind among them: a block refuses
+#: another kind's with a message naming its own; each kind lists its ``column_keys``)
+CURVE_KEY_DOCS = {
+    "file": Key(REQUIRED, "", "a CSV file path", "The data file: a CSV with a header row; relative to the "
+                                                 "configuration file unless absolute."),
+    "control_column": Key(REQUIRED, "", "a column name", "The column of the control quantity (CMOD, displacement ...)."),
+    "control_unit": Key(REQUIRED, "", _words(CONTROL_UNITS), "The unit of the control column (scaled to mm)."),
+    "force_unit": Key(REQUIRED, "", f"force: {_words(FORCE_UNITS)}; a local quantity: {_words(LOCAL_UNITS)}",
+                      "The unit of the measured values (scaled to N, a local quantity to mm)."),
+    "kind": Key(REQUIRED, "", "a registered kind", "The kind of the block: which columns hold the data and how "
+                                                   "their scatter is known."),
+    "force_columns": Key(REQUIRED, "", "a list of column names", "The force columns: one per repeated test (their "
+                                                                  "mean and sample std), or the one curve."),
+    "mean_column": Key(REQUIRED, "", "a column name", "The mean force of the repeats."),
+    "lower_column": Key(REQUIRED, "", "a column name", "The lowest force of the repeats (std = (upper - lower) / 4)."),
+    "upper_column": Key(REQUIRED, "", "a column name", "The highest force of the repeats."),
+    "std": Key(UNSET, "force_unit", "> 0; this or relative_std", "The standard deviation of every value."),
+    "relative_std": Key(UNSET, "-", "> 0; this or std", "The standard deviation as a fraction of |y|."),
+    "n_points": Key(REQUIRED, "", "integer >= 3", "The number of data values taken from the curve."),
+    "control_range": Key(Said("the range common to the columns"), "control_unit", "[start, stop], 0 < start < stop",
+                         "The part of the curve used."),
+    "quantity": Key(FORCE, "", f'"{FORCE}" or a local observable of the specimen (e.g. "fpz_width")',
+                    "What the values measure: the force, or a local quantity of the specimen [mm]."),
+    "name": Key(Said('"global" (a force) or the quantity'), "", "a non-empty string", "The block's name in the results."),
+    "specimen": Key(UNSET, "", "a table of the specimen's fields",
+                    "Fields of [specimen] overridden for this test (a size series: one block per size); blocks "
+                    "of the same specimen share one forward run."),
+    "weight": BLOCK_KEYS["weight"],
+    "damage_threshold": Key(0.0, "-", "0 <= t < 1; a local quantity only", "The damage counted in the width."),
+    "role": BLOCK_KEYS["role"],
+    "delimiter": Key(",", "", '"," | ";" | "\\t" (or "tab") | " " (any run of spaces and tabs)',
+                     "The cell separator of the file."),
+    "decimal": Key(".", "", _words(DECIMALS), 'The decimal mark ("," needs another delimiter).'),
+    "backtrack_tolerance": Key(Said("1 % of the control's range"), "control_unit", ">= 0",
+                               "The largest backtrack of the control column dropped as noise."),
+    "negate": Key([], "", 'a list of "control" and/or "force"', "The columns the machine records with a negative "
+                                                                "sign, multiplied by -1."),
+    "sampling": Key(SAMPLINGS[0], "", _words(SAMPLINGS),
+                    '"equally-spaced": n_points equally spaced control values, the one nearest the measured peak '
+                    'moved onto it; "measured": the measured points themselves, all if at most n_points, else '
+                    "n_points of them by arc length along the normalised curve (ends and peak kept)."),
+}
+CURVE_KEYS = tuple(CURVE_KEY_DOCS)
 
 
 def _csv_table(ck, key: str, value, path: Path, delimiter: str, decimal: str, columns):
@@ -203,4 +246,4 @@ def _negated(ck, key: str, value) -> tuple:
     return tuple(dict.fromkeys(value))
 
 
-__all__ = ["CURVE_KEYS", "read_curve_fields", "required"]
+__all__ = ["CURVE_KEYS", "CURVE_KEY_DOCS", "read_curve_fields", "required"]

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from fracid.data.covariance import STD_ALLOWED, usable_std
-from fracid.inverse.experiments.curve_table import CURVE_KEYS, read_curve_fields, required
+from fracid.inverse.experiments.curve_table import CURVE_KEY_DOCS, CURVE_KEYS, read_curve_fields, required
 from fracid.inverse.core.observations import FORCE
 from fracid.inverse.experiments.vocabulary import CONTROL_UNITS, FORCE_UNITS, LOCAL_UNITS
 from fracid.settings.checks import SettingError
@@ -97,6 +97,11 @@ class CurveKind:
     keys: tuple = CURVE_KEYS
     source: str | None = None
     view: str | None = None  # drawn in the fit figure
+
+    @property
+    def key_docs(self) -> dict:
+        """Key -> :class:`~fracid.settings.keys.Key` of the block's keys (those of the curve kinds' shared table)."""
+        return CURVE_KEY_DOCS
 
     def read(self, ck, index: int, raw: dict, context) -> tuple:
         """(the validated :class:`CurveExperimentConfig`, None): see :mod:`fracid.inverse.experiments.registry`."""

@@ -32,8 +32,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from fracid.inverse.experiments.field import FieldExperimentConfig, check_matches
-from fracid.inverse.experiments.vocabulary import ROLES
+from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, ROLES
 from fracid.settings.checks import is_number
+from fracid.settings.keys import REQUIRED, Key, Said
 
 #: the keys of each derived kind
 DERIVED_KEYS = {
@@ -50,6 +51,25 @@ _REQUIRED = {
     "radius": "a number > 0 [mm]: the radius of the plane fits (about 1.5 DIC point spacings or more)",
     "offsets": "a list of at least 2 nonzero, increasing distances from the crack line [mm], e.g. [5, 8, 11, 14]",
     "threshold": "a number > 0 [-]: the strain above which a sample counts (a few times kappa_i)",
+}
+#: the keys of the derived kinds, each described (what each kind takes: :data:`DERIVED_KEYS`)
+DERIVED_KEY_DOCS = {
+    "kind": Key(REQUIRED, "", "a registered kind", "The kind of the block: the crack-opening profile by virtual "
+                "extensometers across the crack, or the process-zone width by strain transects."),
+    "field": Key(REQUIRED, "", _REQUIRED["field"], "The field block the estimate is made from; give it role = "
+                 '"source" so that its measurements are not counted twice.'),
+    "heights": Key(REQUIRED, "mm", "a list of increasing positions", "Positions along the ligament."),
+    "gauge": Key(REQUIRED, "mm", "> 0", "The half-length of the gauges (their ends at +-gauge from the crack line), "
+                 "beyond the band of missing points."),
+    "radius": Key(REQUIRED, "mm", "> 0", "The radius of the plane fits (about 1.5 DIC point spacings or more)."),
+    "pairs": Key(Said("true if the field has points on both sides"), "", "true | false",
+                 "Gauge ends on both sides of the crack (the rigid motion cancels), or one: the symmetric half, "
+                 "w = 2 u_n(+gauge) (the field's rigid-motion prior makes each frame's mean and tilt uninformative)."),
+    "offsets": Key(REQUIRED, "mm", "at least 2 nonzero, increasing distances", "The samples of each transect: "
+                   "signed distances from the crack line (positive on the modelled side)."),
+    "threshold": Key(REQUIRED, "-", "> 0", "The strain above which a sample counts (a few times kappa_i)."),
+    "name": Key(Said("the kind's quantity"), "", "a non-empty string", "The block's name in the results."),
+    **BLOCK_KEYS,
 }
 #: the keys whose library errors begin "key = value" (:mod:`fracid.data.dic.derived`)
 _STATED = ("heights", "gauge", "radius", "offsets", "threshold")
@@ -217,6 +237,11 @@ class DerivedKind:
     source: str | None = "field"
     view: str | None = None  # drawn in the fit figure, against the control
 
+    @property
+    def key_docs(self) -> dict:
+        """Key -> :class:`~fracid.settings.keys.Key` of the kind's keys."""
+        return {key: DERIVED_KEY_DOCS[key] for key in self.keys if key in DERIVED_KEY_DOCS}
+
     def read(self, ck, index: int, raw: dict, context) -> tuple:
         """(the validated :class:`DerivedExperimentConfig`, None)."""
         return read_derived_experiment(ck, index, raw, context), None
@@ -242,5 +267,5 @@ class DerivedKind:
 OPENING = DerivedKind("opening", DERIVED_KEYS["opening"])
 FPZ_WIDTH = DerivedKind("fpz-width", DERIVED_KEYS["fpz-width"])
 
-__all__ = ["DERIVED_KEYS", "FPZ_WIDTH", "OPENING", "QUANTITIES", "DerivedExperimentConfig", "DerivedKind",
+__all__ = ["DERIVED_KEYS", "DERIVED_KEY_DOCS", "FPZ_WIDTH", "OPENING", "QUANTITIES", "DerivedExperimentConfig", "DerivedKind",
            "derived_block", "read_derived_experiment"]

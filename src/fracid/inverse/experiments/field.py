@@ -27,15 +27,50 @@ import numpy as np
 
 from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.inverse.experiments.crack_region import away_from_crack
-from fracid.inverse.experiments.vocabulary import ROLES
+from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, ROLES
 from fracid.settings.checks import show
+from fracid.settings.keys import REQUIRED, UNSET, Key, Said
 
-#: the keys of a field block
-FIELD_KEYS = ("kind", "frames_file", "control_column", "x", "y", "u", "v", "sigma", "quality", "displacement",
-              "min_quality",
-              "coordinate_unit", "scale", "rotation_deg", "origin_camera", "origin_specimen", "marked_camera",
-              "marked_specimen", "frames", "components", "std", "subset_size", "rigid_motion", "rigid_std",
-              "exclude_near", "point_spacing", "name", "weight", "role")
+_CLOUD = "A column of the point clouds (a point-data array of VTU/VTK frames)"
+_PLACEMENT = "The placement of the camera on the specimen"
+#: the keys of a field block, each described
+FIELD_KEY_DOCS = {
+    "kind": Key(REQUIRED, "", "a registered kind", "The kind of the block."),
+    "frames_file": Key(REQUIRED, "", "a CSV file path", "The frame table (frame, file and load columns); relative "
+                                                        "to the configuration file unless absolute."),
+    "control_column": Key(REQUIRED, "", "a column name", "The frame table's column of each frame's control value."),
+    "x": Key("X", "", "a column name", f"{_CLOUD}: the x coordinate."),
+    "y": Key("Y", "", "a column name", f"{_CLOUD}: the y coordinate."),
+    "u": Key("U", "", "a column name", f"{_CLOUD}: the x displacement."),
+    "v": Key("V", "", "a column name", f"{_CLOUD}: the y displacement."),
+    "sigma": Key(UNSET, "", "a column name", f"{_CLOUD}: the displacement's standard deviation."),
+    "quality": Key(UNSET, "", "a column name", f"{_CLOUD}: the correlation quality."),
+    "displacement": Key(Said('"displacement", else "U"'), "", "a point-data array name",
+                        "Frames listed as .vtu/.vtk files: their displacement array."),
+    "min_quality": Key(UNSET, "", "a number; needs quality", "Points of lower quality are dropped."),
+    "coordinate_unit": Key("mm", "", '"mm" | "px" (needs the placement)', "The unit of the clouds' coordinates."),
+    "scale": Key(UNSET, "mm per camera unit", "> 0", f"{_PLACEMENT}: its scale."),
+    "rotation_deg": Key(0.0, "degrees", "a number", f"{_PLACEMENT}: the camera's rotation."),
+    "origin_camera": Key(UNSET, "camera unit", "[X, Y]", f"{_PLACEMENT}: a point in the camera's frame ..."),
+    "origin_specimen": Key(UNSET, "mm", "[x, y]", "... and the same point in the specimen's."),
+    "marked_camera": Key(UNSET, "camera unit", "a list of [X, Y] points",
+                         f"{_PLACEMENT}, fitted: marked points in the camera's frame (instead of scale, rotation_deg "
+                         "and the origins); points off the specimen's mesh: up to 10 % dropped (warned), more refused."),
+    "marked_specimen": Key(UNSET, "mm", "a list of [x, y] points", "The same points in the specimen's frame."),
+    "frames": Key(Said("all"), "", "a list of frame numbers, control increasing",
+                  "The frames used; a frame without any valid value is dropped (warned)."),
+    "components": Key(["u", "v"], "", '"u" | "v" | ["u", "v"]', "The displacement components used."),
+    "std": Key(Said("the files' sigma"), "mm", "> 0", "The standard deviation of every value."),
+    "subset_size": Key(UNSET, "mm", "> 0", "Errors correlated over a subset of this size (low rank + diagonal)."),
+    "rigid_motion": Key(True, "", "true | false", "The rigid motion of every frame removed from data and model, by a "
+                                                  "vague prior of std rigid_std (false: the data have none)."),
+    "rigid_std": Key(1.0, "mm", "> 0", "The std of the rigid motion's vague prior."),
+    "exclude_near": Key(UNSET, "mm", ">= 0", "Points nearer the specimen's crack path are dropped."),
+    "point_spacing": Key(UNSET, "mm", "> 0", "A dense field is thinned to one point per square of this side."),
+    "name": Key("field", "", "a non-empty string", "The block's name (the derived blocks name it as their field)."),
+    **BLOCK_KEYS,
+}
+FIELD_KEYS = tuple(FIELD_KEY_DOCS)
 #: point-cloud column keys and their defaults (those of :func:`fracid.data.dic.read_dic_frames`)
 COLUMN_KEYS = {"x": "X", "y": "Y", "u": "U", "v": "V", "sigma": None, "quality": None, "displacement": None}
 PLACEMENT_KEYS = ("scale", "rotation_deg", "origin_camera", "origin_specimen")
@@ -270,6 +305,11 @@ class FieldKind:
     source: str | None = None
     view: str | None = "displacement-field"  # the report's maps and per-frame fit
 
+    @property
+    def key_docs(self) -> dict:
+        """Key -> :class:`~fracid.settings.keys.Key` of the block's keys."""
+        return FIELD_KEY_DOCS
+
     def read(self, ck, index: int, raw: dict, context) -> tuple:
         """(the validated :class:`FieldExperimentConfig`, its FieldBlock)."""
         return read_field_experiment(ck, index, raw, context)
@@ -293,5 +333,5 @@ class FieldKind:
 
 FIELD = FieldKind()
 
-__all__ = ["COLUMN_KEYS", "FIELD", "FIELD_KEYS", "PLACEMENT_KEYS", "FieldExperimentConfig", "FieldKind",
+__all__ = ["COLUMN_KEYS", "FIELD", "FIELD_KEYS", "FIELD_KEY_DOCS", "PLACEMENT_KEYS", "FieldExperimentConfig", "FieldKind",
            "check_matches", "field_block", "placed_field_block", "read_field_experiment"]

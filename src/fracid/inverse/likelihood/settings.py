@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fracid.settings import checks as settings
+from fracid.settings.keys import FROM_CLASS, Key, described
 
 DISCRETISATION_KEY, MODEL_ERROR_KEY = "discretisation_error", "model_error"
 DISCRETISATION_KINDS = ("off", "richardson")
@@ -100,8 +101,34 @@ class ModelError:
             raise ValueError(f"ModelError.bounds = {self.bounds!r}; give 0 < lower < upper (fractions of the peak)")
 
 
-DISCRETISATION_KEYS = ("kind", "refinement", "observed_order", "order", "correlation_length", "iterations")
-MODEL_ERROR_KEYS = ("kind", "prior", "scale", "bounds", "groups", "correlation_length", "iterations")
+def _words(values) -> str:
+    return " | ".join(f'"{value}"' for value in values)
+
+
+#: the keys of the table ``[identify.discretisation_error]``, described (meanings and defaults:
+#: :class:`DiscretisationError`'s)
+DISCRETISATION_KEY_DOCS = described({
+    "kind": Key(DISCRETISATION_KINDS[1], "", _words(DISCRETISATION_KINDS),
+                "The term: the mesh's error at the estimate from a mesh refined (Richardson), added to the data "
+                'covariance; "off": none.'),
+    "refinement": Key(FROM_CLASS, "-", "1 < r <= 4"),
+    "observed_order": Key(FROM_CLASS, "", "true | false"),
+    "order": Key(FROM_CLASS, "-", "0.5 <= p <= 4"),
+    "correlation_length": Key(FROM_CLASS, "-", "> 0"),
+    "iterations": Key(FROM_CLASS, "", "1 <= n <= 10"),
+}, DiscretisationError)
+#: the keys of the table ``[identify.model_error]``, described (meanings and defaults: :class:`ModelError`'s)
+MODEL_ERROR_KEY_DOCS = described({
+    "kind": Key(FROM_CLASS, "", _words(MODEL_ERROR_KINDS)),
+    "prior": Key(FROM_CLASS, "", _words(PRIORS)),
+    "scale": Key(FROM_CLASS, "-", "> 0"),
+    "bounds": Key(list(ModelError.bounds), "-", "[lower, upper], 0 < lower < upper"),
+    "groups": Key(FROM_CLASS, "", _words(GROUPINGS)),
+    "correlation_length": Key(FROM_CLASS, "-", "> 0"),
+    "iterations": Key(FROM_CLASS, "", "1 <= n <= 10"),
+}, ModelError)
+DISCRETISATION_KEYS = tuple(DISCRETISATION_KEY_DOCS)
+MODEL_ERROR_KEYS = tuple(MODEL_ERROR_KEY_DOCS)
 
 
 def _kind_and_table(key: str, raw, kinds, keys) -> tuple[str, dict]:
@@ -181,6 +208,6 @@ def as_model_error(value) -> ModelError | None:
     return value if isinstance(value, ModelError) else model_error_from_config(value)
 
 
-__all__ = ["DISCRETISATION_KEY", "DISCRETISATION_KINDS", "DiscretisationError", "FIXED_POINT_TOL", "GROUPINGS", "MODEL_ERROR_KEY",
+__all__ = ["DISCRETISATION_KEY", "DISCRETISATION_KEY_DOCS", "MODEL_ERROR_KEY_DOCS", "DISCRETISATION_KINDS", "DiscretisationError", "FIXED_POINT_TOL", "GROUPINGS", "MODEL_ERROR_KEY",
            "MODEL_ERROR_KINDS", "ModelError", "PRIORS", "as_discretisation", "as_model_error",
            "discretisation_from_config", "model_error_from_config"]

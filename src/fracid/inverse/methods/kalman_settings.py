@@ -10,6 +10,7 @@ import numpy as np
 
 from fracid.inverse.methods.kalman_status import DEFAULT_MAX_STARTS
 from fracid.settings import checks as settings
+from fracid.settings.keys import FROM_CLASS, Key, Said, described
 
 
 #: Kalman steps per pass when [identify.kalman] groups is not given. A step costs one run (with exact
@@ -52,9 +53,19 @@ class KalmanSettings:
                 "tol": self.tol, "restart": self.restart}
 
 
-#: the keys of ``[identify.kalman]`` and the values of its ``restart``
-KALMAN_KEYS = ("groups", "max_iterations", "tol", "restart", "max_starts")
+#: the values of ``[identify.kalman] restart``, and the table's keys, described (their meanings are
+#: :class:`KalmanSettings`'s but that of groups, which the configuration gives as a count)
 RESTARTS = ("linearize", "prior-mean")
+KALMAN_KEY_DOCS = described({
+    "groups": Key(Said(f"{DEFAULT_GROUPS} (n_y if fewer)"), "", "integer, 1 <= groups <= n_y (the total n_points)",
+                  "Consecutive observation groups: the filter's steps per pass (one run each with exact "
+                  "sensitivities)."),
+    "max_iterations": Key(FROM_CLASS, "", "integer >= 1"),
+    "tol": Key(FROM_CLASS, "standard deviations", "> 0"),
+    "restart": Key(FROM_CLASS, "", " | ".join(f'"{r}"' for r in RESTARTS)),
+    "max_starts": Key(FROM_CLASS, "", "integer >= 1"),
+}, KalmanSettings)
+KALMAN_KEYS = tuple(KALMAN_KEY_DOCS)
 
 
 def kalman_from_table(raw, n_y: int | None) -> KalmanSettings:
@@ -96,4 +107,4 @@ def named_groups(groups, n_y: int, blocks=()):
     raise ValueError(f"groups = {groups!r}; give index arrays, None, 'blocks' or 'all'")
 
 
-__all__ = ["DEFAULT_GROUPS", "KALMAN_KEYS", "RESTARTS", "KalmanSettings", "kalman_from_table", "named_groups"]
+__all__ = ["DEFAULT_GROUPS", "KALMAN_KEYS", "KALMAN_KEY_DOCS", "RESTARTS", "KalmanSettings", "kalman_from_table", "named_groups"]

@@ -16,14 +16,14 @@ from fracid.inverse.core.plans import StagePlan, likely_iterations, plural, runs
 from fracid.inverse.core.sensitivity import exact_sensitivity, sensitivity_label
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.gauss_newton import gauss_newton
-from fracid.inverse.methods.knn_settings import knn_from_table, knn_template
+from fracid.inverse.methods.knn_settings import KNN_KEY_DOCS, knn_from_table, knn_template
 from fracid.inverse.methods.knn_started import KnnStarted, KnnStartedResult, LocalFit, population_plan
 from fracid.settings import checks as settings
 from fracid.settings.checks import SettingsContext, toml_line
+from fracid.settings.keys import FROM_CLASS, Key, described
 
 #: the table of the Gauss-Newton stage's settings in ``[identify]``, and its keys
 GAUSS_NEWTON_TABLE = "gauss-newton"
-GAUSS_NEWTON_KEYS = ("max_iterations", "tol")
 
 
 @dataclass
@@ -68,6 +68,8 @@ class KnnGaussNewton(KnnStarted):
 
     #: the tables of [identify] this method reads (:meth:`from_config`)
     config_tables: ClassVar[tuple] = ("knn", GAUSS_NEWTON_TABLE)
+    #: their keys, described (set below the class: the meanings of [identify.gauss-newton] are its docstring's)
+    config_keys: ClassVar[dict] = {}
 
     @classmethod
     def from_config(cls, tables: dict, context: SettingsContext) -> KnnGaussNewton:
@@ -129,4 +131,10 @@ class KnnGaussNewton(KnnStarted):
                         runs=fit.runs, failed=len(fit.failures), counters={"iterations": fit.iterations}, note=note)
 
 
-__all__ = ["GAUSS_NEWTON_KEYS", "GAUSS_NEWTON_TABLE", "GaussNewtonResult", "KnnGaussNewton"]
+#: the keys of ``[identify.gauss-newton]``, described (defaults and meanings: :class:`KnnGaussNewton`'s)
+GAUSS_NEWTON_KEY_DOCS = described({"max_iterations": Key(FROM_CLASS, "", "integer >= 1"),
+                                   "tol": Key(FROM_CLASS, "standard deviations", "> 0")}, KnnGaussNewton)
+GAUSS_NEWTON_KEYS = tuple(GAUSS_NEWTON_KEY_DOCS)
+KnnGaussNewton.config_keys = {"knn": KNN_KEY_DOCS, GAUSS_NEWTON_TABLE: GAUSS_NEWTON_KEY_DOCS}
+
+__all__ = ["GAUSS_NEWTON_KEYS", "GAUSS_NEWTON_KEY_DOCS", "GAUSS_NEWTON_TABLE", "GaussNewtonResult", "KnnGaussNewton"]

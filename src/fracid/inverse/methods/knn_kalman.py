@@ -22,9 +22,10 @@ from fracid.inverse.core.plans import StagePlan, likely_iterations, plural, runs
 from fracid.inverse.core.sensitivity import sensitivity_label
 from fracid.inverse.core.stage_records import PATH, POPULATION
 from fracid.inverse.methods.kalman import kalman_filter
-from fracid.inverse.methods.kalman_settings import DEFAULT_GROUPS, KalmanSettings, kalman_from_table, named_groups
+from fracid.inverse.methods.kalman_settings import (DEFAULT_GROUPS, KALMAN_KEY_DOCS, KalmanSettings, kalman_from_table,
+                                                    named_groups)
 from fracid.inverse.methods.kalman_status import restarted
-from fracid.inverse.methods.knn_settings import knn_from_table, knn_template
+from fracid.inverse.methods.knn_settings import KNN_KEY_DOCS, knn_from_table, knn_template
 from fracid.inverse.methods.knn_started import KnnStarted, KnnStartedResult, LocalFit, knn_output, population_plan
 from fracid.settings.checks import SettingsContext, toml_line
 
@@ -71,6 +72,8 @@ class KnnKalman(KnnStarted):
 
     #: the tables of [identify] this method reads (:meth:`from_config`)
     config_tables: ClassVar[tuple] = ("knn", "kalman")
+    #: their keys, described (:data:`~fracid.inverse.methods.knn_settings.KNN_KEY_DOCS`, :data:`KALMAN_KEY_DOCS`)
+    config_keys: ClassVar[dict] = {"knn": KNN_KEY_DOCS, "kalman": KALMAN_KEY_DOCS}
 
     @classmethod
     def from_config(cls, tables: dict, context: SettingsContext) -> KnnKalman:

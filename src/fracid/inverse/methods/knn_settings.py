@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 from fracid.settings import checks as settings
 from fracid.settings.checks import SettingError, SettingsContext, bytes_text, toml_line
+from fracid.settings.keys import Key, described
 
 
 @dataclass(frozen=True)
@@ -56,13 +57,21 @@ MAX_POPULATION = 100_000
 
 #: the table of the population's settings in ``[identify]``, and its keys
 KNN_TABLE = "knn"
-KNN_KEYS = ("n", "method", "k", "seed", "screening")
 #: ``[identify.knn] screening``: the default element-size factor of the population's mesh (benchmarks/demo_speed.py,
 #: docs/speed/install.md) and the largest allowed (a coarser mesh resolves too little of a process zone to rank)
 DEFAULT_SCREENING = 2.0
 MAX_SCREENING = 4.0
 #: ``[identify.knn] method``: how the KNN population is sampled (:func:`~fracid.inverse.methods.knn.design`)
 KNN_METHODS = ("sobol", "lhs", "grid")
+#: the keys of ``[identify.knn]``, described (their meanings are :class:`KnnSettings`'s)
+KNN_KEY_DOCS = described({
+    "n": Key(64, "", f"integer >= 2; the population (n, or n**p for a grid) at most {MAX_POPULATION:,}"),
+    "method": Key("sobol", "", " | ".join(f'"{m}"' for m in KNN_METHODS)),
+    "k": Key(5, "", "1 <= k <= the population"),
+    "seed": Key(0, "", "integer >= 0"),
+    "screening": Key(DEFAULT_SCREENING, "-", f"1 <= screening <= {MAX_SCREENING:g}"),
+}, KnnSettings)
+KNN_KEYS = tuple(KNN_KEY_DOCS)
 
 
 def knn_from_table(raw, context: SettingsContext) -> KnnSettings:
@@ -125,4 +134,4 @@ def knn_template(raw: dict, prior: str = "the prior") -> list[str]:
                       "population on a mesh this many times coarser (1: the configured mesh)")]
 
 
-__all__ = ["DEFAULT_SCREENING", "KNN_KEYS", "MAX_SCREENING", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]
+__all__ = ["DEFAULT_SCREENING", "KNN_KEYS", "KNN_KEY_DOCS", "MAX_SCREENING", "KNN_METHODS", "KNN_TABLE", "MAX_POPULATION", "KnnSettings", "knn_from_table", "knn_template"]

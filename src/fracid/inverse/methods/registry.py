@@ -9,7 +9,8 @@ counters and records in the result, the report's sections). A method meets
 
 A new method is a class and one line here (or ``METHODS[name] = cls`` from the user's code). Its settings
 come from the configuration's tables ``[identify.<table>]`` that it declares in ``config_tables`` (without it:
-the table of its name, ``[identify.<name>]``), read and checked by its ``from_config(tables, context)`` class
+the table of its name, ``[identify.<name>]``), with their keys described in ``config_keys`` (table -> key ->
+:class:`~fracid.settings.keys.Key`, read by the configuration reference: :func:`table_keys`), read and checked by its ``from_config(tables, context)`` class
 method (:func:`method_from_tables`; the checkers and their :class:`~fracid.settings.checks.SettingError`
 are in :mod:`fracid.settings.checks`); ``config_template(tables)`` writes them for ``fracid init``. The
 configuration knows no method: it allows every table a registered method declares (:func:`known_tables`) and
@@ -67,6 +68,17 @@ def known_tables() -> tuple:
     return tuple(dict.fromkeys(table for cls in METHODS.values() for table in config_tables(cls)))
 
 
+def table_keys(table: str) -> dict:
+    """The keys of the table ``[identify.<table>]``, described (key -> :class:`~fracid.settings.keys.Key`): those
+    the first registered method that reads it declares in its ``config_keys`` (table -> keys); empty when none
+    does."""
+    for name in table_readers(table):
+        keys = (getattr(METHODS[name], "config_keys", None) or {}).get(table)
+        if keys:
+            return dict(keys)
+    return {}
+
+
 def table_readers(table: str) -> tuple:
     """The names of the registered methods that read the table ``table``."""
     return tuple(name for name, cls in METHODS.items() if table in config_tables(cls))
@@ -109,4 +121,4 @@ def method_stages(name: str) -> dict:
 
 
 __all__ = ["DEFAULT_METHOD", "METHODS", "StudyMethod", "config_tables", "known_tables",
-           "method_from_tables", "method_stages", "table_readers"]
+           "method_from_tables", "method_stages", "table_keys", "table_readers"]
