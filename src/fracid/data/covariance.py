@@ -1,6 +1,6 @@
 """The standard deviation s of each point of a block and its diagonal covariance diag(s^2).
 
-Standard-deviation floor: a standard deviation below ``std_floor`` times the peak |y| of the block
+Standard-deviation floor: a standard deviation below ``std_floor`` times the peak ``|y|`` of the block
 (default :data:`DEFAULT_STD_FLOOR`, 1 %) is raised to that value and the points concerned are listed in
 the notes; without it, a point where the repeats or the envelope happen to coincide (s = 0) would get an
 infinite weight.
@@ -34,7 +34,7 @@ _RULE = re.compile(r"^range/(\d+(?:\.\d*)?)$")
 
 
 def check_floor(std_floor) -> float:
-    """``std_floor`` as a float, checked finite and >= 0 (a fraction of the peak |y|)."""
+    """``std_floor`` as a float, checked finite and >= 0 (a fraction of the peak ``|y|``)."""
     value = real_number(std_floor, "std_floor")
     if not (math.isfinite(value) and value >= 0.0):
         raise DataError(f"std_floor must be a finite fraction >= 0, got {std_floor!r}")
@@ -42,14 +42,14 @@ def check_floor(std_floor) -> float:
 
 
 def apply_floor(s: np.ndarray, y: np.ndarray, points: np.ndarray, std_floor: float) -> tuple[np.ndarray, list[str]]:
-    """Raise s to std_floor * peak |y| where it is smaller.
+    """Raise s to std_floor * peak ``|y|`` where it is smaller.
 
     Parameters
     ----------
     s, y, points : numpy.ndarray, shape (n,)
         Standard deviations, values and control values [mm] of the block.
     std_floor : float
-        The floor, a fraction of the peak |y| (checked by :func:`check_floor`).
+        The floor, a fraction of the peak ``|y|`` (checked by :func:`check_floor`).
 
     Returns
     -------

@@ -93,7 +93,7 @@ def _eigenpairs(points, std, subset_size, seed) -> tuple[np.ndarray, np.ndarray]
 def _rank(values: np.ndarray, vectors: np.ndarray, variance: float, tolerance: float) -> int:
     """The fewest modes k whose U U^T, with the rest of the variance on the diagonal, is within
     ``tolerance`` of the kernel in relative Frobenius norm: the error is the off-diagonal part of the
-    tail sum_{i > k} lambda_i v_i v_i^T, |tail|^2 - |diag tail|^2, for every k at once."""
+    tail sum_{i > k} lambda_i v_i v_i^T, ``|tail|``^2 - ``|diag tail|``^2, for every k at once."""
     values = np.clip(values, 0.0, None)
     total = np.sum(values**2)
     tail2 = total - np.cumsum(values**2)  # |tail_k|_F^2, k = 1..m

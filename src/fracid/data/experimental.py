@@ -78,7 +78,7 @@ def from_repeats(
     name : str
         Block name.
     std_floor : float
-        Floor on the standard deviation as a fraction of the peak |mean| (see module docstring).
+        Floor on the standard deviation as a fraction of the peak ``|mean|`` (see module docstring).
     sampling : {"equally-spaced", "measured"}
         See :func:`with_std`; the measured points are those of all the repeats (the knots of their mean).
 
@@ -143,7 +143,7 @@ def from_envelope(
     name : str
         Block name.
     std_floor : float
-        Floor on s as a fraction of the peak |mean| (see module docstring).
+        Floor on s as a fraction of the peak ``|mean|`` (see module docstring).
     sampling : {"equally-spaced", "measured"}
         See :func:`with_std`; the measured points and the peak are the mean curve's.
 
@@ -200,7 +200,7 @@ def with_std(
     curve : Curve
         The measured curve.
     std : float or array_like, shape (n_points,)
-        Standard deviation: absolute [N] (> 0), or with ``relative=True`` a fraction of |y| at each point.
+        Standard deviation: absolute [N] (> 0), or with ``relative=True`` a fraction of ``|y|`` at each point.
     n_points : int
         Number of sampling points n_y.
     control_range : (float, float), optional
@@ -208,9 +208,9 @@ def with_std(
     name : str
         Block name.
     relative : bool
-        Read ``std`` as a fraction of |y| per point; the floor then applies (|y| may vanish).
+        Read ``std`` as a fraction of ``|y|`` per point; the floor then applies (``|y|`` may vanish).
     std_floor : float
-        Floor on s as a fraction of the peak |y|, relative std only.
+        Floor on s as a fraction of the peak ``|y|``, relative std only.
     sampling : {"equally-spaced", "measured"}
         ``"equally-spaced"`` (default): n_points equally spaced control values, the one nearest the
         measured peak moved onto it (the data keep the peak exactly). ``"measured"``: the measured points

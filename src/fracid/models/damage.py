@@ -58,7 +58,7 @@ class DamageModel(PathFollowingModel):
         """The width 2 pi sqrt(c) = pi sqrt(2) l of the damage band at the onset of localisation (Peerlings et al.
         1996: the localisation zone of the gradient model spans a full wave of cos(x / sqrt(c))); the integral
         model's Gaussian of standard deviation l = sqrt(2 c) has the same second moment as the gradient model's
-        Green function exp(-|x| / sqrt(c)) / (2 sqrt(c)), and measured on the 100 mm bar its damaged zone is as wide
+        Green function exp(-``|x|`` / sqrt(c)) / (2 sqrt(c)), and measured on the 100 mm bar its damaged zone is as wide
         (11.6 and 21 mm at the peak for c = 1 and 4 mm^2, against 11.2 and 19.9 mm of the gradient model).
 
         The band then widens as the damage grows (implicit gradient): measured on the 100 mm bar (exponential law,

@@ -2,7 +2,7 @@
 measurement std beside the discretisation std and the model-error std, the estimates without and with them; and
 the posterior's model-error std (``PosteriorResult.model_error``).
 
-Units: those of each block (N for forces, mm for widths), also in % of the block's largest |measured value|.
+Units: those of each block (N for forces, mm for widths), also in % of the block's largest ``|measured value|``.
 """
 
 from __future__ import annotations

@@ -34,9 +34,9 @@ def fit_metrics(result, skip=()) -> list[dict]:
     list of dict
         Per block: ``block``, ``n`` (points where both values are finite), ``rms`` (root mean square
         of y_fit - y_exp over the measured range, in the block's unit: N for forces),
-        ``rms_percent`` (rms in % of |measured peak|), ``peak_measured`` and ``peak_computed`` (the
+        ``rms_percent`` (rms in % of ``|measured peak|``), ``peak_measured`` and ``peak_computed`` (the
         value of largest magnitude; the computed one on the run's own curve when the result keeps it, so that a
-        peak between two data points counts), ``peak_error_percent`` ((computed - measured) / |measured| in %),
+        peak between two data points counts), ``peak_error_percent`` ((computed - measured) / ``|measured|`` in %),
         ``index_peak_measured``/``index_peak_computed`` (positions in y) and ``f`` (the block's share
         of the objective sum(((y_exp - y_fit) / std_exp)^2)).
     """

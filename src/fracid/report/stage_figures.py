@@ -75,7 +75,7 @@ def _objective_for_log(f: np.ndarray, failed: np.ndarray):
 
 
 def strongest_pair(result) -> tuple[int, int] | None:
-    """Indices (i, j), i < j, of the two parameters with the largest |correlation|; None for p < 2."""
+    """Indices (i, j), i < j, of the two parameters with the largest ``|correlation|``; None for p < 2."""
     p = len(result.names)
     if p < 2:
         return None

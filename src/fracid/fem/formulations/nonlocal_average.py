@@ -2,7 +2,7 @@
 
 The nonlocal equivalent strain at integration point i is the weighted mean
 
-    ebar_i = sum_j w_j psi(|x_j - x_i|) eps_j / sum_j w_j psi(|x_j - x_i|)
+    ebar_i = sum_j w_j psi(``|x_j - x_i|``) eps_j / sum_j w_j psi(``|x_j - x_i|``)
 
 over the integration points j (w_j their volume weights), with the Gaussian weight
 psi(rho) = exp(-rho^2 / (2 l^2)). Dividing by the sum of the weights is the boundary correction: a

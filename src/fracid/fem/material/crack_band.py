@@ -59,7 +59,7 @@ def major_principal(s):
 
 
 def _plane_invariants(s):
-    """m = (sxx + syy) / 2, a = (sxx - syy) / 2, sxy and r = sqrt(a^2 + sxy^2) (kept above 1e-12 |m| + 1e-30,
+    """m = (sxx + syy) / 2, a = (sxx - syy) / 2, sxy and r = sqrt(a^2 + sxy^2) (kept above 1e-12 ``|m|`` + 1e-30,
     see :func:`principal_tension`): lambda_1,2 = m +- r."""
     m = 0.5 * (s[..., 0] + s[..., 1])
     a = 0.5 * (s[..., 0] - s[..., 1])
@@ -93,7 +93,7 @@ def principal_tension(s):
     a = (sxx - syy) / 2, r = sqrt(a^2 + sxy^2) (lambda_1,2 = m +- r):
     lambda_1 P_1 = (m + r) / 2 (1, 1, 0) + (m / r + 1) / 2 (a, -a, sxy), a closed form with a
     closed-form derivative. At equal principal values (r = 0) the direction is undefined; r is kept
-    above 1e-12 |m| + 1e-30 there (the damage term then acts along an arbitrary but fixed axis).
+    above 1e-12 ``|m|`` + 1e-30 there (the damage term then acts along an arbitrary but fixed axis).
     """
     s = np.asarray(s, dtype=float)
     m, a, t, r = _plane_invariants(s)
@@ -132,7 +132,7 @@ def crack_direction_stress_nu_derivative(s):
 
 def snap_back_limit(E, law, params) -> float:
     """Widest crack band [mm] for which the band's stress-strain law has no snap-back:
-    h_max = E / max_w |d sigma / dw| (the softening slope of the band, -1 / (1/E - h / |sigma'|),
+    h_max = E / max_w ``|d sigma / dw|`` (the softening slope of the band, -1 / (1/E - h / ``|sigma'|``),
     must stay negative), with E [MPa] and the steepest slope of ``law`` at ``params``
     (``law.steepest_slope(params)`` [MPa/mm])."""
     return float(E / law.steepest_slope(params))

@@ -98,7 +98,7 @@ def modified_von_mises_plane_stress(strain, nu, eta):
 def modified_von_mises_uniaxial(strain, nu, eta):
     """Equivalent strain of the uniaxial stress state (eps, -nu eps, -nu eps), for 1D models.
 
-    In closed form eps_eq = ((eta - 1) eps + (eta + 1) |eps|) / (2 eta): eps in tension, |eps|/eta in
+    In closed form eps_eq = ((eta - 1) eps + (eta + 1) ``|eps|``) / (2 eta): eps in tension, ``|eps|``/eta in
     compression, independent of nu.
 
     Parameters

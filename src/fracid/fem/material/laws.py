@@ -172,7 +172,7 @@ class HordijkLaw(ShapeLaw):
         return dict(zip(("c1", "c2"), params.area_factor_derivatives()))
 
     def steepest_shape_slope(self, params, samples: int = 2001) -> float:
-        """max |f'| over 2001 points of [0, 1] (the law is smooth there)."""
+        """max ``|f'|`` over 2001 points of [0, 1] (the law is smooth there)."""
         return float(np.max(np.abs(hordijk_shape(np.linspace(0.0, 1.0, samples), params.c1, params.c2)[1])))
 
 

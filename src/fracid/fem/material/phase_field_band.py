@@ -24,7 +24,7 @@ elongation of the whole band, is
 
     w = int (sigma / E) omega dx = 2 (sigma / E) l int_0^{d*} sqrt(omega(d) / (R(d) - R(d*))) dd,
 
-using |d'| = (1 / l) sqrt(omega (R(d) - R(d*))). The integrand behaves as sqrt(d) at d = 0 and as
+using ``|d'|`` = (1 / l) sqrt(omega (R(d) - R(d*))). The integrand behaves as sqrt(d) at d = 0 and as
 (d* - d)^(-1/2) at d*: it is integrated as sqrt(omega(d) / d / D(d)) against the algebraic weight
 d^(1/2) (d* - d)^(-1/2) (QUADPACK's QAWS, ``scipy.integrate.quad(weight="alg")``), with the divided
 difference D(d) = (R(d) - R(d*)) / (d* - d) > 0 evaluated without cancellation (it tends to -R'(d*)). For d*

@@ -18,7 +18,7 @@ exponential shape), not exponential. The area under the whole law is Gf (the ful
 optimal profile of the crack functional; :func:`dissipated_energy` gives it to ~1e-14), and the initial slope
 is k0 = -(ft^2 / (2 Gf)) ((a2 + p + 1/2) / 2)^(3/2), from which Wu's a2 are set.
 
-Against the nominal laws (:func:`target_law`), max |sigma - sigma_target| / ft over the law:
+Against the nominal laws (:func:`target_law`), max ``|sigma - sigma_target|`` / ft over the law:
 
 - linear (2, -1/2, 0): exactly the linear law, sigma = ft (1 - d*) and w = 2 Gf d* / ft in closed form;
 - exponential (5/2, 2^(5/3) - 3, 0): 2.6e-3, at w = 1.74 Gf / ft;
@@ -121,7 +121,7 @@ def centre_stress(centre_values, E, ft, Gf, l, p, a2, a3):
 def crack_opening(centre_values, E, ft, Gf, l, p, a2, a3):
     """Crack opening w [mm] of the localized band with centre phase field d*.
 
-    w = 2 (sigma / E) int_0^{d*} omega(d) / |d'(d)| dd, |d'| = (1 / l) sqrt(alpha - (alpha* / omega*) omega),
+    w = 2 (sigma / E) int_0^{d*} omega(d) / ``|d'(d)|`` dd, ``|d'|`` = (1 / l) sqrt(alpha - (alpha* / omega*) omega),
     by adaptive quadrature with the end singularities as algebraic weights (relative accuracy ~1e-12; for
     d* near 1 limited by the representation of 1 - d*, about 1e-16 / (1 - d*) relative).
 

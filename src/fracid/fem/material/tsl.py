@@ -42,7 +42,7 @@ class TractionSeparationLaw(Protocol):
     [mm], where the traction vanishes (``np.inf`` if it never does). ``scales(params)``: the
     characteristic ``strain`` (ft / E) [-] and ``opening`` [mm] a specimen sizes its default control
     with and the crack band's solver its tolerance. ``steepest_slope(params)``: max over w of
-    |d sigma / d w| [MPa/mm], the crack band's snap-back limit (needed by the crack band only).
+    ``|d sigma / d w|`` [MPa/mm], the crack band's snap-back limit (needed by the crack band only).
     """
 
     name: str
@@ -213,7 +213,7 @@ class ShapeLaw:
     A subclass gives the normalised shape: ``shape(x, params) -> (f, df / dx)`` on 0 <= x < 1 with
     f(0) = 1; ``shape_derivatives(x, params) -> {name: d f / d name}`` at fixed x for the shape's
     parameters; ``area(params)`` I = int_0^1 f dx [-] and ``area_derivatives(params) -> {name:
-    d I / d name}``; ``steepest_shape_slope(params)``, max |df / dx| [-]. This class turns them
+    d I / d name}``; ``steepest_shape_slope(params)``, max ``|df / dx|`` [-]. This class turns them
     into the law's values and exact parameter derivatives at fixed w (through wc as well).
     """
 
@@ -229,7 +229,7 @@ class ShapeLaw:
         return {"strain": params.ft / params.E, "opening": self.critical_opening(params)}
 
     def steepest_slope(self, params) -> float:
-        """max |d sigma / d w| = ft max |f'| / wc [MPa/mm]."""
+        """max ``|d sigma / d w|`` = ft max ``|f'|`` / wc [MPa/mm]."""
         return params.ft * self.steepest_shape_slope(params) / self.critical_opening(params)
 
     def _normalised(self, w, params):

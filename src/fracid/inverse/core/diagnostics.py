@@ -78,8 +78,8 @@ def block_curve(curves, index: int) -> tuple[np.ndarray, np.ndarray] | None:
 def elastic_points(x, y, fraction: float = ELASTIC_FRACTION, std=None) -> tuple[np.ndarray, bool]:
     """Indices of the elastic part of a curve (control ``x`` [mm], values ``y``), and whether they lie in it.
 
-    The points of the curve's own rising branch (up to its own peak, control > 0) whose |y| is at most
-    ``fraction`` of |peak| (True), within SIGNIFICANCE ``std`` when given (a noisy point just above the line is
+    The points of the curve's own rising branch (up to its own peak, control > 0) whose ``|y|`` is at most
+    ``fraction`` of ``|peak|`` (True), within SIGNIFICANCE ``std`` when given (a noisy point just above the line is
     not left out); when there is none, the first point of the rising branch (False: the secant to it is only a
     lower bound of the initial slope); none when nothing rises at control > 0.
     """
@@ -171,7 +171,7 @@ def _ratio(a: float, b: float) -> float:
 
 
 def worst_residual(control, y, std, y_fit, blocks) -> dict | None:
-    """The point of largest |computed - measured| / std: ``index`` in y, ``block``, ``control``,
+    """The point of largest ``|computed - measured|`` / std: ``index`` in y, ``block``, ``control``,
     ``measured``, ``computed`` and ``residual_std`` (signed, in units of the data's std); None when no
     point has a finite residual and a std > 0."""
     scaled = (np.asarray(y_fit, float) - y) / np.where(std > 0, std, np.nan)

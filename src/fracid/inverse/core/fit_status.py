@@ -150,7 +150,7 @@ def _bounds_std(bounds, p) -> np.ndarray:
 
 
 def correlated_pairs(C) -> list[tuple]:
-    """(i, j, r) of every pair with |r| above :data:`CORRELATION_LIMIT`."""
+    """(i, j, r) of every pair with ``|r|`` above :data:`CORRELATION_LIMIT`."""
     C = np.asarray(C, float)
     std = np.sqrt(np.maximum(np.diag(C), np.finfo(float).tiny))
     r = C / np.outer(std, std)

@@ -173,7 +173,7 @@ class MethodResult(GaussianEstimate, StageRecords):
 
     @property
     def rms_percent(self) -> float:
-        """RMS of (measured - computed) in per cent of the largest |measured| value (NaN if not computed)."""
+        """RMS of (measured - computed) in per cent of the largest ``|measured|`` value (NaN if not computed)."""
         y_exp, y_fit = np.asarray(self.y_exp, float), np.asarray(self.y_fit, float)
         scale = np.max(np.abs(y_exp)) if y_exp.size else 0.0
         rms = np.sqrt(np.mean((y_fit - y_exp) ** 2))

@@ -76,7 +76,7 @@ def memoized(evaluate):
 
 @dataclass(frozen=True)
 class CentralDifferences:
-    """S_j = (h(x + dx_j) - h(x - dx_j)) / (2 dx_j), dx_j = relative_step * max(|x_j|, floor_j).
+    """S_j = (h(x + dx_j) - h(x - dx_j)) / (2 dx_j), dx_j = relative_step * max(``|x_j|``, floor_j).
 
     The 2 p + 1 runs go to the executor together. A failed perturbed run falls back to the
     one-sided difference with the other side; a failed central run raises :class:`ForwardRunError`.
@@ -162,7 +162,7 @@ class SensitivityHistory:
     S : ndarray, shape (n, p)
         d y / d x.
     normalised : ndarray, shape (n, p)
-        d y_t / d x_j * x_j / max |y| of the block of y_t: the response change for a 100 % change
+        d y_t / d x_j * x_j / max ``|y|`` of the block of y_t: the response change for a 100 % change
         of x_j, relative to the block's largest value.
     information : ndarray, shape (n, p, p)
         Fisher information of the observations 1..t: S_1:t^T C_1:t^-1 S_1:t.
@@ -248,7 +248,7 @@ def sensitivity_history(evaluate, x, C_exp, C0, *, names=None, blocks=None, sens
         Prior covariance (e.g. from the bounds or from KNN): the reference the shares are taken from.
     names : sequence of str, optional
     blocks : sequence of (name, start, stop), optional
-        Data blocks; each is normalised by its own largest |y| (global and local data differ in units).
+        Data blocks; each is normalised by its own largest ``|y|`` (global and local data differ in units).
     sensitivity : callable, optional
         The sensitivity method; by default :func:`exact_sensitivity`'s choice.
     """

@@ -7,7 +7,7 @@ of y_h,
     e = y_h - y = (y_h - y_h/r) r^p / (r^p - 1),
 
 per output (:func:`richardson_error`). The order p is observed per data block from a third, coarser mesh
-(h r): p = log(|y_hr - y_h| / |y_h - y_h/r|) / log r in RMS norms over the block (:func:`observed_order`),
+(h r): p = log(``|y_hr - y_h|`` / ``|y_h - y_h/r|``) / log r in RMS norms over the block (:func:`observed_order`),
 clipped to :data:`ORDER_RANGE` (a pre-asymptotic sequence gives a low order: the clip keeps the error bounded,
 a lower order is the conservative side); where the changes are at round-off level the order is not observable
 and the stated nominal order is used (1 by default: e twice the change, conservative for the quadratic

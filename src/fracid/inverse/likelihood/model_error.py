@@ -14,7 +14,7 @@ C0 the parameters' prior covariance (uniform over the bounds). The third term co
 parameters take from the residual (for a linear model the estimate is then the restricted maximum likelihood
 one, unbiased). The identification is then run again with C_s, and the two repeated to a fixed point
 (:mod:`fracid.inverse.likelihood.terms`). Priors (:func:`log_prior`): half-Cauchy of scale ``scale`` x the group's
-largest |y_exp|, or log-uniform; the range is ``bounds`` x that value.
+largest ``|y_exp|``, or log-uniform; the range is ``bounds`` x that value.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ class ErrorGroups:
     indices : list of ndarray
         The entries of y of each group.
     scales : ndarray
-        The largest |y_exp| of each group [units of y]: the prior's scale and the bounds are fractions of it.
+        The largest ``|y_exp|`` of each group [units of y]: the prior's scale and the bounds are fractions of it.
     modes : list of ndarray or None
         ``kind = "bias"``: the unit modes (n, r_g) of the kernel along the control on the group's entries; None for
         independent errors.

@@ -72,9 +72,9 @@ class ModelError:
     prior : {"half-cauchy", "log-uniform"}
         Prior of sigma_m: half-Cauchy of scale ``scale`` or log-uniform between the ``bounds``.
     scale : float
-        The half-Cauchy's scale, as a fraction of the group's largest |measured value| [-].
+        The half-Cauchy's scale, as a fraction of the group's largest ``|measured value|`` [-].
     bounds : (float, float)
-        The range of sigma_m, fractions of the group's largest |measured value| [-].
+        The range of sigma_m, fractions of the group's largest ``|measured value|`` [-].
     groups : {"block", "quantity"}
         One sigma_m per data block, or one per observed quantity (blocks of forces share one).
     correlation_length : float

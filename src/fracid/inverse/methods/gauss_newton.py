@@ -108,7 +108,7 @@ def gauss_newton(evaluate, y_exp, C_exp, x0, C0, *, sensitivity=None, executor=N
 
         Phi(x) = (y_exp - h(x))^T C_exp^-1 (y_exp - h(x)) + (x - x0)^T C0^-1 (x - x0),
 
-    as the least-squares problem |r(x)|^2 of the whitened residual
+    as the least-squares problem ``|r(x)|``^2 of the whitened residual
     r(x) = [L_exp^-1 (h(x) - y_exp); L0^-1 (x - x0)] (C_exp = L_exp L_exp^T, C0 = L0 L0^T), solved by
     :func:`scipy.optimize.least_squares` (method ``"trf"``) in the variables x / sqrt(diag C0), with
     the Jacobian [L_exp^-1 S; L0^-1] from ``sensitivity``. x and y are in the caller's units. Scaling,
@@ -222,7 +222,7 @@ def _last_step(problem, tol, callback):
 
 
 def _step(J, r, lo, hi):
-    """The undamped Gauss-Newton step argmin |r + J dz| within lo <= dz <= hi (exact for small p)."""
+    """The undamped Gauss-Newton step argmin ``|r + J dz|`` within lo <= dz <= hi (exact for small p)."""
     return lsq_linear(J, -r, bounds=(lo, hi), method="bvls").x
 
 

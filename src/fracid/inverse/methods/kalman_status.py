@@ -146,7 +146,7 @@ def pass_change(x_before, x_after, C, f_before, f_after) -> PassChange:
 
 
 def valley_text(C, names):
-    """The valley of C in words, or None: the most correlated pair when |r| is above
+    """The valley of C in words, or None: the most correlated pair when ``|r|`` is above
     :data:`VALLEY_CORRELATION`, else the parameter that dominates a principal direction
     :data:`VALLEY_WIDTH_RATIO` times wider (in std) than the next one."""
     p = C.shape[0]

@@ -85,7 +85,7 @@ def snap_to_bounds(x, lower, upper):
     """x with every entry within :data:`BOUND_TOLERANCE` of the box's span from a bound put on that bound.
 
     The solvers stop within their tolerance of an active bound; snapping makes the bound exact. An
-    unbounded direction is measured against |x| + 1 instead of the span.
+    unbounded direction is measured against ``|x|`` + 1 instead of the span.
     """
     span = np.where(np.isfinite(upper - lower), upper - lower, np.abs(x) + 1.0)
     x = np.where(x - lower <= BOUND_TOLERANCE * span, lower, x)

@@ -146,7 +146,7 @@ class PosteriorSettings:
 
 def log_likelihood(records, y_exp, C_exp, marginal=None):
     """-1/2 chi^2 of every record (-inf where the run failed or left outputs out), and the outputs;
-    chi^2 = |C_exp.whiten(y - y_exp)|^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`), or
+    chi^2 = ``|C_exp.whiten(y - y_exp)|``^2 (``C_exp`` a :class:`~fracid.data.covariance_matrix.Covariance`), or
     ``marginal(residuals)``: the model error's std integrated out (relative to C_exp's normalisation)."""
     y = np.array([np.asarray(r.y, float) if r.ok else np.full(len(y_exp), np.nan) for r in records])
     good = np.all(np.isfinite(y), axis=1)

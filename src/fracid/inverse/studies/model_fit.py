@@ -79,7 +79,7 @@ class ModelFit:
     control, force : ndarray
         Curve of the run at the estimate from 0 to the last data control value [mm], [N].
     rms_relative : float
-        RMS of ``y_fit - y`` over the data points divided by the data's largest |y| [-].
+        RMS of ``y_fit - y`` over the data points divided by the data's largest ``|y|`` [-].
     peak_force : float
         Largest force of the run at the estimate [N].
     dissipated_energy : float
@@ -138,7 +138,7 @@ class ModelFit:
 
 
 def relative_rms(y_fit, y) -> float:
-    """RMS of ``y_fit - y`` divided by the largest |y| [-] (NaN entries of ``y_fit`` count as missing)."""
+    """RMS of ``y_fit - y`` divided by the largest ``|y|`` [-] (NaN entries of ``y_fit`` count as missing)."""
     y_fit, y = np.asarray(y_fit, float), np.asarray(y, float)
     both = np.isfinite(y_fit) & np.isfinite(y)
     if not both.any():

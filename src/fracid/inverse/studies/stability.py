@@ -28,7 +28,7 @@ class Stability:
     errors : list of str
         Failure reason per replicate ("" when it ran).
     noise_level : float
-        RMS of std / |y| over the data (:func:`relative_noise`): the relative noise added.
+        RMS of std / ``|y|`` over the data (:func:`relative_noise`): the relative noise added.
     seed : int
     """
 
@@ -62,7 +62,7 @@ class Stability:
 
 
 def relative_noise(y_exp, C_noise) -> float:
-    """RMS of std / |y| over the values the noise does not swamp (|y| >= 3 std; all if none), the std that of the
+    """RMS of std / ``|y|`` over the values the noise does not swamp (``|y|`` >= 3 std; all if none), the std that of the
     measurement noise alone (a marginalised rigid motion left out: :meth:`Covariance.noise_diag`) [-]."""
     variance = C_noise.noise_diag()
     clear = y_exp**2 >= 9.0 * variance

@@ -66,7 +66,7 @@ class StudySettings:
     noise_seed : int
         Seed of the replicates' noise.
     tolerance : float
-        Largest relative standard deviation std / |estimate| called identified [-] (0.1: 10 %).
+        Largest relative standard deviation std / ``|estimate|`` called identified [-] (0.1: 10 %).
     posterior : PosteriorSettings or None
         Sample the posterior on the exact model with these settings after the checks, and give the
         verdict from its 90 % credible intervals; None (default): no posterior, the verdict from the

@@ -41,7 +41,7 @@ class Prediction:
 
     @property
     def relative_rms(self) -> float:
-        """RMS of (computed - measured) / max |measured|."""
+        """RMS of (computed - measured) / max ``|measured|``."""
         return float(np.sqrt(np.mean((self.y - self.y_exp) ** 2)) / np.max(np.abs(self.y_exp)))
 
     @property

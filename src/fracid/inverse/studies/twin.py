@@ -24,7 +24,7 @@ def synthetic_data(operator, x_true, std, *, seed: int | None = 0) -> Experiment
         The known parameters.
     std : dict of str -> float, or float
         Per block name: the noise standard deviation. A value in (0, 1) with the key suffixed
-        ``":relative"`` (e.g. ``{"global:relative": 0.02}``) is relative to the block's largest |y|;
+        ``":relative"`` (e.g. ``{"global:relative": 0.02}``) is relative to the block's largest ``|y|``;
         a plain float applies to every block as relative.
     seed : int or None
         Seed of the noise; None gives noise-free data (with the stated covariance).
@@ -90,7 +90,7 @@ class TwinOutcome:
 
     @property
     def relative_std(self) -> np.ndarray:
-        """Posterior standard deviation / |estimate|: the expected estimation error."""
+        """Posterior standard deviation / ``|estimate|``: the expected estimation error."""
         ident = self.study.identification
         return ident.std / np.abs(ident.x)
 

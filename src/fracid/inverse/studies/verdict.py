@@ -3,9 +3,9 @@
 The rules read the posterior covariance C of the estimate (linearised at the estimate), the prior
 covariance from the bounds, and the uniqueness and stability checks when they were run:
 
-* **identified** - relative standard deviation std / |x| <= ``tolerance``, and the multi-start
+* **identified** - relative standard deviation std / ``|x|`` <= ``tolerance``, and the multi-start
   ends agree within their standard deviations;
-* **correlated with X** - std / |x| > tolerance, but the conditional standard deviation (what the
+* **correlated with X** - std / ``|x|`` > tolerance, but the conditional standard deviation (what the
   data would give if the other parameters were known, 1 / sqrt((C^-1)_jj)) is within tolerance:
   the data fix a combination of the parameters, not each one (a valley of the objective);
 * **not identifiable from these data** - neither: the data remove little of the prior variance.
@@ -22,7 +22,7 @@ posterior, one cut by a bound):
 
 * the value is the posterior mean, and the "std" is the std-equivalent of the equal-tailed 90 %
   credible interval: its half-width / 1.645 (what it is for a normal distribution); *identified*
-  when it is within ``tolerance`` of |posterior mean|;
+  when it is within ``tolerance`` of ``|posterior mean|``;
 * the correlation matrix, the partner and r are those of the posterior's weighted covariance;
 * the conditional std is the std-equivalent times sqrt(1 - R^2), R^2 = 1 - 1 / (C_jj (C^-1)_jj) the
   squared multiple correlation of the parameter with the others in the weighted covariance (its
@@ -95,7 +95,7 @@ class ParameterVerdict:
 
     @property
     def relative_std(self) -> float:
-        """std / |value|: what the rule compares with the tolerance."""
+        """std / ``|value|``: what the rule compares with the tolerance."""
         return self.std / abs(self.value)
 
     def measure_text(self, unit: str = "") -> str:
@@ -186,7 +186,7 @@ def parameter_verdicts(names, x, C, C_prior, *, data: DataDescription = DataDesc
     stability : Stability, optional
         From :func:`fracid.inverse.studies.stability.stability`; its scatter is reported.
     strong : float
-        |correlation| reported as strong.
+        ``|correlation|`` reported as strong.
     posterior : PosteriorResult, optional
         The sampled posterior (:func:`fracid.inverse.sampling.posterior.posterior`; any object with ``mean``,
         ``cov`` and ``credible_intervals(level)`` in the order of ``names``): the rules then read its
