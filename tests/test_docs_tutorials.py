@@ -15,6 +15,7 @@ import re
 import shutil
 import subprocess
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -88,6 +89,7 @@ def run_page(page: Path, directory: Path, files: Path = FILES) -> None:
     try:
         for block in filter(runnable, blocks(page.read_text(encoding="utf-8"))):
             label = f"{where}, {block.language} block at line {block.line}"
+            start = time.perf_counter()
             if block.language == "bash":
                 proc = subprocess.run(["bash", "-c", shell_script(block.text)], cwd=directory, capture_output=True,
                                       text=True, timeout=TIMEOUT, stdin=subprocess.DEVNULL)
@@ -99,6 +101,8 @@ def run_page(page: Path, directory: Path, files: Path = FILES) -> None:
                     exec(compile(block.text, label, "exec"), namespace)
                 except Exception as error:  # noqa: BLE001 - any error of a page's code fails that page
                     raise BlockFailed(f"{label} raised {type(error).__name__}: {error}\n{block.text}") from error
+            if os.environ.get("FRACID_TEST_TIMES"):
+                print(f"TIME {time.perf_counter() - start:6.2f} s  {label}", file=sys.__stderr__, flush=True)
     finally:
         os.chdir(old)
 
