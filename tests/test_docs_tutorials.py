@@ -186,3 +186,12 @@ def test_blocks_reads_info_strings_and_longer_fences():
     found = blocks("```{toctree}\nx\n```\n````bash\n```\ninner\n```\n````\n~~~python\ny = 1\n~~~\n")
     assert [(b.language, b.line) for b in found] == [("{toctree}", 1), ("bash", 4), ("python", 9)]
     assert found[1].text == "```\ninner\n```\n"
+
+
+def test_fracid_falls_back_to_python_m_fracid_off_path(monkeypatch, tmp_path):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    script = shell_script("pip install fracid\nfracid --version\n")
+    assert "pip install" not in script and f'"{sys.executable}" -m fracid' in script
+    proc = subprocess.run(["bash", "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PATH": "/usr/bin:/bin"})
+    assert proc.returncode == 0 and proc.stdout.startswith("fracid "), proc.stderr
