@@ -53,7 +53,7 @@ def documented(cls) -> dict:
     return {**numpydoc_parameters(cls, "Attributes"), **numpydoc_parameters(cls)}
 
 
-#: a reST role with its target (``:func:`~fracid.models.simulate```, ``:mod:`text <target>```)
+#: a reST role with its target (``:func:`~fracid.models.forward.simulate```, ``:mod:`text <target>```)
 _ROLE = re.compile(r":[a-z]+(?::[a-z]+)?:`~?([^`<]*?)(?:\s*<[^`>]*>)?`")
 
 
