@@ -42,7 +42,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "**/runs.sqlite*", "gallery/*.ipynb", "gallery/*.py", "gallery/*.zip",
+exclude_patterns = ["_build", "tutorials/files/**", "**/runs.sqlite*", "gallery/*.ipynb", "gallery/*.py", "gallery/*.zip",
                     "gallery/*.json", "sg_execution_times.rst"]
 templates_path = ["_templates"]
 
