@@ -85,6 +85,24 @@ def test_every_public_name_has_an_api_entry(site):
             assert f"{package}.{name}" in text or f">{name}<" in text, (package, name)
 
 
+@pytest.mark.slow
+def test_every_command_and_option_has_a_cli_entry(site):
+    import argparse
+
+    from fracid.cli.dispatch import parser
+
+    html, _ = site
+    text = " ".join(re.sub(r"<[^>]+>", " ", (html / "reference" / "cli.html").read_text(encoding="utf-8")).split())
+    text = re.sub(r"\s*-\s*", "-", text)  # the usage lines' highlighting splits "size-effect", "--out"
+    sub = next(a for a in parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for name, command in sub.choices.items():
+        assert f"fracid {name} [" in text, name
+        section = text[text.index(f"fracid {name} ["):]
+        for action in command._actions:
+            for option in set(action.option_strings) - {"-h", "--help"}:
+                assert re.search(rf"(?<![\w-]){re.escape(option)}(?![\w-])", section), (name, option)
+
+
 def test_missing_entries_names_a_public_name_without_entry():
     packages = ["fracid.specimens"]
     names = {f"fracid.specimens.{n}" for n in api.public_names("fracid.specimens")}
