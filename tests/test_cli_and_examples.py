@@ -2,7 +2,6 @@
 
 import json
 import re
-import runpy
 import subprocess
 import sys
 from pathlib import Path
@@ -109,12 +108,6 @@ def test_bad_config_exits_2_with_one_paragraph_and_no_traceback(tmp_path, text, 
 def test_bad_workers_option(capsys):
     assert cli.main(["simulate", str(CONFIGS / "bar_simulate.toml"), "--workers", "0"]) == 2
     assert "--workers" in capsys.readouterr().err
-
-
-@pytest.mark.parametrize("example", sorted((ROOT / "examples").glob("*.py")), ids=lambda p: p.name)
-def test_example_runs(example, capsys):
-    runpy.run_path(str(example), run_name="__main__")
-    assert capsys.readouterr().out.strip()
 
 
 BAR_SERIES = """
