@@ -87,7 +87,7 @@ def write_identification(args, job, out, result) -> None:
     say(args, result.summary())
     stages = " + ".join(f"{c['runs']} {result.stages[stage]} ({c['failed']} failed, {c.get('computed', c['runs'])} computed)"
                         for stage, c in result.stage_runs().items())
-    say(args, f"fit: RMS error {result.rms_percent:.3g} % of the measured peak; forward runs: {stages}; "
+    say(args, f"fit: {result.rms_text()}; forward runs: {stages}; "
               f"{result.runs['wall_seconds']:.0f} s")
     figures_written = sorted(p.relative_to(out).as_posix() for p in (out / "figures").glob("*.png"))
     wrote(args, out, ["result.json", "fit.csv", "report.html", *figures_written, "runs.sqlite"])

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import difflib
+import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -144,8 +145,39 @@ def delimiter_hint(header: Sequence[str], delimiter: str) -> str | None:
     return None
 
 
+#: largest data file read [bytes]: its text lines and cells take about 10 times the file's size in memory, so
+#: 200 MiB (about 3 million DIC points of 7 columns) is about 2 GiB read; a larger export is thinned or split
+MAX_TABLE_BYTES = 200 * 2**20
+#: bytes read at the start of a file to tell a binary file (a NUL byte) from text
+SNIFF_BYTES = 65536
+
+
+def check_text_file(path: str, limit: int = MAX_TABLE_BYTES) -> None:
+    """Refuse, before reading it, a file larger than ``limit`` bytes or one whose first :data:`SNIFF_BYTES` hold a
+    NUL byte (a binary file: a spreadsheet, an image, a MATLAB file, not CSV text).
+
+    Raises
+    ------
+    DataError
+        Naming the file, its size and the limit, or the NUL byte's offset, and what to do.
+    """
+    size = os.path.getsize(path)
+    if size > limit:
+        raise DataError(f"{path}: {size / 2**20:.0f} MiB, more than the {limit / 2**20:.0f} MiB a data file may have "
+                        "(its text takes about 10 times its size in memory): export fewer points (a coarser DIC "
+                        "step, a region of interest) or split it into one file per frame")
+    with open(path, "rb") as handle:
+        head = handle.read(SNIFF_BYTES)
+    nul = head.find(b"\x00")
+    if nul >= 0 and not head.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 is named by the decoder
+        raise DataError(f"{path}: a NUL byte at offset {nul}: a binary file, not CSV text; export "
+                        "the data as CSV (text) from the program that wrote it")
+
+
 def _text_lines(path: str) -> list[str]:
-    """The lines of a UTF-8 text file (a BOM removed), line ends kept for :mod:`csv`."""
+    """The lines of a UTF-8 text file (a BOM removed), line ends kept for :mod:`csv`; a file too large or binary
+    refused first (:func:`check_text_file`)."""
+    check_text_file(path)
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:
             return handle.readlines()

@@ -21,7 +21,7 @@ class BlockView:
     block : str
         The block's name.
     heading : str
-        The section's heading, e.g. ``"Displacement field field"``.
+        The section's heading, e.g. ``"Displacement field dic"``.
     text : str
         A paragraph (plain text, escaped by the report).
     header, rows : list

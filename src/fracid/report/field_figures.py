@@ -178,7 +178,7 @@ def field_view(name: str, coordinates: dict, measured, computed, std, control_la
                     computed, std=noise_std, covariance=covariance, control=coordinates.get("control"),
                     point=coordinates.get("point"))
     control_name = control_label.rsplit(" [", 1)[0]
-    stem = f"field_{file_stem(name)}"
+    stem = field_stem(name)
     figures = {f"{stem}_summary": (summary_figure(fit, name=name, control_label=control_label),
                                          "Residual RMS per frame in noise stds (whitened by the data covariance; 1: "
                                          "the noise) and the rigid motion fitted per frame.")}
@@ -188,7 +188,25 @@ def field_view(name: str, coordinates: dict, measured, computed, std, control_la
             f"Frame {k + 1}: measured displacement with the frame's fitted rigid motion removed, computed at the "
             "estimate, and their difference, in micrometres over the specimen's face (dots: the points).")
     header, rows = field_table(fit, control_name)
-    return BlockView(name, f"Displacement field {name}", field_text(fit), header, rows, figures)
+    return BlockView(name, field_heading(name), field_text(fit), header, rows, figures)
 
 
-__all__ = ["field_view", "frame_figure", "frame_title", "hole_free_triangulation", "map_row_height", "summary_figure"]
+#: the heading of a field block's section; its last word names the figures' files
+HEADING = "Displacement field"
+_NOUN = HEADING.split()[-1].lower()
+
+
+def field_heading(name: str) -> str:
+    """The report's heading of the field block ``name``: "Displacement field", and its name unless that is
+    the heading's last word itself (not "Displacement field field")."""
+    return HEADING if name.strip().lower() == _NOUN else f"{HEADING} {name}"
+
+
+def field_stem(name: str) -> str:
+    """The file-name stem of the field block ``name``'s figures: ``field_<name>``, or ``field`` for a block named
+    "field" (not ``field_field``)."""
+    stem = file_stem(name)
+    return _NOUN if stem.lower() == _NOUN else f"{_NOUN}_{stem}"
+
+
+__all__ = ["field_heading", "field_stem", "field_view", "frame_figure", "frame_title", "hole_free_triangulation", "map_row_height", "summary_figure"]

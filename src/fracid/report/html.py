@@ -96,9 +96,9 @@ def parameter_section(result, control=None) -> str:
     status += f" (what to do: {esc(action)})" if action else ""
     warnings = result.warnings(control=control) if hasattr(result, "warnings") else []
     shown = "".join(f'<li><span class="warn">warning</span>: {esc(w)}</li>' for w in warnings)
-    rms = getattr(result, "rms_percent", float("nan"))
+    rms_text = result.rms_text() if hasattr(result, "rms_text") else "RMS error not computed"
     return (f"<h2>Identified parameters</h2>\n{table}\n"
-            f"<p>{esc(status_label(result))}: {status}. Fit: RMS error {num(rms, 3)} % of the measured peak. Standard "
+            f"<p>{esc(status_label(result))}: {status}. Fit: {esc(rms_text)}. Standard "
             "deviations are the square roots of the diagonal of the posterior covariance C.</p>"
             + (f'\n<ul class="notes">{shown}</ul>' if shown else ""))
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fracid.report.block_view import BlockView
-from fracid.report.field_figures import field_view
+from fracid.report.field_figures import field_heading, field_view
 from fracid.report.figures import block_control_labels, float_array, result_blocks
 
 
@@ -34,20 +34,21 @@ class View:
         computed values and data std.
     quantities : tuple of str
         The observed quantities of the blocks it shows (an observation kind's ``quantity``).
-    heading : str
-        The heading of a block of such a quantity whose coordinates are not given (``"... {name}"``).
+    heading : str or callable
+        The heading of a block of such a quantity whose coordinates are not given (``"... {name}"``, or a
+        function of the block's name).
     missing : str
         The text of such a block (``{name}``, ``{n}`` its values, ``{held}``: "not given" or "given for m values").
     """
 
     build: Callable
     quantities: tuple = ()
-    heading: str = "Block {name}"
+    heading: str | Callable = "Block {name}"
     missing: str = "Block {name!r} ({n} values): its coordinates are {held}, so it is not drawn."
 
 
 #: view name -> :class:`View`; the first is the default of coordinates that name none
-VIEWS = {"displacement-field": View(field_view, quantities=("u",), heading="Displacement field {name}",
+VIEWS = {"displacement-field": View(field_view, quantities=("u",), heading=field_heading,
                        missing="Block {name!r} ({n} values) is a displacement field; its point coordinates are {held}, "
                                "so it is not drawn (a field is no curve against the control). fracid identify draws "
                                "its maps.")}
@@ -94,7 +95,8 @@ def block_views(result, fields=None, control_label: str | None = None) -> list[B
         view = VIEWS[(info or {}).get("view") or by_quantity.get(name) or next(iter(VIEWS))]
         if info is None or _entries(info) != stop - start:
             held = "not given" if info is None else f"given for {_entries(info)} values"
-            views.append(BlockView(name, view.heading.format(name=name),
+            heading = view.heading(name) if callable(view.heading) else view.heading.format(name=name)
+            views.append(BlockView(name, heading,
                                    view.missing.format(name=name, n=stop - start, held=held)))
             continue
         views.append(view.build(name, info, y_exp[start:stop], y_fit[start:stop], std[start:stop], label))

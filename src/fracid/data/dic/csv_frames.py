@@ -24,43 +24,44 @@ from fracid.data.cells import check_cell_count, parse_cell
 from fracid.data.dic.assemble import FrameCloud, assemble
 from fracid.data.dic.vtk_frames import read_vtk_cloud
 from fracid.data.errors import DataError
-from fracid.data.table import column_indices, parse_table, read_table
+from fracid.data.table import check_format, column_indices, parse_table, read_table
 from fracid.settings.checks import show
 
 #: cells read as a missing value in the columns that may have holes
 MISSING_CELLS = ("", "nan")
 
 
-def _table(path: str, columns: list[str], what: str):
+def _table(path: str, columns: list[str], what: str, delimiter: str = ",", decimal: str = "."):
     """:func:`read_table` of ``path`` with an unreadable or missing file named, as ``what``."""
     try:
-        return read_table(path, columns=columns)
+        return read_table(path, delimiter, decimal, columns=columns)
     except OSError as error:
         raise DataError(f"{what} {path}: cannot be read ({error.strerror or error})") from None
 
 
-def _holey_columns(table, names: list[str], indices: list[int]) -> np.ndarray:
+def _holey_columns(table, names: list[str], indices: list[int], delimiter: str = ",", decimal: str = ".") -> np.ndarray:
     """Values (n_rows, n_columns) of columns that may have holes: an empty cell or NaN is NaN."""
     values = np.empty((len(table.rows), len(names)))
     for r, (line, cells) in enumerate(table.rows):
-        check_cell_count(table.path, line, cells, table.header, ",", ".")
+        check_cell_count(table.path, line, cells, table.header, delimiter, decimal)
         for c, (name, index) in enumerate(zip(names, indices)):
             text = cells[index].strip() if index < len(cells) else ""
-            values[r, c] = math.nan if text.lower() in MISSING_CELLS else parse_cell(table.path, line, name, text)
+            values[r, c] = (math.nan if text.lower() in MISSING_CELLS
+                            else parse_cell(table.path, line, name, text, decimal, delimiter))
     return values
 
 
-def read_cloud(path: str, columns: dict) -> FrameCloud:
+def read_cloud(path: str, columns: dict, delimiter: str = ",", decimal: str = ".") -> FrameCloud:
     """One frame's point cloud; ``columns`` maps "x", "y", "u", "v" and optionally "sigma", "quality" to the
-    file's column names (None: absent)."""
+    file's column names (None: absent); cells separated by ``delimiter``, numbers with the ``decimal`` mark."""
     wanted = {key: name for key, name in columns.items() if name is not None}
-    table = _table(path, list(wanted.values()), "point cloud")
-    indices = dict(zip(wanted, column_indices(table, list(wanted.values()))))
-    xy, rows = parse_table(table, [wanted["x"], wanted["y"]], [indices["x"], indices["y"]])
+    table = _table(path, list(wanted.values()), "point cloud", delimiter, decimal)
+    indices = dict(zip(wanted, column_indices(table, list(wanted.values()), delimiter)))
+    xy, rows = parse_table(table, [wanted["x"], wanted["y"]], [indices["x"], indices["y"]], decimal, delimiter)
     if len(rows) == 0:
         raise DataError(f"{path}: no data rows below the header (line {table.header_line})")
     holey = [key for key in ("u", "v", "sigma", "quality") if key in wanted]
-    values = _holey_columns(table, [wanted[k] for k in holey], [indices[k] for k in holey])
+    values = _holey_columns(table, [wanted[k] for k in holey], [indices[k] for k in holey], delimiter, decimal)
     by_key = dict(zip(holey, values.T))
     sigma = by_key.get("sigma")
     if sigma is not None and np.any(sigma < 0.0):
@@ -70,16 +71,17 @@ def read_cloud(path: str, columns: dict) -> FrameCloud:
     return FrameCloud(path, xy, np.column_stack([by_key["u"], by_key["v"]]), rows, sigma, by_key.get("quality"))
 
 
-def read_frame_table(path: str, frame_column: str, file_column: str, load_columns) -> tuple:
+def read_frame_table(path: str, frame_column: str, file_column: str, load_columns, delimiter: str = ",",
+                     decimal: str = ".") -> tuple:
     """Frame numbers, point-cloud paths (resolved against the table's folder) with their table rows, and the
     load columns of the frame table (all other columns if ``load_columns`` is None)."""
     requested = [frame_column, file_column, *(load_columns or [])]
-    table = _table(path, requested, "frame table")
+    table = _table(path, requested, "frame table", delimiter, decimal)
     if load_columns is None:
         load_columns = [name for name in table.header if name not in (frame_column, file_column)]
     names = [frame_column, *load_columns]
-    file_index, *numeric = column_indices(table, [file_column, *names])
-    values, rows = parse_table(table, names, numeric)
+    file_index, *numeric = column_indices(table, [file_column, *names], delimiter)
+    values, rows = parse_table(table, names, numeric, decimal, delimiter)
     if len(rows) == 0:
         raise DataError(f"{path}: the frame table has no data rows below the header (line {table.header_line})")
     frames = []
@@ -100,7 +102,7 @@ def read_frame_table(path: str, frame_column: str, file_column: str, load_column
 
 def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quality=None, min_quality=None,
                     coordinate_unit="mm", load_columns=None, placement=None, frame_column="frame",
-                    file_column="file", point_tolerance=1e-6, displacement=None):
+                    file_column="file", point_tolerance=1e-6, displacement=None, delimiter=",", decimal="."):
     """Read a DIC export: a frame table and the point cloud of every frame, placed on the specimen.
 
     Parameters
@@ -127,6 +129,9 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
     displacement : str or None
         For frames in VTU/VTK files: the point-data array of the displacements (None: "displacement", else
         "U"); ``sigma`` and ``quality`` then name point-data arrays, ``x``, ``y``, ``u``, ``v`` are not used.
+    delimiter, decimal : str
+        Cell separator and decimal mark of the frame table and the CSV point clouds
+        (:func:`fracid.data.table.check_format`): a European export reads with ``";"`` and ``","``.
 
     Returns
     -------
@@ -140,6 +145,7 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
         frames with different points, a frame number that is not an integer.
     """
     table_path = file_path(table_path)
+    delimiter, decimal = check_format(delimiter, decimal)
     columns = {"x": x, "y": y, "u": u, "v": v, "sigma": sigma, "quality": quality}
     for key, name in columns.items():
         if name is not None or key in "xyuv":
@@ -149,14 +155,16 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
     if load_columns is not None:
         load_columns = [column_name(name, f"load_columns[{k}]") for k, name in enumerate(load_columns)]
     frames, files, load, notes = read_frame_table(table_path, column_name(frame_column, "frame_column"),
-                                                  column_name(file_column, "file_column"), load_columns)
+                                                  column_name(file_column, "file_column"), load_columns, delimiter,
+                                                  decimal)
     clouds = []
     for path, line in files:
         if not os.path.isfile(path):
             raise DataError(f"{table_path}: row {line}, column {show(file_column)}: the point-cloud file {path} does "
                             "not exist (paths are relative to the frame table's folder)")
         vtk = path.lower().endswith((".vtu", ".vtk"))
-        clouds.append(read_vtk_cloud(path, displacement, sigma, quality) if vtk else read_cloud(path, columns))
+        clouds.append(read_vtk_cloud(path, displacement, sigma, quality) if vtk
+                      else read_cloud(path, columns, delimiter, decimal))
     data = assemble(clouds, frames, load, placement=placement, coordinate_unit=coordinate_unit,
                     min_quality=min_quality, point_tolerance=point_tolerance, notes=notes)
     return replace(data, source=(table_path, *data.source))

@@ -173,11 +173,38 @@ class MethodResult(GaussianEstimate, StageRecords):
 
     @property
     def rms_percent(self) -> float:
-        """RMS of (measured - computed) in per cent of the largest ``|measured|`` value (NaN if not computed)."""
+        """RMS fit error in per cent of each block's largest ``|measured|`` value, pooled over the blocks'
+        points (NaN if not computed): each block is measured in its own unit (N for forces, mm for
+        displacements and widths), so no block's unit is divided by another's."""
+        rows = self.block_rms()
+        n = sum(row["n"] for row in rows)
+        return float(np.sqrt(sum(row["n"] * row["percent"] ** 2 for row in rows) / n)) if n else float("nan")
+
+    def block_rms(self) -> list:
+        """Per data block: ``name``, ``n`` (its points), ``rms`` of (computed - measured) in the block's own
+        unit, ``unit`` ("N" for a force, "mm" otherwise) and ``percent`` (the rms in % of the block's largest
+        ``|measured|``; NaN if not computed)."""
         y_exp, y_fit = np.asarray(self.y_exp, float), np.asarray(self.y_fit, float)
-        scale = np.max(np.abs(y_exp)) if y_exp.size else 0.0
-        rms = np.sqrt(np.mean((y_fit - y_exp) ** 2))
-        return float(100 * rms / scale) if scale > 0 else float("nan")
+        blocks = [(str(b[0]), int(b[1]), int(b[2])) for b in (self.blocks or [])] or [("data", 0, y_exp.size)]
+        quantities = list(self.quantities or [])
+        rows = []
+        for k, (name, start, stop) in enumerate(blocks):
+            measured = y_exp[start:stop]
+            residual = (y_fit[start:stop] - measured) if y_fit.size == y_exp.size else np.full(stop - start, np.nan)
+            rms = float(np.sqrt(np.mean(residual**2))) if residual.size else float("nan")  # NaN if a point is
+            scale = float(np.max(np.abs(measured))) if measured.size else 0.0
+            unit = "N" if (quantities[k] if k < len(quantities) else "force") == "force" else "mm"
+            rows.append({"name": name, "n": stop - start, "rms": rms, "unit": unit,
+                         "percent": 100.0 * rms / scale if scale > 0 else float("nan")})
+        return rows
+
+    def rms_text(self) -> str:
+        """The fit error in words: each block's RMS in its own unit and in % of its measured peak."""
+        rows = self.block_rms()
+        if len(rows) == 1:
+            return f"RMS error {rows[0]['percent']:.3g} % of the measured peak ({rows[0]['rms']:.3g} {rows[0]['unit']})"
+        return "RMS error " + ", ".join(f"{r['name']} {r['rms']:.3g} {r['unit']} ({r['percent']:.3g} % of its peak)"
+                                         for r in rows)
 
     @property
     def misfit_std(self) -> float:

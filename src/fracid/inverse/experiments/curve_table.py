@@ -13,8 +13,8 @@ from pathlib import Path
 
 from fracid.data.sampling import SAMPLINGS
 from fracid.inverse.core.observations import FORCE
-from fracid.inverse.experiments.vocabulary import (BLOCK_KEYS, CONTROL_UNITS, DECIMALS, DELIMITERS, FORCE_UNITS,
-                                                   LOCAL_UNITS, ROLES)
+from fracid.inverse.experiments.vocabulary import (BLOCK_KEYS, CONTROL_UNITS, FORCE_UNITS, FORMAT_KEYS,
+                                                   LOCAL_UNITS, ROLES, file_format)
 from fracid.settings.checks import show
 from fracid.settings.keys import REQUIRED, UNSET, Key, Said
 
@@ -52,9 +52,7 @@ CURVE_KEY_DOCS = {
     "weight": BLOCK_KEYS["weight"],
     "damage_threshold": Key(0.0, "-", "0 <= t < 1; a local quantity only", "The damage counted in the width."),
     "role": BLOCK_KEYS["role"],
-    "delimiter": Key(",", "", '"," | ";" | "\\t" (or "tab") | " " (any run of spaces and tabs)',
-                     "The cell separator of the file."),
-    "decimal": Key(".", "", _words(DECIMALS), 'The decimal mark ("," needs another delimiter).'),
+    **FORMAT_KEYS,
     "backtrack_tolerance": Key(Said("1 % of the control's range"), "control_unit", ">= 0",
                                "The largest backtrack of the control column dropped as noise."),
     "negate": Key([], "", 'a list of "control" and/or "force"', "The columns the machine records with a negative "
@@ -119,7 +117,7 @@ def read_curve_fields(ck, i: int, raw, context, kind) -> dict:
     n_points = ck.integer(f"{prefix}.n_points", required(ck, prefix, raw, "n_points", context),
                           "must be an integer >= 3", lambda v: v >= 3)
     sampling = ck.choice(f"{prefix}.sampling", raw.get("sampling", SAMPLINGS[0]), SAMPLINGS)
-    delimiter, decimal = _file_format(ck, prefix, raw)
+    delimiter, decimal = file_format(ck, prefix, raw)
     backtrack = _backtrack_tolerance(ck, prefix, raw, control_unit)
     options, columns = kind.read_columns(ck, prefix, raw)
     _check_columns(ck, prefix, raw, file, delimiter, decimal,
@@ -165,21 +163,6 @@ def _kind(ck, prefix: str, raw: dict, context) -> str:
         if name in {k for ks in context.column_keys.values() for k in ks} and name not in own:
             ck.fail(f"{prefix}.{name}", raw[name], f"not used by kind {kind!r}, which takes " + ", ".join(own))
     return kind
-
-
-def _file_format(ck, prefix: str, raw: dict) -> tuple[str, str]:
-    """(cell separator, decimal mark) of the data file: ``delimiter`` and ``decimal``."""
-    delimiter = raw.get("delimiter", ",")
-    if not isinstance(delimiter, str) or delimiter not in DELIMITERS:
-        ck.fail(f"{prefix}.delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run of '
-                                                 "spaces and tabs); the cell separator of the file")
-    delimiter = DELIMITERS[delimiter]
-    decimal = ck.choice(f"{prefix}.decimal", raw.get("decimal", "."), DECIMALS)
-    if decimal == delimiter:
-        ck.fail(f"{prefix}.decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
-                                              'default) a comma cannot also mark the decimals; files with decimal '
-                                              'commas are separated by ";" or tabs: set delimiter = ";" or "tab"')
-    return delimiter, decimal
 
 
 def _backtrack_tolerance(ck, prefix: str, raw: dict, control_unit: str) -> float | None:

@@ -27,7 +27,7 @@ import numpy as np
 
 from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.inverse.experiments.crack_region import away_from_crack
-from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, ROLES
+from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, FORMAT_KEYS, ROLES, file_format
 from fracid.settings.checks import show
 from fracid.settings.keys import REQUIRED, UNSET, Key, Said
 
@@ -67,6 +67,9 @@ FIELD_KEY_DOCS = {
     "rigid_std": Key(1.0, "mm", "> 0", "The std of the rigid motion's vague prior."),
     "exclude_near": Key(UNSET, "mm", ">= 0", "Points nearer the specimen's crack path are dropped."),
     "point_spacing": Key(UNSET, "mm", "> 0", "A dense field is thinned to one point per square of this side."),
+    "file_column": Key("file", "", "a column name", "The frame table's column of each frame's point-cloud file "
+                       "(relative to the frame table's folder)."),
+    **FORMAT_KEYS,
     "name": Key("field", "", "a non-empty string", "The block's name (the derived blocks name it as their field)."),
     **BLOCK_KEYS,
 }
@@ -95,6 +98,9 @@ class FieldExperimentConfig:
     rigid_std: float | None = 1.0  # None: no rigid motion removed
     exclude_near: float | None = None
     point_spacing: float | None = None
+    file_column: str = "file"
+    delimiter: str = ","
+    decimal: str = "."
     name: str = "field"
     weight: float = 1.0
     role: str = "calibration"
@@ -119,7 +125,8 @@ def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
 
     dic = read_dic_frames(exp.file, **dict(exp.columns), min_quality=exp.min_quality,
                           coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
-                          placement=exp.placement)
+                          placement=exp.placement, file_column=exp.file_column, delimiter=exp.delimiter,
+                          decimal=exp.decimal)
     inside, dropped = points_on_mesh(specimen, dic.points, exp.placement)
     away = away_from_crack(specimen, exp.exclude_near)
     region = inside if away is None else (lambda points: inside & away(points))
@@ -228,7 +235,7 @@ def _blamed_key(exp: FieldExperimentConfig, message: str) -> str:
     """The key a DataError of the reader or of field_block is about (a column, the frames, the std ...)."""
     if message.startswith(("frames", "control column")):
         return "frames"
-    for name, column in (("control_column", exp.control_column), *exp.columns):
+    for name, column in (("control_column", exp.control_column), ("file_column", exp.file_column), *exp.columns):
         if column is not None and f"column {show(column)}" in message:
             return name
     for name in ("std", "subset_size", "rigid_std"):
@@ -261,6 +268,7 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
     columns = _columns(ck, prefix, raw)
     min_quality = _optional_number(ck, f"{prefix}.min_quality", raw, "min_quality", "must be a number", lambda v: True)
     unit = ck.choice(f"{prefix}.coordinate_unit", raw.get("coordinate_unit", "mm"), ("mm", "px"))
+    delimiter, decimal = file_format(ck, prefix, raw)
     positive = "must be a number > 0 [mm]"
     exp = FieldExperimentConfig(
         index=i, file=file, control_column=control_column, columns=columns, n_points=0,
@@ -272,6 +280,8 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
         exclude_near=_optional_number(ck, f"{prefix}.exclude_near", raw, "exclude_near", "must be a number >= 0 [mm]",
                                       lambda v: v >= 0),
         point_spacing=_optional_number(ck, f"{prefix}.point_spacing", raw, "point_spacing", positive, lambda v: v > 0),
+        file_column=ck.string(f"{prefix}.file_column", raw.get("file_column", "file"), "must be a column name (string)"),
+        delimiter=delimiter, decimal=decimal,
         name=ck.string(f"{prefix}.name", raw.get("name", "field"), "must be a non-empty string"),
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
         role=ck.choice(f"{prefix}.role", raw.get("role", "calibration"), ROLES))

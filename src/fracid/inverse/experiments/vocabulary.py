@@ -30,4 +30,30 @@ BLOCK_KEYS = {
                 'calibrated on; "source": read and checked only (the field a derived block comes from).'),
 }
 
-__all__ = ["BLOCK_KEYS", "CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE_UNITS", "LOCAL_UNITS", "ROLES"]
+#: the keys of a block read from delimited text files: its cells' separator and decimal mark
+FORMAT_KEYS = {
+    "delimiter": Key(",", "", '"," | ";" | "\\t" (or "tab") | " " (any run of spaces and tabs)',
+                     "The cell separator of the files."),
+    "decimal": Key(".", "", " | ".join(f'"{mark}"' for mark in DECIMALS),
+                   'The decimal mark ("," needs another delimiter).'),
+}
+
+
+def file_format(ck, prefix: str, raw: dict) -> tuple[str, str]:
+    """(cell separator, decimal mark) of the data files: ``delimiter`` and ``decimal``
+    (``ck``: the configuration checker)."""
+    delimiter = raw.get("delimiter", ",")
+    if not isinstance(delimiter, str) or delimiter not in DELIMITERS:
+        ck.fail(f"{prefix}.delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run of '
+                                                 "spaces and tabs); the cell separator of the file")
+    delimiter = DELIMITERS[delimiter]
+    decimal = ck.choice(f"{prefix}.decimal", raw.get("decimal", "."), DECIMALS)
+    if decimal == delimiter:
+        ck.fail(f"{prefix}.decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
+                                              'default) a comma cannot also mark the decimals; files with decimal '
+                                              'commas are separated by ";" or tabs: set delimiter = ";" or "tab"')
+    return delimiter, decimal
+
+
+__all__ = ["BLOCK_KEYS", "CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE_UNITS", "FORMAT_KEYS", "LOCAL_UNITS", "ROLES",
+           "file_format"]
