@@ -1,11 +1,21 @@
 """``python -m fracid`` and the ``fracid`` command: the stop signals are handled before anything heavy is
-imported, so that a Ctrl-C while the command starts ends it with a message, not a traceback."""
+imported, so that a Ctrl-C while the command starts ends it with a message, not a traceback.
+
+OpenBLAS runs on one thread in the command's own process unless the user set ``OPENBLAS_NUM_THREADS``:
+fracid's dense work is many mid-sized factorisations (the correlated-noise SVDs), where OpenBLAS's threads
+spin-wait for each other and for the other processes on the cores. Measured on 2 cores (issue 41):
+``fracid check examples/dic/identify.toml`` 17 to 44 s with the default threads against 5 to 8 s with one, beside
+two busy processes; a 4000 x 1000 SVD 1.9 s against 1.0 s on a quiet machine. The variable must be set before
+numpy is first imported (OpenBLAS reads it once). MKL (PARDISO's threads) is left as it is; the workers of
+process pools limit every library themselves (:mod:`fracid.runtime.executors`)."""
 
 import os
 import sys
 
-from fracid.runtime.exits import describe, stop_signals
-from fracid.runtime.stops import stopped_by
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from fracid.runtime.exits import describe, stop_signals  # noqa: E402 -- after the thread setting, see above
+from fracid.runtime.stops import stopped_by  # noqa: E402
 
 
 def run() -> None:
