@@ -105,9 +105,9 @@ def test_the_fit_error_is_given_per_block_in_its_own_unit():
     assert rows["global"]["unit"] == "N" and rows["field"]["unit"] == "mm"
     np.testing.assert_allclose([rows["global"]["rms"], rows["field"]["rms"]], [10.0, 1e-4])
     np.testing.assert_allclose([rows["global"]["percent"], rows["field"]["percent"]], [1.0, 1.0])
-    # 1 % of each block's own peak: 1 %, where one RMS over both blocks over the largest value (1000 N) mixed
-    # newtons and millimetres into 0.71 %
-    assert result.rms_percent == pytest.approx(1.0)
+    # one RMS over both blocks over the largest value (1000 N) mixes newtons and millimetres: 0.71 %, which the
+    # headline no longer shows when there are several blocks
+    assert result.rms_percent == pytest.approx(100 * np.sqrt(50.0) / 1000.0)
     text = result.rms_text()
     assert "global 10 N (1 % of its peak)" in text and "field 0.0001 mm (1 % of its peak)" in text
 

@@ -173,12 +173,13 @@ class MethodResult(GaussianEstimate, StageRecords):
 
     @property
     def rms_percent(self) -> float:
-        """RMS fit error in per cent of each block's largest ``|measured|`` value, pooled over the blocks'
-        points (NaN if not computed): each block is measured in its own unit (N for forces, mm for
-        displacements and widths), so no block's unit is divided by another's."""
-        rows = self.block_rms()
-        n = sum(row["n"] for row in rows)
-        return float(np.sqrt(sum(row["n"] * row["percent"] ** 2 for row in rows) / n)) if n else float("nan")
+        """RMS of (measured - computed) over all the data in per cent of the largest ``|measured|`` value (NaN if
+        not computed): the poor-fit bound reads it. With blocks of different units it is dominated by the largest
+        (a force in N beside widths in mm); :meth:`block_rms` gives each block in its own unit."""
+        y_exp, y_fit = np.asarray(self.y_exp, float), np.asarray(self.y_fit, float)
+        scale = np.max(np.abs(y_exp)) if y_exp.size else 0.0
+        rms = np.sqrt(np.mean((y_fit - y_exp) ** 2))
+        return float(100 * rms / scale) if scale > 0 else float("nan")
 
     def block_rms(self) -> list:
         """Per data block: ``name``, ``n`` (its points), ``rms`` of (computed - measured) in the block's own
