@@ -106,7 +106,8 @@ def extensometer_opening(points, u, a, b) -> tuple[np.ndarray, str]:
     Raises
     ------
     DataError
-        If the ends coincide, or the nearest DIC point is farther from an end than 3 point spacings.
+        If the ends coincide or are nearest the same point, or the nearest DIC point is farther from an end than
+        3 point spacings.
     """
     points, u = np.asarray(points, dtype=float), np.asarray(u, dtype=float)
     ends = np.array([a, b], dtype=float)
@@ -120,6 +121,10 @@ def extensometer_opening(points, u, a, b) -> tuple[np.ndarray, str]:
         if d > 3.0 * spacing:
             raise DataError(f"extensometer end {end.tolist()} mm: the nearest DIC point is {d:.3g} mm away (the points "
                             f"are {spacing:.3g} mm apart): place the extensometer on the measured region")
+    if nearest[0] == nearest[1]:
+        raise DataError(f"extensometer {ends.tolist()} mm: both ends are nearest the same DIC point "
+                        f"{points[nearest[0]].round(4).tolist()} mm: place them on measured points on either side of "
+                        "the notch")
     direction = (ends[1] - ends[0]) / length
     opening = (u[:, nearest[1]] - u[:, nearest[0]]) @ direction
     note = (f"extensometer over {length:.4g} mm: points {points[nearest[0]].round(4).tolist()} and "
@@ -207,5 +212,36 @@ def offset_by_opening(log_time, log_opening, frames, relative, opening, interval
     return FrameTimes(frames, relative + best, uncertainty, "opening", best, tuple(notes))
 
 
-__all__ = ["FrameTimes", "MAX_GRID", "MISFIT_RISE", "extensometer_opening", "offset_by_opening", "times_from_rate",
-           "times_given"]
+@dataclass(frozen=True)
+class SynchronisedFrames:
+    """Frames on a log's clock with the log's values at their times (what the check figure draws).
+
+    Parameters
+    ----------
+    log : MachineLog
+        The log.
+    times : FrameTimes
+        The frames' times.
+    control : str
+        The log's column of the control [mm].
+    force : str or None
+        The log's column of the force [N], if read.
+    values : dict of str -> numpy.ndarray
+        Each log column at the frames' times [mm or N].
+    """
+
+    log: object
+    times: FrameTimes
+    control: str
+    force: str | None
+    values: dict
+
+
+def synchronised(log, times: FrameTimes, control: str, force: str | None = None) -> SynchronisedFrames:
+    """The log's columns at the frames' ``times`` (:meth:`~fracid.data.machine_log.MachineLog.at`: a frame outside the
+    log is refused, naming it)."""
+    return SynchronisedFrames(log, times, control, force, log.at(times.times, times.frames))
+
+
+__all__ = ["FrameTimes", "MAX_GRID", "MISFIT_RISE", "SynchronisedFrames", "extensometer_opening", "offset_by_opening",
+           "synchronised", "times_from_rate", "times_given"]
