@@ -141,13 +141,14 @@ def _check_declared(path: str, header: list[str], units_rows, name: str, index: 
         raise DataError(f"{path}: column {show(name)} is declared in {declared} ({where}) but read in {unit}; {why}")
 
 
-def _check_increasing(path: str, name: str, time: np.ndarray, rows: np.ndarray) -> None:
-    """Refuse a time column that does not increase strictly, naming the first row where it does not."""
+def _check_increasing(path: str, name: str, time: np.ndarray, rows: np.ndarray, unit: str) -> None:
+    """Refuse a time column (in the file's ``unit``) that does not increase strictly, naming the first row where it
+    does not."""
     bad = np.flatnonzero(np.diff(time) <= 0.0)
     if bad.size:
         k = int(bad[0])
-        raise DataError(f"{path}: column {show(name)} must increase strictly, but row {rows[k + 1]} ({time[k + 1]:g}) "
-                        f"does not follow row {rows[k]} ({time[k]:g}){'' if bad.size == 1 else f' ({bad.size} rows)'}; "
+        raise DataError(f"{path}: column {show(name)} must increase strictly, but row {rows[k + 1]} ({time[k + 1]:g} "
+                        f"{unit}) does not follow row {rows[k]} ({time[k]:g} {unit}){'' if bad.size == 1 else f' ({bad.size} rows)'}; "
                         "a log with two tests or a restarted clock is split into one file per test")
 
 
@@ -201,8 +202,8 @@ def read_machine_log(path, time_column: str, columns: Mapping[str, str], time_un
     if len(lines) < 2:
         raise DataError(f"{path}: {len(lines)} data row(s) below the header (line {table.header_line}); a log needs at "
                         "least 2")
+    _check_increasing(path, time_column, values[:, 0], lines, time_unit)
     values = values * np.array([_SCALES[unit] for unit in units.values()])
-    _check_increasing(path, time_column, values[:, 0], lines)
     skipped = [line for line, _ in units_rows]
     notes = (*table.notes(), *([f"{path}: line(s) {skipped} below the header skipped (units)"] if skipped else []),
              f"{path}: {len(lines)} samples, {time_column} in {time_unit}, " +
