@@ -246,3 +246,49 @@ def test_the_field_block_takes_each_frames_control_from_the_log(tmp_path):
     assert field.log.file == tmp_path / "log.csv" and field.control_column == "CMOD (log)"
     block = field_block(field, build_specimen(config, field))
     np.testing.assert_allclose(block.frames, CMOD, rtol=1e-6)
+
+
+BY_STAMPS = LOG_KEYS + 'frame_time_column = "t_ms"\nframe_time_unit = "ms"'
+STAMPS = 1e3 * (5.0 + 1e3 * CMOD)
+
+
+@pytest.mark.parametrize("block, stamps, key, words", [
+    ('control_column = "cmod_mm"\nlog_time_unit = "ms"', None, "log_time_unit", ["needs machine_log"]),
+    ('control_column = "cmod_mm"\n' + BY_STAMPS, STAMPS, "control_column", ["remove control_column"]),
+    (LOG_KEYS + "frame_rate = 0.1", None, "trigger_offset", ["frame number 0"]),
+    (BY_STAMPS + "\nframe_rate = 0.1", STAMPS, "frame_rate", ["one of them: both are given"]),
+    (LOG_KEYS + "frame_rate = 0.1\ntrigger_offset = 1.0\nsynchronise = \"opening\"", None, "trigger_offset",
+     ["finds the offset"]),
+    (LOG_KEYS + 'frame_rate = 0.1\nsynchronise = "opening"', None, "extensometer", ["two ends"]),
+    (BY_STAMPS.replace('log_decimal = ","', 'log_decimal = ";"'), STAMPS, "log_decimal", ["must be one of '.', ','"]),
+    (BY_STAMPS.replace('log_force_unit = "kN"', 'log_force_unit = "N"'), STAMPS, "machine_log",
+     ["column 'Kraft' is declared in kN (line 4)", "1000 times off"]),
+    (BY_STAMPS, STAMPS + 5000.0, "frame_time_column", ["frame 6 at t = 210 s outside the log's time range 5 to 205 s",
+                                                        "column 'Zeit', rows 5 to 45"]),
+])
+def test_the_log_keys_are_refused_naming_the_key(tmp_path, block, stamps, key, words):
+    from fracid.config import ConfigError
+
+    with pytest.raises(ConfigError) as err:
+        _field(_example_with_log(tmp_path, block, stamps))
+    message = str(err.value)
+    assert f"experiments[1].{key}" in message, message
+    for word in words:
+        assert word in message, message
+
+
+def test_the_check_figure_marks_the_frames_on_the_load_curve(tmp_path, log):
+    from fracid.report.sync_figure import synchronisation_figure, write_synchronisation_figure
+
+    sync = synchronised(log, times_from_rate((1, 2, 3), 0.1, 5.0), "CMOD", "F")
+    fig = synchronisation_figure(sync)
+    left, right = fig.axes[:2]
+    assert left.get_xlabel() == "CMOD [mm]" and left.get_ylabel() == "F [N]"
+    np.testing.assert_allclose(left.lines[1].get_xdata(), sync.values["CMOD"])  # the frames, on the curve
+    assert [t.get_text() for t in left.texts] == ["1", "2", "3"] and "frame rate" in right.get_title()
+    path = write_synchronisation_figure(sync, tmp_path / "sync.png")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(FileExistsError):
+        write_synchronisation_figure(sync, path)
+    without_force = synchronisation_figure(synchronised(log, times_from_rate((1, 2), 0.1, 5.0), "CMOD"))
+    assert without_force.axes[0].get_xlabel() == "time [s]"
