@@ -157,7 +157,7 @@ def test_the_offset_is_found_from_the_opening_within_one_frame_interval(log, off
     interval = 1.0 / rate
     assert abs(found.offset - offset) < interval
     assert abs(found.offset - offset) <= found.uncertainty and found.uncertainty >= 0.5 * interval
-    assert found.method == "opening" and not any(n.startswith("WARNING") for n in found.notes)
+    assert found.method == "extensometer" and not any(n.startswith("WARNING") for n in found.notes)
     np.testing.assert_allclose(found.times, relative + found.offset)
 
 

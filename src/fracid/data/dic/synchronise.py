@@ -41,7 +41,7 @@ class FrameTimes:
     uncertainty : float
         How far the times may be off [s] (0 for given time stamps and a given offset).
     method : str
-        "time stamps", "frame rate" or "opening".
+        "time stamps", "frame rate" or "extensometer".
     offset : float or None
         The offset [s] added to the frames' own times (the log time of frame number 0 for a frame rate).
     notes : tuple of str
@@ -209,7 +209,7 @@ def offset_by_opening(log_time, log_opening, frames, relative, opening, interval
         notes.append(f"WARNING: offsets from {within.min():.6g} to {within.max():.6g} s match the opening about as well "
                      "(the opening changes too little over the frames, or it repeats): the synchronisation is uncertain;"
                      " give the frames' times or a trigger offset instead")
-    return FrameTimes(frames, relative + best, uncertainty, "opening", best, tuple(notes))
+    return FrameTimes(frames, relative + best, uncertainty, "extensometer", best, tuple(notes))
 
 
 @dataclass(frozen=True)
