@@ -292,3 +292,32 @@ def test_the_check_figure_marks_the_frames_on_the_load_curve(tmp_path, log):
         write_synchronisation_figure(sync, path)
     without_force = synchronisation_figure(synchronised(log, times_from_rate((1, 2), 0.1, 5.0), "CMOD"))
     assert without_force.axes[0].get_xlabel() == "time [s]"
+
+
+def test_the_field_block_finds_the_offset_from_an_extensometer(tmp_path):
+    from fracid.config.builders import build_specimen
+    from fracid.inverse.experiments.field import field_block
+
+    _example_with_log(tmp_path, 'control_column = "cmod_mm"')
+    # a camera at 0.05 frames per s whose frame 0 is at 10 s on the log's clock: frame i sees the log's CMOD at
+    # t = 10 + 20 i, i.e. (t - 5) / 1000 mm; points on either side of the notch (2 mm wide) open by it
+    cmod = (10.0 + 20.0 * np.arange(1, 7) - 5.0) / 1e3
+    x, y = np.meshgrid([-9.0, -6.0, -3.0, 3.0, 6.0, 9.0], [2.0, 5.0, 8.0])
+    rows = ["frame,file", *(f"{i},cloud{i}.csv" for i in range(1, 7))]
+    (tmp_path / "cam.csv").write_text("\n".join(rows) + "\n")
+    for i, c in enumerate(cmod, start=1):
+        u = 0.5 * c * np.sign(x.ravel())
+        lines = ["X,Y,U,V", *(f"{a},{b},{du:.9f},0" for a, b, du in zip(x.ravel(), y.ravel(), u))]
+        (tmp_path / f"cloud{i}.csv").write_text("\n".join(lines) + "\n")
+    text = (tmp_path / "identify.toml").read_text()
+    start, end = text.index('[[experiments]]                     # the DIC field'), text.index("[identify]")
+    block = ('[[experiments]]\nkind = "field"\nframes_file = "cam.csv"\nstd = 0.001\n' + LOG_KEYS +
+             'frame_rate = 0.05\nsynchronise = "opening"\nextensometer = [[-3.0, 2.0], [3.0, 2.0]]\n\n')
+    (tmp_path / "identify.toml").write_text(text[:start] + block + text[end:])
+    config, field = _field(tmp_path / "identify.toml")
+    assert field.log.synchronise == "opening" and field.log.extensometer == ((-3.0, 2.0), (3.0, 2.0))
+    built = field_block(field, build_specimen(config, field))
+    np.testing.assert_allclose(built.frames, cmod, atol=2e-5)  # the offset within 0.02 s here
+    note = next(n for n in built.data.notes if "frames matched to the log's CMOD" in n)
+    offset, uncertainty = map(float, re.search(r"offset (\S+) s \+- (\S+) s", note).groups())
+    assert abs(offset - 10.0) < 20.0 and abs(offset - 10.0) <= uncertainty and uncertainty == pytest.approx(10.0)
