@@ -35,6 +35,7 @@ import hostile_dic
 import hostile_estimate
 import hostile_files
 import hostile_fit
+import hostile_machine_log
 import hostile_mesh
 import hostile_paths
 import hostile_plausibility
@@ -153,7 +154,8 @@ CASES = {
 
 #: the other cases, one module per class of defect (files and signals, data files, meshes, plausibility and API)
 for _module in (hostile_files, hostile_data, hostile_mesh, hostile_checks, hostile_plausibility, hostile_fit,
-                hostile_dic, hostile_paths, hostile_compare, hostile_estimate, hostile_status, hostile_screening):
+                hostile_dic, hostile_paths, hostile_compare, hostile_estimate, hostile_status, hostile_screening,
+                hostile_machine_log):
     assert not set(_module.CASES) & set(CASES), set(_module.CASES) & set(CASES)
     CASES.update(_module.CASES)
 

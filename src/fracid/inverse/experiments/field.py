@@ -27,6 +27,8 @@ import numpy as np
 
 from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.inverse.experiments.crack_region import away_from_crack
+from fracid.inverse.experiments.field_log import (LOG_KEY_DOCS, frame_table_columns, read_log_settings,
+                                                  synchronise_frames)
 from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, FORMAT_KEYS, ROLES, file_format
 from fracid.settings.checks import show
 from fracid.settings.keys import REQUIRED, UNSET, Key, Said
@@ -38,7 +40,8 @@ FIELD_KEY_DOCS = {
     "kind": Key(REQUIRED, "", "a registered kind", "The kind of the block."),
     "frames_file": Key(REQUIRED, "", "a CSV file path", "The frame table (frame, file and load columns); relative "
                                                         "to the configuration file unless absolute."),
-    "control_column": Key(REQUIRED, "", "a column name", "The frame table's column of each frame's control value."),
+    "control_column": Key(Said("required without machine_log"), "", "a column name",
+                          "The frame table's column of each frame's control value."),
     "x": Key("X", "", "a column name", f"{_CLOUD}: the x coordinate."),
     "y": Key("Y", "", "a column name", f"{_CLOUD}: the y coordinate."),
     "u": Key("U", "", "a column name", f"{_CLOUD}: the x displacement."),
@@ -70,6 +73,7 @@ FIELD_KEY_DOCS = {
     "file_column": Key("file", "", "a column name", "The frame table's column of each frame's point-cloud file "
                        "(relative to the frame table's folder)."),
     **FORMAT_KEYS,
+    **LOG_KEY_DOCS,
     "name": Key("field", "", "a non-empty string", "The block's name (the derived blocks name it as their field)."),
     **BLOCK_KEYS,
 }
@@ -99,6 +103,7 @@ class FieldExperimentConfig:
     exclude_near: float | None = None
     point_spacing: float | None = None
     file_column: str = "file"
+    log: object = None  # LogSettings (fracid.inverse.experiments.field_log) or None
     delimiter: str = ","
     decimal: str = "."
     name: str = "field"
@@ -124,9 +129,14 @@ def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
     from fracid.inverse.experiments.field_on_mesh import points_on_mesh
 
     dic = read_dic_frames(exp.file, **dict(exp.columns), min_quality=exp.min_quality,
-                          coordinate_unit=exp.coordinate_unit, load_columns=[exp.control_column],
+                          coordinate_unit=exp.coordinate_unit,
+                          load_columns=frame_table_columns(exp.log, exp.control_column),
                           placement=exp.placement, file_column=exp.file_column, delimiter=exp.delimiter,
                           decimal=exp.decimal)
+    sync_warnings = []
+    if exp.log is not None:
+        dic, synced = synchronise_frames(dic, exp.log, exp.frames)
+        sync_warnings = [note.removeprefix("WARNING: ") for note in synced.times.notes if note.startswith("WARNING: ")]
     inside, dropped = points_on_mesh(specimen, dic.points, exp.placement)
     away = away_from_crack(specimen, exp.exclude_near)
     region = inside if away is None else (lambda points: inside & away(points))
@@ -134,7 +144,7 @@ def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
                      subset_size=exp.subset_size, rigid_std=exp.rigid_std, region=region,
                      point_spacing=exp.point_spacing, name=exp.name)
     notes = [note.removeprefix("WARNING: ") for note in block.data.notes if note.startswith("WARNING: field ")]
-    return block, [*([dropped] if dropped else []), *notes]
+    return block, [*([dropped] if dropped else []), *sync_warnings, *notes]
 
 
 def _optional_number(ck, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
@@ -262,9 +272,13 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
         ck.missing(f"{prefix}.frames_file", "the frame table (CSV with frame, file and load columns), relative to "
                    "the config file")
     file = ck.file(f"{prefix}.frames_file", raw["frames_file"], context.base)
-    if "control_column" not in raw:
-        ck.missing(f"{prefix}.control_column", "the frame table's column of the control value [mm], e.g. 'cmod_mm'")
-    control_column = ck.string(f"{prefix}.control_column", raw["control_column"], "must be a column name (string)")
+    log = read_log_settings(ck, prefix, raw, context.base)
+    if log is None and "control_column" not in raw:
+        ck.missing(f"{prefix}.control_column", "the frame table's column of the control value [mm], e.g. 'cmod_mm' "
+                   "(or machine_log, the testing machine's log)")
+    control_column = log.control_name if log is not None else ck.string(f"{prefix}.control_column",
+                                                                        raw["control_column"],
+                                                                        "must be a column name (string)")
     columns = _columns(ck, prefix, raw)
     min_quality = _optional_number(ck, f"{prefix}.min_quality", raw, "min_quality", "must be a number", lambda v: True)
     unit = ck.choice(f"{prefix}.coordinate_unit", raw.get("coordinate_unit", "mm"), ("mm", "px"))
@@ -281,6 +295,7 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
                                       lambda v: v >= 0),
         point_spacing=_optional_number(ck, f"{prefix}.point_spacing", raw, "point_spacing", positive, lambda v: v > 0),
         file_column=ck.string(f"{prefix}.file_column", raw.get("file_column", "file"), "must be a column name (string)"),
+        log=log,
         delimiter=delimiter, decimal=decimal,
         name=ck.string(f"{prefix}.name", raw.get("name", "field"), "must be a non-empty string"),
         weight=ck.number(f"{prefix}.weight", raw.get("weight", 1.0), "must be a number > 0", lambda v: v > 0),
@@ -288,7 +303,7 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
     try:
         block, warnings = placed_field_block(exp, context.specimen())
     except DataError as err:
-        key = _blamed_key(exp, str(err))
+        key = getattr(err, "key", None) or _blamed_key(exp, str(err))
         ck.fail(f"{prefix}.{key}", raw.get(key, COLUMN_KEYS.get(key)), str(err))
     except ValueError as err:
         ck.fail(f"{prefix}.exclude_near", raw.get("exclude_near"), str(err))

@@ -39,17 +39,18 @@ FORMAT_KEYS = {
 }
 
 
-def file_format(ck, prefix: str, raw: dict) -> tuple[str, str]:
+def file_format(ck, prefix: str, raw: dict, stem: str = "", default: tuple = (",", ".")) -> tuple[str, str]:
     """(cell separator, decimal mark) of the data files: ``delimiter`` and ``decimal``
-    (``ck``: the configuration checker)."""
-    delimiter = raw.get("delimiter", ",")
+    (``ck``: the configuration checker), or the keys of another file named with ``stem`` (``log_delimiter``),
+    ``default`` when not given."""
+    delimiter = raw.get(f"{stem}delimiter", default[0])
     if not isinstance(delimiter, str) or delimiter not in DELIMITERS:
-        ck.fail(f"{prefix}.delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run of '
-                                                 "spaces and tabs); the cell separator of the file")
+        ck.fail(f"{prefix}.{stem}delimiter", delimiter, 'must be one of ",", ";", "\\t" (or "tab"), " " (any run '
+                                                        "of spaces and tabs); the cell separator of the file")
     delimiter = DELIMITERS[delimiter]
-    decimal = ck.choice(f"{prefix}.decimal", raw.get("decimal", "."), DECIMALS)
+    decimal = ck.choice(f"{prefix}.{stem}decimal", raw.get(f"{stem}decimal", default[1]), DECIMALS)
     if decimal == delimiter:
-        ck.fail(f"{prefix}.decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
+        ck.fail(f"{prefix}.{stem}decimal", decimal, 'a decimal comma needs another delimiter: with delimiter = "," (the '
                                               'default) a comma cannot also mark the decimals; files with decimal '
                                               'commas are separated by ";" or tabs: set delimiter = ";" or "tab"')
     return delimiter, decimal
