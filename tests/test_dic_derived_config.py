@@ -12,7 +12,7 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dic"
 RIGID = np.outer(np.linspace(0.2, 1.0, 6), [0.004, -0.012, 5e-5])
 HEIGHTS = [30, 35, 40, 45]
 OPENING = {"kind": '"opening"', "field": '"field"', "heights": str(HEIGHTS), "gauge": "6.0", "radius": "5.0"}
-WIDTH = {"kind": '"fpz-width"', "field": '"field"', "heights": "[30, 40]", "offsets": "[5, 8, 11, 14]",
+WIDTH = {"kind": '"fpz-width"', "field": '"field"', "heights": "[30, 40]", "offsets": "[4, 7, 10, 13, 16]",
          "radius": "5.0", "threshold": "3e-5"}
 #: the field as the derived blocks' source only; its rigid-motion prior off: the twin's motion is known (RIGID)
 SOURCE = {"role": '"source"', "rigid_motion": "false"}

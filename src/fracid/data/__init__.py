@@ -20,6 +20,7 @@ from fracid.data.checks import require_positive_force
 from fracid.data.curves import Curve, curve_from_arrays, read_curve_csv
 from fracid.data.covariance_matrix import Block, Covariance, Dense, Diagonal, as_covariance, block_diagonal
 from fracid.data.covariance_low_rank import LowRankPlusDiagonal
+from fracid.data.covariance_sparse import SparseCovariance
 from fracid.data.dataset import ExperimentalData, stack
 from fracid.data.errors import DataError, DataTypeError
 from fracid.data.dic import CameraPlacement, DicData, fit_placement, read_dic_frames, read_dic_vtk
@@ -45,6 +46,7 @@ __all__ = [
     "Diagonal",
     "ExperimentalData",
     "LowRankPlusDiagonal",
+    "SparseCovariance",
     "SAMPLINGS",
     "as_covariance",
     "block_diagonal",

@@ -3,12 +3,14 @@
 Every inverse method and the posterior use C_exp only through ``solve`` (C^-1 b), ``logdet``
 (log det C), ``whiten`` (L^-1 r with C = L L^T, so that ``|whiten(r)|^2 = r^T C^-1 r``), ``color``
 (L z: a draw of N(0, C) from a standard normal z), ``diag`` (the variances) and ``take`` (the
-covariance of a subset of the entries). Four kinds implement them:
+covariance of a subset of the entries). Five kinds implement them:
 
 * :class:`Diagonal` ``diag(var)``: independent errors (what standard deviations give), O(n);
 * :class:`Dense` ``C``: any symmetric positive definite matrix (small n), Cholesky factor;
 * :class:`~fracid.data.covariance_low_rank.LowRankPlusDiagonal` ``diag(d) + U U^T``: independent errors
   plus k shared modes (Woodbury identity and the matrix determinant lemma), O(n k^2), in its own module;
+* :class:`~fracid.data.covariance_sparse.SparseCovariance` ``diag(s) K diag(s)``, K sparse: errors correlated
+  with near neighbours only (a DIC field), a sparse symmetric factorisation, in its own module;
 * :class:`Block` the block diagonal of any of these (stacked datasets).
 
 :func:`as_covariance` turns what the user gives (a covariance object, a 1-D array of variances, a

@@ -141,8 +141,10 @@ def plus_diagonal(C, add) -> Covariance:
                                for block, start, stop in zip(C.blocks, C.offsets[:-1], C.offsets[1:])])
     if isinstance(C, LowRankUpdate):
         return LowRankUpdate(plus_diagonal(C.base, add), C.U)
+    if hasattr(C, "plus_diagonal"):  # a kind that keeps its own form (SparseCovariance)
+        return C.plus_diagonal(add)
     raise TypeError(f"plus_diagonal: a {type(C).__name__} covariance has no diagonal to add to; give a Diagonal, "
-                    "Dense, LowRankPlusDiagonal, Block or LowRankUpdate")
+                    "Dense, LowRankPlusDiagonal, SparseCovariance, Block or LowRankUpdate")
 
 
 __all__ = ["LowRankUpdate", "low_rank_update", "plus_diagonal"]

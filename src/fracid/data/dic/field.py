@@ -12,12 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from fracid.data.arguments import real_number
 from fracid.data.covariance import check_positive_std
 from fracid.data.covariance_matrix import Covariance, Diagonal, block_diagonal
-from fracid.data.covariance_low_rank import LowRankPlusDiagonal
 from fracid.data.dataset import ExperimentalData
 from fracid.data.dic.data import DicData
 from fracid.data.errors import DataError, DataTypeError
@@ -104,39 +102,46 @@ def entry_std(dic: DicData, frame_indices: np.ndarray, components: tuple, std) -
 def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple, subset_size,
                      rigid_std=None) -> tuple[Covariance, str]:
     """The covariance [mm^2] of all entries (frame, component, point order): diag(sigma^2), or with
-    ``subset_size`` [mm] the spatially correlated model of :mod:`fracid.data.dic_noise` (a correlation kernel per
-    frame and component, scaled by sigma: C = D K D, D = diag(sigma)); with ``rigid_std`` [mm] the rigid motion
-    of every frame marginalised (:mod:`fracid.data.dic.rigid`: one low-rank-plus-diagonal block per frame, both
-    components and the prior's columns in it). ``sigma`` NaN (missing values) are set to 1: those entries are
-    dropped."""
+    ``subset_size`` [mm] the spatially correlated model of :mod:`fracid.data.dic_noise` (a sparse correlation
+    K per frame and component, scaled by sigma: C = D K D, D = diag(sigma); K factorised once for all of them);
+    with ``rigid_std`` [mm] the rigid motion of every frame marginalised (:mod:`fracid.data.dic.rigid`: its
+    prior's columns added to each frame's block, both components). ``sigma`` NaN (missing values) are set to 1:
+    those entries are dropped."""
     sigma = np.where(np.isnan(sigma), 1.0, sigma)
     n_c, n = len(components), len(components) * len(points)
     if subset_size is None:
-        U, d, note = np.zeros((len(points), 0)), np.ones(len(points)), "independent errors (diagonal covariance)"
+        note, correlation = "independent errors (diagonal covariance)", None
     else:
-        from fracid.data.dic_noise import dic_covariance
-
-        size = real_number(subset_size, "subset_size")
-        if not (np.isfinite(size) and size > 0):
-            raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
-        correlation = dic_covariance(points, 1.0, size)
-        U, d = correlation.U, correlation.D.var
-        note = (f"errors correlated over the subset size {size:g} mm (Gaussian kernel, l = {size / 2:g} mm, "
-                f"{U.shape[1]} modes per frame and component; independent between them)")
+        correlation, note = _correlation(points, subset_size)
+    per_frame = sigma.reshape(n_frames, n_c, len(points))
     if rigid_std is None:
-        if subset_size is None:
+        if correlation is None:
             return Diagonal(sigma**2), note
-        return block_diagonal([correlation] * (n_frames * n_c)).scaled(sigma), note
-    from fracid.data.dic.rigid import prior_columns
+        return block_diagonal([correlation.scaled(s) for s in per_frame.reshape(-1, len(points))]), note
+    from fracid.data.dic.rigid import with_rigid_motion
 
     std = real_number(rigid_std, "rigid_std")
     check_positive_std(std, "rigid_std")
-    rigid = prior_columns(points, components, std)
-    noise_U, noise_d = scipy.linalg.block_diag(*[U] * n_c), np.tile(d, n_c)  # one frame, unit sigma
-    frames = [LowRankPlusDiagonal(np.hstack([noise_U * s[:, None], rigid]), noise_d * s**2, nuisance=rigid.shape[1])
-              for s in sigma.reshape(n_frames, n)]
+    bases = ([Diagonal(s.reshape(-1) ** 2) for s in per_frame] if correlation is None else
+             [block_diagonal([correlation.scaled(c) for c in s]) for s in per_frame])
+    frames = [with_rigid_motion(base, points, components, std) for base in bases]
     return block_diagonal(frames), (f"{note}; the rigid motion of every frame (t_x, t_y, theta) marginalised: "
                                     f"prior std {std:g} mm, removed from data and model alike")
+
+
+def _correlation(points, subset_size) -> tuple:
+    """The unit-std sparse covariance of one component at the points and its note."""
+    from fracid.data.dic_noise import NUGGET, dic_covariance, support_radius
+
+    size = real_number(subset_size, "subset_size")
+    if not (np.isfinite(size) and size > 0):
+        raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
+    correlation = dic_covariance(points, 1.0, size)
+    neighbours = correlation.correlation.nnz / max(len(points), 1) - 1.0
+    return correlation, (f"errors correlated over the subset size {size:g} mm (compactly supported kernel, "
+                         f"l = {size / 2:g} mm, zero beyond {support_radius(size):.3g} mm: {neighbours:.0f} "
+                         f"neighbours a point; {NUGGET:g} of the variance independent; frames and components "
+                         f"independent, one sparse factor for all)")
 
 
 def _without_empty_frames(indices, controls, values, missing, sigma) -> tuple:

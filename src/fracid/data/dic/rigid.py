@@ -26,8 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from fracid.data.covariance_matrix import Covariance
 from fracid.data.covariance_low_rank import LowRankPlusDiagonal
+from fracid.data.covariance_matrix import Covariance, Diagonal
+from fracid.data.covariance_update import LowRankUpdate
 
 #: prior std of the rigid translations [mm] (and of the rotation's displacement at the farthest point)
 RIGID_STD = 1.0
@@ -61,20 +62,30 @@ def prior_scales(points, std: float) -> np.ndarray:
     return np.array([std, std, std / max(radius, 1e-12)])
 
 
-def with_rigid_motion(frame_covariance: Covariance, points, components, std: float = RIGID_STD) -> LowRankPlusDiagonal:
+def with_rigid_motion(frame_covariance: Covariance, points, components, std: float = RIGID_STD) -> Covariance:
     """The covariance of one frame's entries with its rigid motion marginalised: C + R diag(s^2) R^T.
 
     Parameters
     ----------
-    frame_covariance : Diagonal or LowRankPlusDiagonal
+    frame_covariance : Covariance
         The noise covariance of the frame's entries [mm^2] (component-major, point fastest).
     points, components
         As :func:`rigid_modes`.
     std : float
         Prior std of the motions [mm] (:data:`RIGID_STD`): much larger than the motions, small enough to keep
         the Woodbury capacitance well conditioned.
+
+    Returns
+    -------
+    Covariance
+        A :class:`~fracid.data.covariance_low_rank.LowRankPlusDiagonal` whose last columns are the prior's
+        (``nuisance``) for a diagonal or low-rank-plus-diagonal C; else a
+        :class:`~fracid.data.covariance_update.LowRankUpdate` of C (a sparse correlated C keeps its factor).
+        Either way ``noise_diag`` is C's diagonal.
     """
     modes = prior_columns(points, components, std)
+    if not isinstance(frame_covariance, (Diagonal, LowRankPlusDiagonal)):
+        return LowRankUpdate(frame_covariance, modes)
     low_rank = getattr(frame_covariance, "U", np.zeros((frame_covariance.n, 0)))
     variances = frame_covariance.D.var if hasattr(frame_covariance, "D") else frame_covariance.diag()
     return LowRankPlusDiagonal(np.hstack([low_rank, modes]), variances,

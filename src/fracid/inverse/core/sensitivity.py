@@ -180,6 +180,10 @@ class SensitivityHistory:
     variance_share: np.ndarray
 
 
+#: largest block of another covariance whose information is solved entry by entry (beyond: whitened)
+PREFIX_SOLVE_LIMIT = 200
+
+
 def _prefix_whitening(C_exp) -> bool:
     """Whether ``C_exp.whiten`` is L^-1 with L its lower Cholesky factor, so that the first t whitened rows
     depend on the first t observations only (Diagonal, Dense and blocks of them)."""
@@ -192,8 +196,10 @@ def cumulative_information(S, C_exp) -> np.ndarray:
     """Fisher information of the observations 1..t for every t: S_1:t^T C_1:t^-1 S_1:t, shape (n, p, p).
 
     With a Cholesky whitening W = L^-1 S (C = L L^T, L lower triangular, so that C_1:t = L_1:t L_1:t^T)
-    it is the running sum of w_t w_t^T: O(n p^2), no n x n matrix; other covariances (low rank) solve
-    every leading block, O(n^2) at least.
+    it is the running sum of w_t w_t^T: O(n p^2), no n x n matrix; a low-rank-plus-diagonal one by running
+    Woodbury sums; another covariance of at most :data:`PREFIX_SOLVE_LIMIT` entries solves every leading
+    block, a larger one (a DIC frame: sparse, with its rigid motion) sums its whitened rows: exact at the
+    block's end, within the block in its whitening's order (the entries of one frame share a control value).
 
     Parameters
     ----------
@@ -214,6 +220,9 @@ def cumulative_information(S, C_exp) -> np.ndarray:
         return np.concatenate(parts)
     if isinstance(C_exp, LowRankPlusDiagonal):
         return _low_rank_prefix_information(S, C_exp)
+    if C_exp.n > PREFIX_SOLVE_LIMIT:  # e.g. a DIC frame (sparse, plus its rigid motion): one solve per entry is
+        W = C_exp.whiten(S)           # out of reach; exact at the block's end, its own elimination order within
+        return np.cumsum(W[:, :, None] * W[:, None, :], axis=0)
     return np.array([S[: t + 1].T @ C_exp.take(slice(0, t + 1)).solve(S[: t + 1]) for t in range(S.shape[0])])
 
 

@@ -20,6 +20,7 @@ more refused with the likely cause), and a frame without any valid value is drop
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -122,9 +123,45 @@ def field_block(exp: FieldExperimentConfig, specimen):
     return placed_field_block(exp, specimen)[0]
 
 
+_PLACED: dict = {}  # (config, specimen, files' stat) -> (block, warnings): the last few blocks of this process
+_PLACED_KEPT = 2
+
+
 def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
     """(:func:`field_block`, its warnings): its points located on the specimen's mesh (the few outside dropped,
-    :func:`~fracid.inverse.experiments.field_on_mesh.points_on_mesh`), its frames without a value dropped."""
+    :func:`~fracid.inverse.experiments.field_on_mesh.points_on_mesh`), its frames without a value dropped.
+
+    Built once per process for the same configuration, specimen and files (the size and modification time of
+    every file beside the frame table, and of the machine log): reading the configuration, building the data
+    and the observation all ask for the block, and its covariance's factorisation is its costly part (issue
+    41: three builds per ``check``, a fourth by ``identify``). A FieldBlock is immutable: sharing it is safe."""
+    key = (replace(exp, n_points=0), specimen, _files_stat(exp))
+    if key not in _PLACED:
+        while len(_PLACED) >= _PLACED_KEPT:  # a field block may hold hundreds of MB: keep few
+            _PLACED.pop(next(iter(_PLACED)))
+        _PLACED[key] = _build_placed_field_block(exp, specimen)
+    return _PLACED[key]
+
+
+def _files_stat(exp: FieldExperimentConfig) -> tuple:
+    """(name, size, modification time [ns]) of every file in the frame table's folder and of the machine log;
+    a file that cannot be read gives its name alone (the build then says why)."""
+    def stat(path):
+        try:
+            info = os.stat(path)
+        except (OSError, TypeError, ValueError):
+            return (str(path),)
+        return (str(path), info.st_size, info.st_mtime_ns)
+
+    try:
+        folder = sorted(entry.path for entry in os.scandir(Path(exp.file).parent) if entry.is_file())
+    except (OSError, TypeError, ValueError):
+        folder = [exp.file]
+    log = getattr(exp.log, "file", None)
+    return tuple(stat(path) for path in (*folder, *([log] if log is not None else [])))
+
+
+def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
     from fracid.data.dic import field_block as block_of, read_dic_frames
     from fracid.inverse.experiments.field_on_mesh import points_on_mesh
 
