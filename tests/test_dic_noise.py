@@ -139,3 +139,64 @@ def test_the_correlation_is_symmetric_with_a_unit_diagonal():
 def test_bad_input_is_named(kwargs, match):
     with pytest.raises(ValueError, match=match):
         dic_covariance(**kwargs)
+
+
+@pytest.mark.parametrize("n_side, spacing", [(30, 1.0), (45, 0.7)])
+def test_the_factor_estimate_brackets_the_factor_built(n_side, spacing):
+    from fracid.data.dic_noise import factor_estimate
+
+    points = _grid(n_side, spacing, seed=4)
+    estimate = factor_estimate(points, 6.0)
+    C = dic_covariance(points, 1.0, 6.0)
+    assert estimate["nonzeros"] == pytest.approx(C.correlation.nnz, rel=0.1)  # sampled neighbours
+    kept = 12.0 * C.correlation.nnz + 36.0 * C._factor.L.nnz
+    low, high = estimate["bytes"]
+    assert 0.9 * low <= kept <= 1.1 * high
+
+
+def test_a_field_whose_factor_would_not_fit_is_refused_before_it_is_built(monkeypatch):
+    import fracid.data.dic.field as dic_field
+    from fracid.data.errors import DataError
+
+    points = _grid(10, 1.0)
+    sigma = np.ones(2 * len(points))
+    dic_field.field_covariance(points, sigma, 1, (0, 1), 6.0)  # the default limit: built
+    monkeypatch.setattr(dic_field, "MAX_FACTOR_BYTES", 1e3)
+    monkeypatch.setattr(covariance_sparse, "_Factor", lambda K: pytest.fail("built before the refusal"))
+    with pytest.raises(DataError, match=r"subset_size = 6 mm: .* GB .*100 points a frame.*point_spacing"):
+        dic_field.field_covariance(points, sigma, 1, (0, 1), 6.0)
+
+
+def test_the_information_of_a_large_correlated_frame_is_exact_at_its_end():
+    from fracid.data.covariance_matrix import block_diagonal
+    from fracid.data.dic.rigid import with_rigid_motion
+    from fracid.inverse.core.sensitivity import PREFIX_SOLVE_LIMIT, cumulative_information
+
+    points = _grid(11, 1.0, seed=6)  # 121 points, u and v: a frame of 242 entries, beyond the per-entry limit
+    frame = dic_covariance(points, 1e-3, 4.0)
+    C = block_diagonal([with_rigid_motion(block_diagonal([frame, frame]), points, (0, 1)) for _ in range(2)])
+    assert C.blocks[0].n > PREFIX_SOLVE_LIMIT
+    S = np.random.default_rng(7).standard_normal((C.n, 3))
+    info = cumulative_information(S, C)
+    dense = C.dense()
+    for end in (C.blocks[0].n, C.n):  # each frame's end
+        expected = S[:end].T @ np.linalg.solve(dense[:end, :end], S[:end])
+        np.testing.assert_allclose(info[end - 1], expected, rtol=1e-6)
+
+
+def test_the_kalman_groups_end_where_the_covariance_splits():
+    from fracid.data.covariance_matrix import Diagonal, block_diagonal, independent_cuts
+    from fracid.data.covariance_update import LowRankUpdate
+    from fracid.inverse.methods.kalman import independent_groups
+
+    frame = dic_covariance(_grid(4), 1e-3, 4.0)  # 16 correlated entries
+    C = block_diagonal([Diagonal(np.ones(5)), frame, frame])  # a curve of 5 values, then two frames
+    np.testing.assert_array_equal(independent_cuts(C), [0, 1, 2, 3, 4, 5, 21, 37])
+    groups = [np.arange(a, b) for a, b in ((0, 3), (3, 12), (12, 30), (30, 37))]
+    aligned = independent_groups(groups, C)
+    assert [(g[0], g[-1] + 1) for g in aligned] == [(0, 3), (3, 21), (21, 37)]  # no frame split; one emptied
+    assert independent_groups(groups, LowRankUpdate(Diagonal(np.ones(37)), np.ones(37)))[0].size == 37
+    same = independent_groups(groups, Diagonal(np.ones(37)))  # independent entries: as given
+    assert all(np.array_equal(a, b) for a, b in zip(same, groups)) and len(same) == len(groups)
+    scattered = [np.array([0, 2]), np.array([1, 3])]
+    assert independent_groups(scattered, C) is scattered

@@ -297,6 +297,18 @@ def block_diagonal(covariances) -> Covariance:
     return flat[0] if len(flat) == 1 else Block(flat)
 
 
+def independent_cuts(C: Covariance) -> np.ndarray:
+    """The positions 0 < k < n where ``C`` splits into independent parts (no entry before k correlated with one
+    from k on), and 0 and n: every position for a :class:`Diagonal`, the block ends (and the cuts inside each
+    block) for a :class:`Block`, none inside any other kind."""
+    if isinstance(C, Diagonal):
+        return np.arange(C.n + 1)
+    if isinstance(C, Block):
+        return np.unique(np.concatenate([start + independent_cuts(block)
+                                         for block, start in zip(C.blocks, C.offsets[:-1])]))
+    return np.array([0, C.n])
+
+
 def as_covariance(C, n: int | None = None, *, name: str = "covariance") -> Covariance:
     """``C`` as a :class:`Covariance`, checked symmetric positive definite.
 

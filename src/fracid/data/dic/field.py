@@ -21,6 +21,9 @@ from fracid.data.dic.data import DicData
 from fracid.data.errors import DataError, DataTypeError
 from fracid.settings.checks import show
 
+#: the largest peak memory [B] the correlated-noise factor of a field block may take (estimated before it is built:
+#: :func:`fracid.data.dic_noise.factor_estimate`); beyond, the block is refused with the advice to thin it
+MAX_FACTOR_BYTES = 8e9
 #: component names -> indices (0: u_x, 1: u_y)
 COMPONENTS = {"u": 0, "v": 1}
 
@@ -108,7 +111,7 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
     prior's columns added to each frame's block, both components). ``sigma`` NaN (missing values) are set to 1:
     those entries are dropped."""
     sigma = np.where(np.isnan(sigma), 1.0, sigma)
-    n_c, n = len(components), len(components) * len(points)
+    n_c = len(components)
     if subset_size is None:
         note, correlation = "independent errors (diagonal covariance)", None
     else:
@@ -131,17 +134,24 @@ def field_covariance(points, sigma: np.ndarray, n_frames: int, components: tuple
 
 def _correlation(points, subset_size) -> tuple:
     """The unit-std sparse covariance of one component at the points and its note."""
-    from fracid.data.dic_noise import NUGGET, dic_covariance, support_radius
+    from fracid.data.dic_noise import NUGGET, dic_covariance, factor_estimate, support_radius
 
     size = real_number(subset_size, "subset_size")
     if not (np.isfinite(size) and size > 0):
         raise DataError(f"subset_size = {subset_size!r} [mm]: give a finite number > 0 (the DIC subset size)")
+    cost = factor_estimate(points, size)
+    low, high = (b / 1e9 for b in cost["peak"])
+    where = (f"{len(points)} points a frame, {cost['neighbours']:.0f} neighbours a point within "
+             f"{support_radius(size):.3g} mm")
+    if cost["peak"][0] > MAX_FACTOR_BYTES:
+        raise DataError(f"subset_size = {size:g} mm: the correlated covariance of the field would take {low:.3g} "
+                        f"to {high:.3g} GB ({where}), more than the {MAX_FACTOR_BYTES / 1e9:g} GB fracid allows; "
+                        "thin the field (point_spacing, e.g. half the subset size) or keep a region of it")
     correlation = dic_covariance(points, 1.0, size)
-    neighbours = correlation.correlation.nnz / max(len(points), 1) - 1.0
     return correlation, (f"errors correlated over the subset size {size:g} mm (compactly supported kernel, "
-                         f"l = {size / 2:g} mm, zero beyond {support_radius(size):.3g} mm: {neighbours:.0f} "
-                         f"neighbours a point; {NUGGET:g} of the variance independent; frames and components "
-                         f"independent, one sparse factor for all)")
+                         f"l = {size / 2:g} mm: {where}; {NUGGET:g} of the variance independent; frames and "
+                         f"components independent, one sparse factor for all: "
+                         f"{low:.2g} to {high:.2g} GB at its peak, estimated)")
 
 
 def _without_empty_frames(indices, controls, values, missing, sigma) -> tuple:

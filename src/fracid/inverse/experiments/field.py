@@ -65,7 +65,8 @@ FIELD_KEY_DOCS = {
                   "The frames used; a frame without any valid value is dropped (warned)."),
     "components": Key(["u", "v"], "", '"u" | "v" | ["u", "v"]', "The displacement components used."),
     "std": Key(Said("the files' sigma"), "mm", "> 0", "The standard deviation of every value."),
-    "subset_size": Key(UNSET, "mm", "> 0", "Errors correlated over a subset of this size (low rank + diagonal)."),
+    "subset_size": Key(UNSET, "mm", "> 0", "Errors correlated over a subset of this size (a sparse covariance: "
+                        "fracid.data.dic_noise; the DIC code's subset in pixels times the scale)."),
     "rigid_motion": Key(True, "", "true | false", "The rigid motion of every frame removed from data and model, by a "
                                                   "vague prior of std rigid_std (false: the data have none)."),
     "rigid_std": Key(1.0, "mm", "> 0", "The std of the rigid motion's vague prior."),

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from fracid.data.covariance_matrix import as_covariance, independent_cuts
 from fracid.inverse.methods.assimilation import assimilate
 from fracid.inverse.methods.kalman_status import KalmanResult, judge_last_pass, judge_stop, relaxed
 from fracid.inverse.methods.local_fit_inputs import at_bound, box, check_inputs, snap_to_bounds
@@ -55,6 +56,19 @@ def _observation_groups(n, groups):
     if not np.array_equal(np.sort(flat), np.arange(n)) or np.any(np.diff([g.max() for g in groups]) <= 0):
         raise ValueError("observation groups must cover every observation once, in increasing order")
     return groups
+
+
+def independent_groups(groups: list, C_exp) -> list:
+    """Consecutive ``groups`` with each end moved on to the next position where ``C_exp`` splits into
+    independent parts (:func:`~fracid.data.covariance_matrix.independent_cuts`), so that no group shares a
+    correlated block with another (the filter assimilates them one after another as independent: a DIC frame
+    with its rigid motion, an error term along a curve, stay whole); groups left empty are dropped. Groups that
+    are not consecutive ranges are returned as they are."""
+    if not all(np.array_equal(g, np.arange(g[0], g[-1] + 1)) for g in groups):
+        return groups
+    cuts = independent_cuts(as_covariance(C_exp))
+    ends = np.unique(cuts[np.searchsorted(cuts, [g[-1] + 1 for g in groups])])
+    return [np.arange(a, b) for a, b in zip(np.concatenate([[0], ends[:-1]]), ends) if b > a]
 
 
 def _converged(x_new, x_old, C, tol):
@@ -148,7 +162,8 @@ def kalman_filter(evaluate, y_exp, C_exp, x0, C0, *, groups=None, max_iterations
         parameters is assimilated in information form (:func:`~fracid.inverse.methods.assimilation.assimilate`),
         so no n x n matrix is formed for a diagonal, low-rank or block C_exp. Sequential assimilation
         assumes no correlation between groups (a block-diagonal C_exp); within a group any covariance
-        is used.
+        is used. Consecutive groups are made so: each end is moved on to the end of the correlated block it
+        falls in (:func:`independent_groups`).
     x0, C0 : ndarray
         Prior mean and covariance (from KNN or the user). x0 is moved into the bounds first.
     groups : sequence of index arrays, optional
@@ -182,7 +197,7 @@ def kalman_filter(evaluate, y_exp, C_exp, x0, C0, *, groups=None, max_iterations
     y_exp, C_exp, x0, C0 = check_inputs(y_exp, C_exp, x0, C0)
     if sensitivity is None:
         evaluate, sensitivity = exact_sensitivity(evaluate)
-    groups = _observation_groups(y_exp.size, groups)
+    groups = independent_groups(_observation_groups(y_exp.size, groups), C_exp)
     lower, upper = box(bounds, x0.size)
     x0 = np.clip(x0, lower, upper)
     result = KalmanResult(x=x0.copy(), C=C0.copy(), passes=[{"iteration": 0, "x": x0.copy()}])
