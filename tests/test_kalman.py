@@ -140,3 +140,35 @@ def test_a_filter_that_cannot_run_anywhere_stops_with_a_status():
     result = kalman_filter(evaluate, y, R, x0, C0)
     assert result.failed and result.status.startswith("failed:") and "diverged" in result.status
     np.testing.assert_array_equal(result.x, x0)
+
+
+def test_a_refused_relinearisation_falls_back_once_to_the_last_full_run(monkeypatch):
+    """A first pass that ends beside its last full run, its objective a little above it, does not stop the
+    filter: the next pass is linearised at that run (a Gauss-Newton step from it), once per such point."""
+    import fracid.inverse.methods.kalman as kalman
+
+    x_true = np.array([1.2, 0.6])
+    t = np.linspace(0.1, 2.0, 16)
+
+    def h(x, needed=None):  # nonlinear: the first step-by-step pass stops short of the posterior
+        return x[0] * np.exp(-x[1] * t) + 0.3 * x[0] ** 2
+
+    y, R = h(x_true), np.eye(t.size) * 1e-6
+    x0, C0 = np.array([0.8, 1.0]), np.diag([0.5, 0.5])
+    reference = kalman_filter(h, y, R, x0, C0, groups=[np.arange(8), np.arange(8, 16)])
+    assert reference.converged
+    real, refused = kalman._decreases, []
+
+    def refuse_first(*args):  # the first relinearisation refused, as when the estimate sits a little above
+        if not refused:
+            refused.append(1)
+            return lambda x, y: False
+        return real(*args)
+
+    monkeypatch.setattr(kalman, "_decreases", refuse_first)
+    result = kalman_filter(h, y, R, x0, C0, groups=[np.arange(8), np.arange(8, 16)], max_iterations=10)
+    assert refused and result.converged  # the next pass linearised at the last full run, and on to the end
+    np.testing.assert_allclose(result.x, reference.x, rtol=1e-4)
+    monkeypatch.setattr(kalman, "_decreases", lambda *a: lambda x, y: False)  # every estimate refused
+    stuck = kalman_filter(h, y, R, x0, C0, groups=[np.arange(8), np.arange(8, 16)], max_iterations=10)
+    assert not stuck.converged and stuck.iterations == 2  # the fallback once per point: no endless passes

@@ -89,6 +89,7 @@ class _Linearizer:
         self.result, self.max_backtracks, self.n_outputs = result, max_backtracks, n_outputs
         self.last_full = None  # (point, y) of the last successful run over all outputs
         self.last_error = ""
+        self.anchors_taken = []  # last full runs a pass was linearised at when the estimate was refused
 
     def at(self, x, anchor, needed, where, accept=None):
         tried = []
@@ -263,10 +264,17 @@ def _global_iterations(problem, lin, objective, result, max_iterations, tol, dam
 
 def _relinearize(lin, objective, previous, iteration, result):
     """(point, y, S) of the pass's one linearisation, at the last estimate or backtracked towards the last full
-    run while its objective rises; None when no point runs (then ``result.x`` is that last full run's point)."""
+    run while its objective rises; failing that, at the last full run itself, once per such point (the pass is
+    then a Gauss-Newton step from the best point run: a first pass that ended beside its last full run, a little
+    above it, must not stop the filter there); None when no point is taken (then ``result.x`` is that last full
+    run's point)."""
     anchor = lin.last_full[0] if lin.last_full is not None else None
     accept = None if anchor is None else _decreases(objective, *lin.last_full)
-    got = lin.at(previous, anchor, None, {"iteration": iteration, "step": 0}, accept)
+    where = {"iteration": iteration, "step": 0}
+    got = lin.at(previous, anchor, None, where, accept)
+    if got is None and anchor is not None and not any(np.array_equal(anchor, a) for a in lin.anchors_taken):
+        lin.anchors_taken.append(anchor)
+        got = lin.at(anchor, None, None, where)
     if got is None:  # keep the last point that ran (and its pass's covariance)
         result.x = anchor if anchor is not None else result.x
     return got
