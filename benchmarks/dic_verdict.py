@@ -21,7 +21,11 @@ of the truth (99 % joint region of chi^2(3): 11.34), forward runs and wall times
 asks r(beta, c) >= 0.95 with the curve alone and <= 0.8 with curve + field, as the study's verdict prints.
 
     python benchmarks/dic_verdict.py [--n 16] [--groups 4] [--starts 3] [--replicates 3] [--h-fine 2.0] [--seed 11]
-        [--json out.json]
+        [--json out.json] [--advised truth|nominal]
+
+With ``--advised`` the field's frames are first ranked by their Fisher information at the truth or at the
+nominal parameters (:mod:`fracid.inverse.studies.frame_information`, what ``fracid check`` prints), and the study
+runs on the curve with the advised frames only (the same noisy twin).
 """
 
 from __future__ import annotations
@@ -56,8 +60,9 @@ SPACING, SUBSET, DIC_STD = 1.5, 3.0, 1e-3  # mm
 REGION = (2.0, 20.0)  # mm from the crack line x = 0
 
 
-def twin(beam, seed: int, folder) -> tuple[ExperimentalData, ExperimentalData, list]:
-    """(curve data, curve + field data, [curve kind, field kind]) of the noisy twin."""
+def twin(beam, seed: int, folder, frames=None) -> tuple[ExperimentalData, ExperimentalData, list]:
+    """(curve data, curve + field data, [curve kind, field kind]) of the noisy twin (its field at ``frames``,
+    frame numbers from 1, or all)."""
     params = dataclasses.replace(BASE, **dict(zip(NAMES, TRUTH)))
     curve = Observation(beam, CURVE, control="cmod", name="curve")
     force = ForwardOperator([curve], BASE, NAMES)(TRUTH).y
@@ -70,10 +75,36 @@ def twin(beam, seed: int, folder) -> tuple[ExperimentalData, ExperimentalData, l
     write_dic(folder, synthetic)
     dic = read_dic_frames(os.path.join(folder, "frames.csv"), sigma="sigma")
     lo, hi = REGION
-    block = field_block(dic, control="cmod_mm", subset_size=SUBSET, rigid_std=1.0, name="field",
+    block = field_block(dic, frames=frames, control="cmod_mm", subset_size=SUBSET, rigid_std=1.0, name="field",
                         region=lambda p: (np.abs(p[:, 0]) >= lo) & (np.abs(p[:, 0]) <= hi))
     field = field_observation(block, beam, control="cmod")
     return curve_data, stack(curve_data, block.data), [curve, field]
+
+
+def advised_frames(kinds, data, at) -> list:
+    """The frames :func:`~fracid.inverse.studies.frame_information.rank_frames` advises at the parameters ``at``
+    (the curve's information and the bounds' uniform prior as its prior), printed as `fracid check` would."""
+    from fracid.inverse.core.sensitivity import exact_sensitivity
+    from fracid.inverse.studies.frame_information import frame_information, rank_frames
+
+    operator = ForwardOperator(kinds, BASE, NAMES)
+    evaluate, sensitivity = exact_sensitivity(operator)
+    start = time.perf_counter()
+    _, S, _ = sensitivity(evaluate, np.asarray(at, float), None, None)
+    n_curve = CURVE.size
+    field = kinds[1]
+    keep = field.keep if field.keep is not None else np.ones(FRAMES.size * len(field.components) * len(field.points))
+    per_frame = np.asarray(keep).reshape(FRAMES.size, -1).sum(axis=1)
+    ends = n_curve + np.cumsum(per_frame)
+    slices = [slice(a, b) for a, b in zip(np.concatenate([[n_curve], ends[:-1]]), ends)]
+    C = data.covariance
+    curve_info = frame_information(S, C, [slice(0, n_curve)])[0]
+    width = (SPACE.upper - SPACE.lower) / np.sqrt(12.0)  # the bounds as a uniform prior's std
+    ranking = rank_frames(frame_information(S, C, slices), NAMES, curve_info + np.diag(1.0 / width**2),
+                          labels=[f"frame {k + 1} (CMOD {f:g} mm)" for k, f in enumerate(FRAMES)])
+    print(f"\nframes ranked at {dict(zip(NAMES, np.round(at, 8).tolist()))} (one run with sensitivities, "
+          f"{time.perf_counter() - start:.0f} s):", *ranking.lines(), sep="\n", flush=True)
+    return sorted(int(k) + 1 for k in ranking.advised)
 
 
 def study(label, kinds, data, args) -> dict:
@@ -104,12 +135,22 @@ def main(argv=None):
     parser.add_argument("--starts", type=int, default=3, help="multi-start check")
     parser.add_argument("--replicates", type=int, default=3, help="noisy replicates of the stability check")
     parser.add_argument("--json", default=None)
+    parser.add_argument("--advised", choices=("truth", "nominal"), default=None,
+                        help="then curve + the frames the ranking advises at the truth or at the nominal parameters "
+                             "(demo.toml's: 6.6e-5, 600, 9), and curve + field is not run")
     args = parser.parse_args(argv)
     load_before = os.getloadavg()
     beam = NotchedBeam(h_fine=args.h_fine, h_coarse=3.0 * args.h_fine)
     with tempfile.TemporaryDirectory() as folder:
         curve_data, both_data, kinds = twin(beam, args.seed, folder)
-    rows = [study("curve alone", kinds[:1], curve_data, args), study("curve + field", kinds, both_data, args)]
+    if args.advised:
+        at = TRUTH if args.advised == "truth" else np.array([getattr(BASE, name) for name in NAMES])
+        frames = advised_frames(kinds, both_data, at)
+        with tempfile.TemporaryDirectory() as folder:
+            _, advised_data, advised_kinds = twin(beam, args.seed, folder, frames=frames)
+        rows = [study(f"curve + {len(frames)} advised frames", advised_kinds, advised_data, args)]
+    else:
+        rows = [study("curve alone", kinds[:1], curve_data, args), study("curve + field", kinds, both_data, args)]
     out = {"h_fine": args.h_fine, "points": len(kinds[1].points), "frames": FRAMES.size, "rows": rows,
            "loadavg_before": load_before, "loadavg_after": os.getloadavg()}
     print()

@@ -350,4 +350,4 @@ def as_covariance(C, n: int | None = None, *, name: str = "covariance") -> Covar
 
 
 __all__ = ["DENSE_LIMIT", "Block", "Covariance", "Dense", "Diagonal", "as_column", "as_covariance", "block_diagonal",
-           "checked_index", "checked_rows"]
+           "checked_index", "checked_rows", "independent_cuts"]
