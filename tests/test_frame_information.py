@@ -56,3 +56,14 @@ def test_frame_information_is_each_frames_block_of_the_whole():
 def test_no_frame_is_refused():
     with pytest.raises(ValueError, match="at least one frame"):
         rank_frames([], ("a",))
+
+
+def test_parameters_in_units_many_orders_apart_rank_as_in_common_units():
+    frames = [_along([1.0, 1.0], 100.0), _along([1.0, -1.0], 20.0), _along([1.0, 0.5], 5.0)]
+    prior = np.eye(2) * 1e-2
+    units = np.diag([1e7, 1e-2])  # kappa_i-like against beta-like: the information scales by 1e14 and 1e-4
+    scaled = rank_frames([units @ F @ units for F in frames], ("k", "b"), units @ prior @ units)
+    plain = rank_frames(frames, ("k", "b"), prior)
+    assert scaled.order == plain.order
+    np.testing.assert_allclose(scaled.largest_r, plain.largest_r, rtol=1e-8)
+    np.testing.assert_allclose(scaled.std * np.diag(units), plain.std, rtol=1e-8)

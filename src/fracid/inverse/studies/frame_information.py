@@ -93,15 +93,24 @@ class FrameRanking:
 
 
 def _posterior(information: np.ndarray) -> tuple:
-    """(std, largest |r|, its pair of indices, log det of the covariance) of the information matrix."""
-    C = np.linalg.pinv(information, hermitian=True)
-    std = np.sqrt(np.clip(np.diag(C), 0.0, None))
-    scale = np.where(std > 0, std, 1.0)
-    r = np.abs(C / np.outer(scale, scale))
+    """(std, largest |r|, its pair of indices, log det of the covariance) of the information matrix. Inverted in
+    the scale of its own diagonal: the parameters' units differ by many orders (1e13 for kappa_i against 1e-3
+    for beta), which an unscaled inverse or pseudo-inverse cuts at its relative tolerance."""
+    d = np.sqrt(np.clip(np.diag(information), 0.0, None))
+    seen = d > 0
+    scale = np.where(seen, d, 1.0)
+    scaled = information / np.outer(scale, scale)
+    sign, logdet = np.linalg.slogdet(scaled)
+    if sign <= 0 or not np.all(seen):  # a parameter or a combination unseen: infinite volume
+        C, volume = np.linalg.pinv(scaled, hermitian=True), np.inf
+    else:
+        C, volume = np.linalg.inv(scaled), -(logdet + 2.0 * np.sum(np.log(d)))
+    std = np.sqrt(np.clip(np.diag(C), 0.0, None)) / scale
+    unit = np.sqrt(np.clip(np.diag(C), 1e-300, None))
+    r = np.abs(C / np.outer(unit, unit))
     np.fill_diagonal(r, 0.0)
     i, j = np.unravel_index(int(np.argmax(r)), r.shape)
-    sign, logdet = np.linalg.slogdet(information)
-    return std, float(r[i, j]), (min(i, j), max(i, j)), (-logdet if sign > 0 else np.inf)
+    return std, float(r[i, j]), (min(i, j), max(i, j)), volume
 
 
 def rank_frames(information, names, prior=None, *, labels=None, target: float = 0.8,
