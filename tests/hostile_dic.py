@@ -47,7 +47,7 @@ def dic_case(status, words, config=(), frame=None, args=CHECK, values=None):
 def _with_values(status, words, values):
     def verify(proc, d):
         check(proc, d, status, words)
-        assert f"data block 'field': {values} points" in proc.stdout, proc.stdout
+        assert re.search(rf"field block 'field': .*; {values} values", proc.stdout), proc.stdout
     return verify
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+import fracid.inverse.experiments.built_once as built_once
 import fracid.inverse.experiments.field as field_kind
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dic"
@@ -16,7 +17,7 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dic"
 @pytest.fixture
 def builds(monkeypatch):
     """The number of field-block builds, counted from a fresh cache."""
-    monkeypatch.setattr(field_kind, "_PLACED", {})
+    monkeypatch.setattr(built_once, "_BUILT", {})
     count = []
     build = field_kind._build_placed_field_block
     monkeypatch.setattr(field_kind, "_build_placed_field_block", lambda *a: count.append(1) or build(*a))
@@ -61,12 +62,12 @@ def test_a_changed_frame_table_or_key_builds_it_again(builds, example_copy):
     field_kind.placed_field_block(replace(exp, exclude_near=5.0), key[1])  # another key: another block
     assert len(builds) == 3
     field_kind.placed_field_block(replace(exp, n_points=7), key[1])  # n_points is derived: the same block
-    assert len(builds) == 3 and len(field_kind._PLACED) <= field_kind._PLACED_KEPT
+    assert len(builds) == 3 and len(built_once._BUILT) <= built_once.KEPT
 
 
 def key_of_last() -> tuple:
     """(config, specimen, file stat) of the block built last."""
-    return next(reversed(field_kind._PLACED))
+    return next(reversed(built_once._BUILT))
 
 
 def test_a_rewritten_frame_file_builds_it_again(builds, example_copy):

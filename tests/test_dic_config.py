@@ -172,7 +172,7 @@ def test_fracid_check_lists_the_field_block(capsys):
 
     assert cli.main(["check", str(CONFIG), "--no-time"]) == 0
     out = capsys.readouterr().out
-    assert "data block 'global': 20 points" in out and "data block 'field':" in out
+    assert "data block 'global': 20 points" in out and "field block 'field': 6 frames" in out
 
 
 def _field_config(tmp_path, **changes) -> Path:

@@ -64,13 +64,23 @@ def model_lines(cfg, params) -> list:
     return [f"model: {cfg.model.type}; [model.parameters]: {values}"]
 
 
-def data_lines(data) -> list:
-    """Every data block: points, control range, largest value, std."""
+def data_lines(data, cfg=None) -> list:
+    """Every data block: points, control range, largest value, std in the block's unit; a block whose kind
+    describes itself (``check_lines``: a field's frames, points, noise and placement) in its own words."""
+    kinds = {getattr(exp, "name", None): exp for exp in (cfg.experiments if cfg is not None else ())}
     lines = []
     for name, a, b in data.blocks:
+        exp = kinds.get(name)
+        if hasattr(exp, "check_lines"):
+            from fracid.config import build_specimen
+
+            lines += exp.check_lines(build_specimen(cfg))
+            continue
         c, y, s = data.control[a:b], data.y[a:b], data.std[a:b]
+        unit = "N" if getattr(exp, "measures_force", True) else "mm"
         lines.append(f"data block {name!r}: {b - a} points, control {c.min():.4g} to {c.max():.4g} mm, "
-                     f"peak {np.max(np.abs(y)):.4g}, std {s.min():.3g} to {s.max():.3g} (mean {s.mean():.3g})")
+                     f"peak {np.max(np.abs(y)):.4g} {unit}, std {s.min():.3g} to {s.max():.3g} {unit} "
+                     f"(mean {s.mean():.3g})")
     return lines
 
 
@@ -160,7 +170,7 @@ def run_check(args) -> int:
         operator = build_operator(cfg, data)
         method = build_method(cfg)
         plan = identify_plan(method, operator, data.n_y, len(cfg.identify.parameters), build_space(cfg))
-        lines += data_lines(data) + identify_lines(cfg) + plan_lines(cfg, method, plan)
+        lines += data_lines(data, cfg) + identify_lines(cfg) + plan_lines(cfg, method, plan)
     else:
         lines.append("plan: fracid simulate, one forward run (no [[experiments]] and [identify]: nothing to identify)")
     print("\n".join(lines), flush=True)
@@ -175,4 +185,8 @@ def run_check(args) -> int:
     cores = workers if args.scheduler else available_cores()  # a cluster's cores are its own
     refit = refits(cfg) if operator is not None else (0, 0)
     print("\n".join(time_lines(cfg, timing, plan, workers, cores, refit, mesh_key)))
+    if operator is not None:
+        from fracid.cli.check_frames import frame_ranking_lines
+
+        print("\n".join(frame_ranking_lines(cfg, data, operator, space)), flush=True)
     return 0

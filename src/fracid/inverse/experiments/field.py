@@ -20,7 +20,6 @@ more refused with the likely cause), and a frame without any valid value is drop
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -117,6 +116,18 @@ class FieldExperimentConfig:
     damage_threshold: float = 0.0
     measures_force = False  # displacements [mm]
 
+    def check_lines(self, specimen) -> list:
+        """What ``fracid check`` prints of the block (:mod:`fracid.inverse.experiments.field_check`)."""
+        from fracid.inverse.experiments.field_check import field_check_lines
+
+        return field_check_lines(self, *placed_field_block(self, specimen), specimen)
+
+    def frame_slices(self, specimen, start: int) -> tuple:
+        """(labels, slices) of each frame's entries in the data, the block starting at entry ``start``."""
+        from fracid.inverse.experiments.field_check import field_frame_slices
+
+        return field_frame_slices(self, placed_field_block(self, specimen)[0], start)
+
 
 def field_block(exp: FieldExperimentConfig, specimen):
     """The :class:`~fracid.data.dic.FieldBlock` of the block on the specimen object ``specimen`` (whose crack path
@@ -124,42 +135,14 @@ def field_block(exp: FieldExperimentConfig, specimen):
     return placed_field_block(exp, specimen)[0]
 
 
-_PLACED: dict = {}  # (config, specimen, files' stat) -> (block, warnings): the last few blocks of this process
-_PLACED_KEPT = 2
-
-
 def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
     """(:func:`field_block`, its warnings): its points located on the specimen's mesh (the few outside dropped,
-    :func:`~fracid.inverse.experiments.field_on_mesh.points_on_mesh`), its frames without a value dropped.
+    :func:`~fracid.inverse.experiments.field_on_mesh.points_on_mesh`), its frames without a value dropped; built
+    once per process for the same configuration, specimen and files
+    (:func:`~fracid.inverse.experiments.built_once.built_once`)."""
+    from fracid.inverse.experiments.built_once import built_once
 
-    Built once per process for the same configuration, specimen and files (the size and modification time of
-    every file beside the frame table, and of the machine log): reading the configuration, building the data
-    and the observation all ask for the block, and its covariance's factorisation is its costly part (issue
-    41: three builds per ``check``, a fourth by ``identify``). A FieldBlock is immutable: sharing it is safe."""
-    key = (replace(exp, n_points=0), specimen, _files_stat(exp))
-    if key not in _PLACED:
-        while len(_PLACED) >= _PLACED_KEPT:  # a field block may hold hundreds of MB: keep few
-            _PLACED.pop(next(iter(_PLACED)))
-        _PLACED[key] = _build_placed_field_block(exp, specimen)
-    return _PLACED[key]
-
-
-def _files_stat(exp: FieldExperimentConfig) -> tuple:
-    """(name, size, modification time [ns]) of every file in the frame table's folder and of the machine log;
-    a file that cannot be read gives its name alone (the build then says why)."""
-    def stat(path):
-        try:
-            info = os.stat(path)
-        except (OSError, TypeError, ValueError):
-            return (str(path),)
-        return (str(path), info.st_size, info.st_mtime_ns)
-
-    try:
-        folder = sorted(entry.path for entry in os.scandir(Path(exp.file).parent) if entry.is_file())
-    except (OSError, TypeError, ValueError):
-        folder = [exp.file]
-    log = getattr(exp.log, "file", None)
-    return tuple(stat(path) for path in (*folder, *([log] if log is not None else [])))
+    return built_once(replace(exp, n_points=0), specimen, _build_placed_field_block)
 
 
 def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
