@@ -187,8 +187,41 @@ def field_view(name: str, coordinates: dict, measured, computed, std, control_la
             frame_figure(fit, k, name=name, control_name=control_name),
             f"Frame {k + 1}: measured displacement with the frame's fitted rigid motion removed, computed at the "
             "estimate, and their difference, in micrometres over the specimen's face (dots: the points).")
+    figures.update(local_figures(fit, stem, coordinates.get("crack"), control_label))
     header, rows = field_table(fit, control_name)
     return BlockView(name, field_heading(name), field_text(fit), header, rows, figures)
+
+
+def local_figures(fit: FieldFit, stem: str, crack, control_label: str) -> dict:
+    """The strain maps of every frame and, with the specimen's crack line, the opening profile and the
+    process-zone width, measured and computed (:mod:`fracid.report.field_local`)."""
+    from fracid.data.dic.strain import default_radius
+    from fracid.report.field_local import local_data, local_figure, strain_figure
+
+    radius = default_radius(np.column_stack([fit.x, fit.y]))
+    figures = {}
+    for k in range(fit.n_frames):
+        figures[f"{stem}_strain_frame{k + 1}"] = (
+            strain_figure(fit, k, radius, _strain_map, f"frame {k + 1} of {fit.n_frames}, "
+                                                              f"{control_label.split(' [')[0]} {fit.controls[k]:.4g}"),
+            f"Frame {k + 1}: the largest principal strain, measured and computed at the estimate by the same plane "
+            f"fit within {radius:.3g} mm, and their difference (10⁻³).")
+    if crack is not None:
+        local = local_data(fit, crack, radius)
+        figures[f"{stem}_local"] = (
+            local_figure(fit, local, control_label),
+            f"The crack-opening profile along the ligament (virtual extensometers over {2 * local['gauge']:.3g} mm) "
+            "and the process-zone width per frame, measured (rigid motion removed) and computed, by the same "
+            "estimators.")
+    return figures
+
+
+def _strain_map(fig, ax, x, y, values, shared, label) -> None:
+    """One strain map: the finite values, levels shared with ``shared`` (or centred on 0 when None)."""
+    finite = np.isfinite(values)
+    levels = _levels(shared[np.isfinite(shared)]) if shared is not None else _levels(values[finite], symmetric=True)
+    _map(fig, ax, x[finite], y[finite], values[finite], levels, DISPLACEMENT_MAP if shared is not None else
+         RESIDUAL_MAP, label)
 
 
 #: the heading of a field block's section; its last word names the figures' files

@@ -160,6 +160,17 @@ class FieldObservation:
                 "x": self.points[point, 0], "y": self.points[point, 1]}
         return {name: self._kept_entries(values) for name, values in full.items()}
 
+    def view_extras(self) -> dict:
+        """What the report's view needs besides the coordinates: ``crack``, the specimen's straight crack line
+        (:func:`~fracid.specimens.crack_line.crack_line`; None when it has none), for the opening profile and
+        the process-zone width."""
+        from fracid.specimens.crack_line import crack_line
+
+        try:
+            return {"crack": crack_line(self.specimen)}
+        except ValueError:
+            return {"crack": None}
+
     def differentiable_with(self, model) -> bool:
         return True  # functionals of the displacements
 
