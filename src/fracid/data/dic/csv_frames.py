@@ -51,9 +51,12 @@ def _holey_columns(table, names: list[str], indices: list[int], delimiter: str =
     return values
 
 
-def read_cloud(path: str, columns: dict, delimiter: str = ",", decimal: str = ".") -> FrameCloud:
+def read_cloud(path: str, columns: dict, delimiter: str = ",", decimal: str = ".",
+               failed_sigma: bool = False) -> FrameCloud:
     """One frame's point cloud; ``columns`` maps "x", "y", "u", "v" and optionally "sigma", "quality" to the
-    file's column names (None: absent); cells separated by ``delimiter``, numbers with the ``decimal`` mark."""
+    file's column names (None: absent); cells separated by ``delimiter``, numbers with the ``decimal`` mark.
+    ``failed_sigma``: a negative sigma marks a failed point (its values set missing; DICe's SIGMA = -1), else it
+    is refused."""
     wanted = {key: name for key, name in columns.items() if name is not None}
     table = _table(path, list(wanted.values()), "point cloud", delimiter, decimal)
     indices = dict(zip(wanted, column_indices(table, list(wanted.values()), delimiter)))
@@ -64,6 +67,11 @@ def read_cloud(path: str, columns: dict, delimiter: str = ",", decimal: str = ".
     values = _holey_columns(table, [wanted[k] for k in holey], [indices[k] for k in holey], delimiter, decimal)
     by_key = dict(zip(holey, values.T))
     sigma = by_key.get("sigma")
+    if sigma is not None and failed_sigma:
+        failed = sigma < 0.0
+        for key in ("u", "v", "sigma"):
+            by_key[key] = np.where(failed, np.nan, by_key[key])
+        sigma = by_key["sigma"]
     if sigma is not None and np.any(sigma < 0.0):
         r = int(np.flatnonzero(sigma < 0.0)[0])
         raise DataError(f"{path}: row {rows[r]}, column {show(wanted['sigma'])}: {sigma[r]:g} is negative; a "
@@ -102,7 +110,8 @@ def read_frame_table(path: str, frame_column: str, file_column: str, load_column
 
 def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quality=None, min_quality=None,
                     coordinate_unit="mm", load_columns=None, placement=None, frame_column="frame",
-                    file_column="file", point_tolerance=1e-6, displacement=None, delimiter=",", decimal="."):
+                    file_column="file", point_tolerance=1e-6, displacement=None, delimiter=",", decimal=".",
+                    failed_sigma=False):
     """Read a DIC export: a frame table and the point cloud of every frame, placed on the specimen.
 
     Parameters
@@ -132,6 +141,9 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
     delimiter, decimal : str
         Cell separator and decimal mark of the frame table and the CSV point clouds
         (:func:`fracid.data.table.check_format`): a European export reads with ``";"`` and ``","``.
+    failed_sigma : bool
+        A negative sigma marks a failed point, set missing at that frame and counted in a note (DICe's SIGMA =
+        -1: :mod:`fracid.data.dic.formats`); False: a negative sigma is refused.
 
     Returns
     -------
@@ -164,7 +176,11 @@ def read_dic_frames(table_path, *, x="X", y="Y", u="U", v="V", sigma=None, quali
                             "not exist (paths are relative to the frame table's folder)")
         vtk = path.lower().endswith((".vtu", ".vtk"))
         clouds.append(read_vtk_cloud(path, displacement, sigma, quality) if vtk
-                      else read_cloud(path, columns, delimiter, decimal))
+                      else read_cloud(path, columns, delimiter, decimal, failed_sigma))
+    if failed_sigma and sigma is not None:
+        failed = [int(np.count_nonzero(np.isnan(c.std))) if c.std is not None else 0 for c in clouds]
+        notes = (*notes, f"{sum(failed)} of {sum(len(c.points) for c in clouds)} point values over {len(clouds)} "
+                 f"frames dropped: failed correlation (sigma < 0 in column {show(sigma)}); per frame {failed}")
     data = assemble(clouds, frames, load, placement=placement, coordinate_unit=coordinate_unit,
                     min_quality=min_quality, point_tolerance=point_tolerance, notes=notes)
     return replace(data, source=(table_path, *data.source))

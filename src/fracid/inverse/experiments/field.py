@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from fracid.data.covariance import STD_ALLOWED, usable_std
+from fracid.data.dic.formats import FORMATS
 from fracid.inverse.experiments.crack_region import away_from_crack
 from fracid.inverse.experiments.field_log import (LOG_KEY_DOCS, frame_table_columns, read_log_settings,
                                                   synchronise_frames)
@@ -51,7 +52,11 @@ FIELD_KEY_DOCS = {
     "displacement": Key(Said('"displacement", else "U"'), "", "a point-data array name",
                         "Frames listed as .vtu/.vtk files: their displacement array."),
     "min_quality": Key(UNSET, "", "a number; needs quality", "Points of lower quality are dropped."),
-    "coordinate_unit": Key("mm", "", '"mm" | "px" (needs the placement)', "The unit of the clouds' coordinates."),
+    "coordinate_unit": Key(Said("mm, or the format's unit"), "", '"mm" | "px" (needs the placement)',
+                           "The unit of the clouds' coordinates."),
+    "format": Key("generic", "", " | ".join(f'"{name}"' for name in FORMATS),
+                  "The export's layout (fracid.data.dic.formats): its columns and unit become the defaults of the "
+                  "column keys and coordinate_unit; dice drops failed subsets (SIGMA = -1) and counts them."),
     "scale": Key(UNSET, "mm per camera unit", "> 0", f"{_PLACEMENT}: its scale."),
     "rotation_deg": Key(0.0, "degrees", "a number", f"{_PLACEMENT}: the camera's rotation."),
     "origin_camera": Key(UNSET, "camera unit", "[X, Y]", f"{_PLACEMENT}: a point in the camera's frame ..."),
@@ -96,6 +101,7 @@ class FieldExperimentConfig:
     placement: object = None  # CameraPlacement or None
     min_quality: float | None = None
     coordinate_unit: str = "mm"
+    format: str = "generic"  # fracid.data.dic.formats.FORMATS
     frames: tuple | None = None
     components: tuple = ("u", "v")
     std: float | None = None
@@ -153,7 +159,7 @@ def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
                           coordinate_unit=exp.coordinate_unit,
                           load_columns=frame_table_columns(exp.log, exp.control_column),
                           placement=exp.placement, file_column=exp.file_column, delimiter=exp.delimiter,
-                          decimal=exp.decimal)
+                          decimal=exp.decimal, failed_sigma=FORMATS[exp.format].failed_sigma)
     sync_warnings = []
     if exp.log is not None:
         dic, synced = synchronise_frames(dic, exp.log, exp.frames)
@@ -254,9 +260,10 @@ def _components(ck, key: str, raw: dict) -> tuple:
     return tuple(values)
 
 
-def _columns(ck, prefix: str, raw: dict) -> tuple:
-    columns = tuple((k, ck.string(f"{prefix}.{k}", raw[k], "must be a column name (string)") if k in raw else d)
-                    for k, d in COLUMN_KEYS.items())
+def _columns(ck, prefix: str, raw: dict, defaults: dict) -> tuple:
+    """((key, column), ...) of COLUMN_KEYS: the given names, else the ``format``'s (``defaults``), else fracid's."""
+    columns = tuple((k, ck.string(f"{prefix}.{k}", raw[k], "must be a column name (string)") if k in raw
+                     else defaults.get(k, d)) for k, d in COLUMN_KEYS.items())
     if "min_quality" in raw and "quality" not in raw:
         ck.fail(f"{prefix}.min_quality", raw["min_quality"], "needs quality = the point clouds' quality column")
     return columns
@@ -300,14 +307,18 @@ def read_field_experiment(ck, i: int, raw: dict, context) -> tuple:
     control_column = log.control_name if log is not None else ck.string(f"{prefix}.control_column",
                                                                         raw["control_column"],
                                                                         "must be a column name (string)")
-    columns = _columns(ck, prefix, raw)
+    layout = FORMATS[ck.choice(f"{prefix}.format", raw.get("format", "generic"), tuple(FORMATS))]
+    columns = _columns(ck, prefix, raw, layout.columns)
     min_quality = _optional_number(ck, f"{prefix}.min_quality", raw, "min_quality", "must be a number", lambda v: True)
-    unit = ck.choice(f"{prefix}.coordinate_unit", raw.get("coordinate_unit", "mm"), ("mm", "px"))
+    unit = ck.choice(f"{prefix}.coordinate_unit", raw.get("coordinate_unit", layout.unit or "mm"), ("mm", "px"))
+    if layout.unit is not None and unit != layout.unit:
+        ck.fail(f"{prefix}.coordinate_unit", unit, f"format = {layout.name!r} writes {layout.unit}: leave "
+                "coordinate_unit out (the placement's scale converts them to mm)")
     delimiter, decimal = file_format(ck, prefix, raw)
     positive = "must be a number > 0 [mm]"
     exp = FieldExperimentConfig(
         index=i, file=file, control_column=control_column, columns=columns, n_points=0,
-        placement=_placement(ck, prefix, raw, unit), min_quality=min_quality, coordinate_unit=unit,
+        placement=_placement(ck, prefix, raw, unit), min_quality=min_quality, coordinate_unit=unit, format=layout.name,
         frames=_frames(ck, f"{prefix}.frames", raw), components=_components(ck, f"{prefix}.components", raw),
         std=_optional_number(ck, f"{prefix}.std", raw, "std", f"must be a number {STD_ALLOWED} [mm]", usable_std),
         subset_size=_optional_number(ck, f"{prefix}.subset_size", raw, "subset_size", positive, lambda v: v > 0),
