@@ -26,7 +26,9 @@ from fracid.report.figures import COMPUTED, MEASURED, new_figure
 MILLI = 1e3
 #: heights of the opening profile and of the width along the ligament (a share of it, away from its ends)
 HEIGHTS = np.linspace(0.15, 0.85, 6)
-#: the width's threshold, a share of the largest measured strain normal to the crack over the frames
+#: the width's threshold, a share of the largest computed strain normal to the crack over the frames (the model's
+#: strains are free of noise; a share of the measured ones would follow the noise where the field cannot resolve the
+#: zone)
 WIDTH_THRESHOLD = 0.3
 
 
@@ -104,7 +106,7 @@ def local_data(fit: FieldFit, line, radius: float) -> dict:
             present = np.isfinite(field[:, normal])
             try:
                 result["profile"][side][k] = opening.evaluate(points, present, field[:, normal])[0]
-                if side == 0:
+                if side == 1:
                     transects = StrainTransects(line, heights, offsets, radius, 0.0)
                     samples.append(transects.strain_matrix(points, present) @ np.where(present, field[:, normal], 0))
             except DataError:
