@@ -321,3 +321,20 @@ def test_the_field_block_finds_the_offset_from_an_extensometer(tmp_path):
     note = next(n for n in built.data.notes if "frames matched to the log's CMOD" in n)
     offset, uncertainty = map(float, re.search(r"offset (\S+) s \+- (\S+) s", note).groups())
     assert abs(offset - 10.0) < 20.0 and abs(offset - 10.0) <= uncertainty and uncertainty == pytest.approx(10.0)
+
+
+def test_the_report_shows_the_synchronised_frames_on_the_load_curve(tmp_path):
+    from fracid.config import build_data, build_operator, build_view_coordinates, load_config
+    from fracid.report.field_figures import field_view
+
+    stamps = 1e3 * (5.0 + 1e3 * CMOD) - 2000.0
+    cfg = load_config(_example_with_log(tmp_path, LOG_KEYS + 'frame_time_column = "t_ms"\nframe_time_unit = "ms"\n'
+                                        "trigger_offset = 2.0", stamps))
+    data = build_data(cfg)
+    operator = build_operator(cfg, data)
+    info = build_view_coordinates(cfg, operator, data)["field"]
+    assert info["sync"] is not None
+    np.testing.assert_allclose(info["sync"].values["CMOD"], CMOD, rtol=1e-6)
+    _, start, stop = data.blocks[1]
+    view = field_view("field", info, data.y[start:stop], data.y[start:stop], None, "CMOD [mm]")
+    assert "field_sync" in view.figures and view.png("field_sync")[:4] == b"\x89PNG"

@@ -200,7 +200,8 @@ def build_view_coordinates(cfg: Config, operator, data) -> dict:
     for exp, observation, (name, start, stop) in zip(cfg.calibration, operator.observations, data.blocks):
         view = experiment_kind(exp).view
         if view is not None:
-            coordinates[name] = {**observation.coordinates(), **getattr(observation, "view_extras", dict)(),
+            extras = exp.view_extras(build_specimen(cfg)) if hasattr(exp, "view_extras") else {}
+            coordinates[name] = {**observation.coordinates(), **getattr(observation, "view_extras", dict)(), **extras,
                                  "view": view, "covariance": data.covariance.take(np.arange(start, stop))}
     return coordinates
 

@@ -188,6 +188,12 @@ def field_view(name: str, coordinates: dict, measured, computed, std, control_la
             f"Frame {k + 1}: measured displacement with the frame's fitted rigid motion removed, computed at the "
             "estimate, and their difference, in micrometres over the specimen's face (dots: the points).")
     figures.update(local_figures(fit, stem, coordinates.get("crack"), control_label))
+    if coordinates.get("sync") is not None:
+        from fracid.report.sync_figure import synchronisation_figure
+
+        figures[f"{stem}_sync"] = (synchronisation_figure(coordinates["sync"]),
+                                   "The frames synchronised with the testing machine's log: marked on its load curve "
+                                   "and, with their uncertainty, on its control over time.")
     header, rows = field_table(fit, control_name)
     return BlockView(name, field_heading(name), field_text(fit), header, rows, figures)
 

@@ -128,6 +128,10 @@ class FieldExperimentConfig:
 
         return field_check_lines(self, *placed_field_block(self, specimen), specimen)
 
+    def view_extras(self, specimen) -> dict:
+        """What the report's view adds: ``sync``, the frames synchronised with the machine log (or None)."""
+        return {"sync": field_synchronisation(self, specimen)}
+
     def frame_slices(self, specimen, start: int) -> tuple:
         """(labels, slices) of each frame's entries in the data, the block starting at entry ``start``."""
         from fracid.inverse.experiments.field_check import field_frame_slices
@@ -148,7 +152,15 @@ def placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
     (:func:`~fracid.inverse.experiments.built_once.built_once`)."""
     from fracid.inverse.experiments.built_once import built_once
 
-    return built_once(replace(exp, n_points=0), specimen, _build_placed_field_block)
+    return built_once(replace(exp, n_points=0), specimen, _build_placed_field_block)[:2]
+
+
+def field_synchronisation(exp: FieldExperimentConfig, specimen):
+    """The frames synchronised with the machine log (:class:`~fracid.data.dic.synchronise.SynchronisedFrames`) of
+    the block built once, or None without a log."""
+    from fracid.inverse.experiments.built_once import built_once
+
+    return built_once(replace(exp, n_points=0), specimen, _build_placed_field_block)[2]
 
 
 def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
@@ -160,7 +172,7 @@ def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
                           load_columns=frame_table_columns(exp.log, exp.control_column),
                           placement=exp.placement, file_column=exp.file_column, delimiter=exp.delimiter,
                           decimal=exp.decimal, failed_sigma=FORMATS[exp.format].failed_sigma)
-    sync_warnings = []
+    sync_warnings, synced = [], None
     if exp.log is not None:
         dic, synced = synchronise_frames(dic, exp.log, exp.frames)
         sync_warnings = [note.removeprefix("WARNING: ") for note in synced.times.notes if note.startswith("WARNING: ")]
@@ -171,7 +183,7 @@ def _build_placed_field_block(exp: FieldExperimentConfig, specimen) -> tuple:
                      subset_size=exp.subset_size, rigid_std=exp.rigid_std, region=region,
                      point_spacing=exp.point_spacing, name=exp.name)
     notes = [note.removeprefix("WARNING: ") for note in block.data.notes if note.startswith("WARNING: field ")]
-    return block, [*([dropped] if dropped else []), *sync_warnings, *notes]
+    return block, [*([dropped] if dropped else []), *sync_warnings, *notes], synced
 
 
 def _optional_number(ck, key: str, raw: dict, name: str, allowed: str, ok) -> float | None:
