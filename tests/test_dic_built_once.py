@@ -10,6 +10,7 @@ import pytest
 
 import fracid.inverse.experiments.built_once as built_once
 import fracid.inverse.experiments.field as field_kind
+import fracid.inverse.experiments.field_build as field_build
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dic"
 
@@ -19,8 +20,8 @@ def builds(monkeypatch):
     """The number of field-block builds, counted from a fresh cache."""
     monkeypatch.setattr(built_once, "_BUILT", {})
     count = []
-    build = field_kind._build_placed_field_block
-    monkeypatch.setattr(field_kind, "_build_placed_field_block", lambda *a: count.append(1) or build(*a))
+    build = field_build._build_placed_field_block
+    monkeypatch.setattr(field_build, "_build_placed_field_block", lambda *a: count.append(1) or build(*a))
     return count
 
 
