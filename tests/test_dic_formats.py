@@ -80,3 +80,12 @@ def test_bad_format_keys_are_named(tmp_path, lines, words):
 
     with pytest.raises(ConfigError, match=words):
         load_config(_config(tmp_path, lines))
+
+
+def test_fracid_check_says_how_many_subsets_were_dropped_and_why(tmp_path, capsys):
+    from fracid import cli
+
+    assert cli.main(["check", str(_config(tmp_path, 'format = "dice"\nframes = [1, 2]')), "--no-time"]) == 0
+    out = capsys.readouterr().out
+    assert "read: 5 of 80 point values over 2 frames dropped: failed correlation (sigma < 0 in column 'SIGMA')" in out
+    assert "field block 'field': 2 frames" in out

@@ -29,6 +29,7 @@ def field_check_lines(exp, block, warnings, specimen) -> list:
              f"{', '.join('uv'[c] for c in block.components)}; {block.data.n_y} values",
              f"  noise: std {std.min():.3g} to {std.max():.3g} mm ({source}); {correlation}"]
     lines.append("  " + _placement_text(exp.placement, block.points, specimen))
+    lines += [f"  read: {n}" for n in notes if "dropped: " in n or n.startswith("region of interest")]
     lines += [f"  note: {w}" for w in warnings]
     return lines
 
