@@ -4,7 +4,8 @@ A field block names its export's layout with ``format``; its columns become the 
 (``x``, ``y``, ``u``, ``v``, ``sigma``), which the configuration may still override, its unit the default of
 ``coordinate_unit``. Only layouts documented by their makers are here, each with its source; any other export
 (VIC-2D/3D, GOM/ZEISS Correlate, MatchID, muDIC, Ncorr saved to CSV...) is read through the generic layout
-with its columns named in the configuration (docs/dic/README.md, "Formats").
+with its columns named in the configuration (docs/dic/README.md, "Formats": muDIC pickles its objects, which
+fracid does not load; Ncorr's .mat files have no reader yet).
 
 - ``generic``: fracid's own CSV point clouds (``X, Y, U, V``, optional sigma and quality columns named by the
   keys), in the unit the configuration gives.
