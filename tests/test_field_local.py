@@ -100,3 +100,18 @@ def test_the_view_has_the_strain_and_local_figures(twin_fit):
     assert [f"field_strain_frame{k}" for k in range(1, 7)] == [k for k in view.figures if "strain" in k]
     assert "field_local" in view.figures
     assert view.png("field_local")[:4] == b"\x89PNG"
+
+
+def test_the_camera_figure_draws_the_files_coordinates(twin_fit):
+    from fracid.report.field_figures import camera_figure, field_view
+
+    fit, info = twin_fit
+    placement = info["placement"]
+    assert info["camera_unit"] == "px"
+    fig = camera_figure(fit, placement, fit.n_frames - 1, "px")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "X [px]" and "camera's frame" in ax.get_title()
+    x0, x1 = ax.get_xlim()  # the camera's pixels (0.1 mm a pixel): hundreds, not the specimen's tens of mm
+    assert x1 - x0 > 5 * (fit.x.max() - fit.x.min())
+    view = field_view("field", info, fit.measured, fit.computed, None, "CMOD [mm]")
+    assert "field_camera" in view.figures

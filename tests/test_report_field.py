@@ -229,7 +229,8 @@ def test_report_has_a_field_section_with_maps_and_a_table_per_frame(field_report
     section = text[text.index("<h2>Displacement field dic</h2>"):]
     section = section[:section.index("<h2>", 10)]
     alts = [alt for alt, _ in images(section)]
-    assert alts == ["field dic summary", "field dic frame1", "field dic frame2", "field dic frame3"]
+    assert alts == ["field dic summary", "field dic frame1", "field dic frame2", "field dic frame3",
+                    "field dic strain frame1", "field dic strain frame2", "field dic strain frame3"]
     rows = re.findall(r"<tr>(.*?)</tr>", section)
     cells = [re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", row) for row in rows]
     assert cells[0][:3] == ["frame", "CMOD [mm]", "values"] and len(cells) == 1 + len(FRAMES)
@@ -250,7 +251,7 @@ def test_report_draws_no_curve_panel_of_the_field_block(field_report):
     assert "Displacement field block(s) dic" in fit
     fig = figures.fit_figure(result, skip={"dic"})
     assert [ax.get_title() for ax in fig.axes if ax.get_visible()] == ["global"]
-    assert len(images(text)) == 2 + 4  # correlation, fit; the field's summary and 3 frames
+    assert len(images(text)) == 2 + 4 + 3  # correlation, fit; the field's summary, 3 frames and their strains
 
 
 def test_report_of_a_field_block_without_coordinates_names_it_and_draws_no_curve(field, tmp_path):
@@ -282,7 +283,8 @@ def test_write_figures_writes_the_field_maps_as_png(field_report, tmp_path):
                                                                                  "covariance": covariance}})
     names = {p.name for p in (tmp_path / "figures").glob("*.png")}
     assert names == {"fit.png", "correlation.png", "field_dic_summary.png", "field_dic_frame1.png",
-                     "field_dic_frame2.png", "field_dic_frame3.png"}
+                     "field_dic_frame2.png", "field_dic_frame3.png", "field_dic_strain_frame1.png",
+                     "field_dic_strain_frame2.png", "field_dic_strain_frame3.png"}
 
 
 def test_a_block_name_is_made_fit_for_a_file_name():

@@ -188,6 +188,11 @@ def field_view(name: str, coordinates: dict, measured, computed, std, control_la
             f"Frame {k + 1}: measured displacement with the frame's fitted rigid motion removed, computed at the "
             "estimate, and their difference, in micrometres over the specimen's face (dots: the points).")
     figures.update(local_figures(fit, stem, coordinates.get("crack"), control_label))
+    if coordinates.get("placement") is not None:
+        figures[f"{stem}_camera"] = (
+            camera_figure(fit, coordinates["placement"], fit.n_frames - 1, coordinates.get("camera_unit", "px")),
+            "The last frame's measured displacements (its rigid motion removed) in the camera's coordinates and "
+            "units, as the DIC code showed them: a check of the placement.")
     if coordinates.get("sync") is not None:
         from fracid.report.sync_figure import synchronisation_figure
 
@@ -220,6 +225,27 @@ def local_figures(fit: FieldFit, stem: str, crack, control_label: str) -> dict:
             "and the process-zone width per frame, measured (rigid motion removed) and computed, by the same "
             "estimators.")
     return figures
+
+
+def camera_figure(fit: FieldFit, placement, k: int, unit: str = "px") -> Figure:
+    """Frame ``k``'s measured displacements in the camera's coordinates and units (the placement inverted:
+    :meth:`~fracid.data.dic.CameraPlacement.to_camera`), one map per component."""
+    from fracid.report.field_local import frame_displacements
+
+    points, measured, _ = frame_displacements(fit, k)
+    camera = placement.to_camera(points)
+    u = placement.displacements_to_camera(np.nan_to_num(measured))
+    u[np.isnan(measured)] = np.nan
+    fig = new_figure(MAP_WIDTH, map_row_height(camera[:, 0], camera[:, 1]) + 0.6)
+    for ax, c in zip(fig.subplots(1, 2, squeeze=False)[0], (0, 1)):
+        finite = np.isfinite(u[:, c])
+        _map(fig, ax, camera[finite, 0], camera[finite, 1], u[finite, c], _levels(u[finite, c]), DISPLACEMENT_MAP,
+             f"{'UV'[c]} [{unit}]")
+        ax.set_xlabel(f"X [{unit}]")
+        ax.set_ylabel(f"Y [{unit}]")
+        ax.set_title(f"{'UV'[c]} measured, frame {k + 1}, in the camera's frame", fontsize=9)
+    fig.suptitle(f"placement: {placement.describe()}", fontsize=9)
+    return fig
 
 
 def _strain_map(fig, ax, x, y, values, shared, label) -> None:

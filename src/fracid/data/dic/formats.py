@@ -5,7 +5,7 @@ A field block names its export's layout with ``format``; its columns become the 
 ``coordinate_unit``. Only layouts documented by their makers are here, each with its source; any other export
 (VIC-2D/3D, GOM/ZEISS Correlate, MatchID, muDIC, Ncorr saved to CSV...) is read through the generic layout
 with its columns named in the configuration (docs/dic/README.md, "Formats": muDIC pickles its objects, which
-fracid does not load; Ncorr's .mat files have no reader yet).
+fracid does not load; Ncorr saves MATLAB v7.3 files, HDF5 that scipy.io cannot read).
 
 - ``generic``: fracid's own CSV point clouds (``X, Y, U, V``, optional sigma and quality columns named by the
   keys), in the unit the configuration gives.

@@ -127,8 +127,10 @@ class FieldExperimentConfig:
         return field_check_lines(self, *placed_field_block(self, specimen), specimen)
 
     def view_extras(self, specimen) -> dict:
-        """What the report's view adds: ``sync``, the frames synchronised with the machine log (or None)."""
-        return {"sync": field_synchronisation(self, specimen)}
+        """What the report's view adds: ``sync``, the frames synchronised with the machine log (or None), and
+        ``placement``, the camera's (or None), and ``camera_unit``, the unit of the files' coordinates."""
+        return {"sync": field_synchronisation(self, specimen), "placement": self.placement,
+                "camera_unit": self.coordinate_unit}
 
     def frame_slices(self, specimen, start: int) -> tuple:
         """(labels, slices) of each frame's entries in the data, the block starting at entry ``start``."""
