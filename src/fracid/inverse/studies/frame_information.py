@@ -7,7 +7,7 @@ gives each frame's Fisher information F_k = S_k^T C_k^-1 S_k (S_k the sensitivit
 C_k their covariance: frames are independent blocks of the data covariance), and :func:`rank_frames` orders
 the frames greedily, each time the one that shrinks the posterior's volume most (log det of
 (P + sum F)^-1, P the prior's information), and follows the stds and the largest correlation along that
-order. The frames advised are the shortest prefix whose largest |r| is at most ``target`` (0.8: no longer
+order. The frames advised are the shortest prefix whose largest ``|r|`` is at most ``target`` (0.8: no longer
 "strongly correlated") or, when no set reaches it, within ``within`` of what all frames give.
 
 Trust: a linearisation at the parameters given; where they are far from the truth the ranking can change
@@ -55,13 +55,13 @@ class FrameRanking:
     std : ndarray (n_frames, p)
         Posterior std of each parameter with the first k + 1 frames of ``order`` [its unit].
     largest_r : ndarray (n_frames,)
-        The largest |r| between two parameters with those frames.
+        The largest ``|r|`` between two parameters with those frames.
     pairs : tuple of (str, str)
-        The pair with that |r|.
+        The pair with that ``|r|``.
     advised : tuple of int
         The frames advised (positions, in ``order``'s order).
     target : float
-        The |r| the advice aims at.
+        The ``|r|`` the advice aims at.
     """
 
     names: tuple
@@ -74,7 +74,7 @@ class FrameRanking:
     target: float
 
     def lines(self, shown: int = 8) -> list:
-        """Text lines: the first ``shown`` frames of the order with the stds and |r| they give, the advice."""
+        """Text lines: the first ``shown`` frames of the order with the stds and ``|r|`` they give, the advice."""
         lines = []
         for k, frame in enumerate(self.order[:shown]):
             stds = ", ".join(f"{name} {s:.3g}" for name, s in zip(self.names, self.std[k]))
@@ -93,7 +93,7 @@ class FrameRanking:
 
 
 def _posterior(information: np.ndarray) -> tuple:
-    """(std, largest |r|, its pair of indices, log det of the covariance) of the information matrix. Inverted in
+    """(std, largest ``|r|``, its pair of indices, log det of the covariance) of the information matrix. Inverted in
     the scale of its own diagonal: the parameters' units differ by many orders (1e13 for kappa_i against 1e-3
     for beta), which an unscaled inverse or pseudo-inverse cuts at its relative tolerance."""
     d = np.sqrt(np.clip(np.diag(information), 0.0, None))
@@ -129,9 +129,9 @@ def rank_frames(information, names, prior=None, *, labels=None, target: float = 
     labels : sequence of str, optional
         Each frame's label (default "frame k", k from 1).
     target : float
-        The largest |r| the advised frames should reach.
+        The largest ``|r|`` the advised frames should reach.
     within : float
-        Without a set reaching ``target``: the advised frames' largest |r| is within this of all frames'.
+        Without a set reaching ``target``: the advised frames' largest ``|r|`` is within this of all frames'.
 
     Returns
     -------
