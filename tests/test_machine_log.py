@@ -338,3 +338,44 @@ def test_the_report_shows_the_synchronised_frames_on_the_load_curve(tmp_path):
     _, start, stop = data.blocks[1]
     view = field_view("field", info, data.y[start:stop], data.y[start:stop], None, "CMOD [mm]")
     assert "field_sync" in view.figures and view.png("field_sync")[:4] == b"\x89PNG"
+
+
+# ------------------------------------------------------------------------ fracid check writes the check figure
+
+
+def _check(config, out, *extra):
+    from fracid.cli.dispatch import main
+
+    return main(["check", str(config), "--no-time", "--out", str(out), *extra])
+
+
+def test_check_writes_the_synchronisation_figure_and_names_it(tmp_path, capsys):
+    from fracid.store.outputs import MANIFEST
+
+    stamps = 1e3 * (5.0 + 1e3 * CMOD)
+    config = _example_with_log(tmp_path, LOG_KEYS + 'frame_time_column = "t_ms"\nframe_time_unit = "ms"', stamps)
+    out = tmp_path / "out"
+    assert _check(config, out) == 0
+    figure = out / "check" / "field_sync.png"
+    assert figure.read_bytes()[:4] == b"\x89PNG" and "check" in (out / MANIFEST).read_text()
+    text = capsys.readouterr().out
+    assert f"check figure of 'field': {figure} (the frames on the machine log's load curve and clock, time stamps" \
+        in text
+    assert _check(config, out) == 0  # its own file: written again
+
+
+def test_check_without_a_log_writes_nothing(tmp_path):
+    config = _example_with_log(tmp_path, 'control_column = "cmod_mm"')
+    out = tmp_path / "out"
+    assert _check(config, out) == 0
+    assert not out.exists()
+
+
+def test_check_does_not_replace_a_check_directory_it_did_not_write(tmp_path, capsys):
+    stamps = 1e3 * (5.0 + 1e3 * CMOD)
+    config = _example_with_log(tmp_path, LOG_KEYS + 'frame_time_column = "t_ms"\nframe_time_unit = "ms"', stamps)
+    (tmp_path / "out" / "check").mkdir(parents=True)
+    (tmp_path / "out" / "check" / "field_sync.png").write_text("mine")
+    assert _check(config, tmp_path / "out") == 2
+    assert "was not written by fracid" in capsys.readouterr().err
+    assert (tmp_path / "out" / "check" / "field_sync.png").read_text() == "mine"

@@ -171,6 +171,9 @@ def run_check(args) -> int:
         method = build_method(cfg)
         plan = identify_plan(method, operator, data.n_y, len(cfg.identify.parameters), build_space(cfg))
         lines += data_lines(data, cfg) + identify_lines(cfg) + plan_lines(cfg, method, plan)
+        from fracid.cli.check_figures import check_figure_lines
+
+        lines += check_figure_lines(cfg, output_path(args, cfg), list(run_inputs(cfg)))
     else:
         lines.append("plan: fracid simulate, one forward run (no [[experiments]] and [identify]: nothing to identify)")
     print("\n".join(lines), flush=True)
