@@ -76,12 +76,21 @@ def data_lines(data, cfg=None) -> list:
 
             lines += exp.check_lines(build_specimen(cfg))
             continue
-        c, y, s = data.control[a:b], data.y[a:b], data.std[a:b]
-        unit = "N" if getattr(exp, "measures_force", True) else "mm"
-        lines.append(f"data block {name!r}: {b - a} points, control {c.min():.4g} to {c.max():.4g} mm, "
-                     f"peak {np.max(np.abs(y)):.4g} {unit}, std {s.min():.3g} to {s.max():.3g} {unit} "
-                     f"(mean {s.mean():.3g})")
+        lines.append(curve_block_line(name, exp, data.control[a:b], data.y[a:b], data.std[a:b]))
     return lines
+
+
+def curve_block_line(name: str, exp, control, y, std) -> str:
+    """A block of values over the control: points, control range, largest value, std, in the units the block
+    gives (``given_units``: its control and value units; mm and N or mm when it gives none), the control also
+    in mm when given in another unit. ``control`` [mm], ``y`` and ``std`` [N or mm] as the data holds them."""
+    internal = "N" if getattr(exp, "measures_force", True) else "mm"
+    (c_unit, c_scale), (unit, scale) = exp.given_units() if hasattr(exp, "given_units") else (("mm", 1.0),
+                                                                                               (internal, 1.0))
+    c, y, s = control / c_scale, y / scale, std / scale
+    in_mm = "" if c_unit == "mm" else f" ({control.min():.4g} to {control.max():.4g} mm)"
+    return (f"data block {name!r}: {len(y)} points, control {c.min():.4g} to {c.max():.4g} {c_unit}{in_mm}, "
+            f"peak {np.max(np.abs(y)):.4g} {unit}, std {s.min():.3g} to {s.max():.3g} {unit} (mean {s.mean():.3g})")
 
 
 def identify_lines(cfg) -> list:

@@ -75,6 +75,11 @@ class CurveExperimentConfig:
         """Multiplier from ``force_unit`` to N (force) or to mm (local quantity)."""
         return (FORCE_UNITS if self.measures_force else LOCAL_UNITS)[self.force_unit]
 
+    def given_units(self) -> tuple:
+        """((control unit, its multiplier to mm), (value unit, its multiplier to N or mm)) as the block gives
+        them (``control_unit``, ``force_unit``): what ``fracid check`` prints the block's values in."""
+        return (self.control_unit, self.control_scale), (self.force_unit, self.force_scale)
+
     @property
     def control_range_mm(self) -> tuple | None:
         """``control_range`` in mm."""
