@@ -53,3 +53,41 @@ def test_a_block_without_given_units_is_printed_in_mm_and_its_quantitys_unit():
                             np.array([1e-3, 2e-3]))
     assert line == ("data block 'opening': 2 points, control 0.01 to 0.2 mm, peak 0.004 mm, std 0.001 to 0.002 mm "
                     "(mean 0.0015)")
+
+
+# ------------------------------------------------------------------------ the frame ranking skipped, saying why
+
+
+@pytest.fixture(scope="module")
+def example():
+    from fracid.config import build_data, load_config
+
+    cfg = load_config(EXAMPLE / "identify.toml")
+    return cfg, build_data(cfg)
+
+
+def test_no_time_says_the_frames_are_not_ranked(example, tmp_path, capsys):
+    from fracid.cli.check_frames import skipped_ranking_lines
+    from fracid.cli.dispatch import main
+
+    assert main(["check", str(EXAMPLE / "identify.toml"), "--no-time", "--out", str(tmp_path / "out")]) == 0
+    assert "frames ranked: not computed (--no-time; it costs one run with exact sensitivities" in capsys.readouterr().out
+    cfg, data = example
+    curve_only = type("Data", (), {"blocks": [b for b in data.blocks if b[0] == "global"]})()
+    assert skipped_ranking_lines(cfg, curve_only) == []  # no block with frames: no line
+
+
+def test_a_model_without_exact_sensitivities_is_not_ranked_by_differences(example, space=None):
+    from fracid.cli.check_frames import frame_ranking_lines
+
+    cfg, data = example
+
+    class Operator:  # no differentiated version: central differences, 2 p + 1 runs
+        names = ["kappa_i", "beta", "c"]
+
+        def __call__(self, x):
+            raise AssertionError("no forward run may be made")
+
+    lines = frame_ranking_lines(cfg, data, Operator(), space)
+    assert lines == ["frames ranked: not computed (the model has no exact sensitivities: 7 runs by central "
+                     "differences; fracid sensitivity gives the information)"]

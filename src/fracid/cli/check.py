@@ -188,6 +188,10 @@ def run_check(args) -> int:
     print("\n".join(lines), flush=True)
     if args.no_time:
         print("time: not measured (--no-time)")
+        if operator is not None:
+            from fracid.cli.check_frames import skipped_ranking_lines
+
+            print("\n".join(skipped_ranking_lines(cfg, data)))
         return 0
     space = build_space(cfg) if operator is not None else None
     screening = next((s.operator for s in plan or [] if s.operator is not None), None)  # a population's coarse mesh

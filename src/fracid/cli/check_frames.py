@@ -1,4 +1,5 @@
-"""The frames a field block should keep, as ``fracid check`` prints them (unless ``--no-time``).
+"""The frames a field block should keep, as ``fracid check`` prints them (unless ``--no-time``, or the model
+has no exact sensitivities: then a line says why not).
 
 For every data block whose kind gives its frames' entries (``frame_slices``: a DIC field), one run with
 sensitivities at the configuration's parameters ranks the frames by their Fisher information
@@ -14,19 +15,36 @@ import time
 import numpy as np
 
 
+def framed_blocks(cfg, data) -> list:
+    """(name, first entry, experiment) of every data block whose kind gives its frames' entries."""
+    kinds = {getattr(exp, "name", None): exp for exp in cfg.experiments}
+    return [(name, a, kinds[name]) for name, a, _ in data.blocks if hasattr(kinds.get(name), "frame_slices")]
+
+
+def skipped_ranking_lines(cfg, data) -> list:
+    """The line that says the frames were not ranked under ``--no-time`` (none when no block has frames)."""
+    if not framed_blocks(cfg, data):
+        return []
+    return ["frames ranked: not computed (--no-time; it costs one run with exact sensitivities at "
+            "[model.parameters])"]
+
+
 def frame_ranking_lines(cfg, data, operator, space) -> list:
     """The ranking's lines of every block with frames (none when no block has frames)."""
     from fracid.config import build_parameters, build_specimen
-    from fracid.inverse.core.sensitivity import ForwardRunError, exact_sensitivity, sensitivity_label
+    from fracid.inverse.core.sensitivity import (DirectDifferentiation, ForwardRunError, exact_sensitivity,
+                                                 sensitivity_label)
     from fracid.inverse.studies.frame_information import frame_information, rank_frames
 
-    kinds = {getattr(exp, "name", None): exp for exp in cfg.experiments}
-    framed = [(name, a, kinds[name]) for name, a, _ in data.blocks if hasattr(kinds.get(name), "frame_slices")]
+    framed = framed_blocks(cfg, data)
     if not framed:
         return []
     params = build_parameters(cfg)
     x = np.array([getattr(params, name) for name in operator.names])
     evaluate, sensitivity = exact_sensitivity(operator)
+    if not isinstance(sensitivity, DirectDifferentiation):  # 2 p + 1 runs by differences: not a check's cost
+        return [f"frames ranked: not computed (the model has no exact sensitivities: {2 * len(x) + 1} runs by "
+                f"central differences; fracid sensitivity gives the information)"]
     start = time.perf_counter()
     try:
         _, S, _ = sensitivity(evaluate, x, None, None)
@@ -52,4 +70,4 @@ def frame_ranking_lines(cfg, data, operator, space) -> list:
     return lines
 
 
-__all__ = ["frame_ranking_lines"]
+__all__ = ["frame_ranking_lines", "framed_blocks", "skipped_ranking_lines"]
