@@ -99,9 +99,8 @@ def local_data(fit: FieldFit, line, radius: float) -> dict:
     n = fit.n_frames
     result = {"profile": (np.full((n, heights.size), np.nan), np.full((n, heights.size), np.nan)),
               "width": (np.full(n, np.nan), np.full(n, np.nan))}
-    samples = []
-    for k in range(n):
-        _, measured, computed = frame_displacements(fit, k)
+    samples, fields = [], [frame_displacements(fit, k)[1:] for k in range(n)]  # each frame's once
+    for k, (measured, computed) in enumerate(fields):
         for side, field in enumerate((measured, computed)):
             present = np.isfinite(field[:, normal])
             try:
@@ -114,8 +113,7 @@ def local_data(fit: FieldFit, line, radius: float) -> dict:
     threshold = WIDTH_THRESHOLD * max((float(np.nanmax(s)) for s in samples), default=0.0)
     if threshold > 0:
         strain = StrainTransects(line, heights, offsets, radius, threshold)
-        for k in range(n):
-            _, measured, computed = frame_displacements(fit, k)
+        for k, (measured, computed) in enumerate(fields):
             for side, field in enumerate((measured, computed)):
                 present = np.isfinite(field[:, normal])
                 try:

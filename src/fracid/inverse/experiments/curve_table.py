@@ -13,14 +13,10 @@ from pathlib import Path
 
 from fracid.data.sampling import SAMPLINGS
 from fracid.inverse.core.observations import FORCE
-from fracid.inverse.experiments.vocabulary import (BLOCK_KEYS, CONTROL_UNITS, FORCE_UNITS, FORMAT_KEYS,
+from fracid.inverse.experiments.vocabulary import (BLOCK_KEYS, choices_text, CONTROL_UNITS, FORCE_UNITS, FORMAT_KEYS,
                                                    LOCAL_UNITS, ROLES, file_format)
 from fracid.settings.checks import show
 from fracid.settings.keys import REQUIRED, UNSET, Key, Said
-
-def _words(values) -> str:
-    return " | ".join(f'"{value}"' for value in values)
-
 
 #: the keys of a curve block's table, each described (the column keys of every curve kind among them: a block refuses
 #: another kind's with a message naming its own; each kind lists its ``column_keys``)
@@ -28,8 +24,8 @@ CURVE_KEY_DOCS = {
     "file": Key(REQUIRED, "", "a CSV file path", "The data file: a CSV with a header row; relative to the "
                                                  "configuration file unless absolute."),
     "control_column": Key(REQUIRED, "", "a column name", "The column of the control quantity (CMOD, displacement ...)."),
-    "control_unit": Key(REQUIRED, "", _words(CONTROL_UNITS), "The unit of the control column (scaled to mm)."),
-    "force_unit": Key(REQUIRED, "", f"force: {_words(FORCE_UNITS)}; a local quantity: {_words(LOCAL_UNITS)}",
+    "control_unit": Key(REQUIRED, "", choices_text(CONTROL_UNITS), "The unit of the control column (scaled to mm)."),
+    "force_unit": Key(REQUIRED, "", f"force: {choices_text(FORCE_UNITS)}; a local quantity: {choices_text(LOCAL_UNITS)}",
                       "The unit of the measured values (scaled to N, a local quantity to mm)."),
     "kind": Key(REQUIRED, "", "a registered kind", "The kind of the block: which columns hold the data and how "
                                                    "their scatter is known."),
@@ -57,7 +53,7 @@ CURVE_KEY_DOCS = {
                                "The largest backtrack of the control column dropped as noise."),
     "negate": Key([], "", 'a list of "control" and/or "force"', "The columns the machine records with a negative "
                                                                 "sign, multiplied by -1."),
-    "sampling": Key(SAMPLINGS[0], "", _words(SAMPLINGS),
+    "sampling": Key(SAMPLINGS[0], "", choices_text(SAMPLINGS),
                     '"equally-spaced": n_points equally spaced control values, the one nearest the measured peak '
                     'moved onto it; "measured": the measured points themselves, all if at most n_points, else '
                     "n_points of them by arc length along the normalised curve (ends and peak kept)."),

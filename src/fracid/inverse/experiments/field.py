@@ -28,7 +28,7 @@ import numpy as np
 from fracid.data.covariance import STD_ALLOWED, usable_std
 from fracid.data.dic.formats import FORMATS
 from fracid.inverse.experiments.field_log import (LOG_KEY_DOCS, read_log_settings)
-from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, FORMAT_KEYS, ROLES, file_format
+from fracid.inverse.experiments.vocabulary import BLOCK_KEYS, FORMAT_KEYS, ROLES, choices_text, file_format
 from fracid.settings.checks import show
 from fracid.settings.keys import REQUIRED, UNSET, Key, Said
 
@@ -52,7 +52,7 @@ FIELD_KEY_DOCS = {
     "min_quality": Key(UNSET, "", "a number; needs quality", "Points of lower quality are dropped."),
     "coordinate_unit": Key(Said("mm, or the format's unit"), "", '"mm" | "px" (needs the placement)',
                            "The unit of the clouds' coordinates."),
-    "format": Key("generic", "", " | ".join(f'"{name}"' for name in FORMATS),
+    "format": Key("generic", "", choices_text(FORMATS),
                   "The export's layout (fracid.data.dic.formats): its columns and unit become the defaults of the "
                   "column keys and coordinate_unit; dice drops failed subsets (SIGMA = -1) and counts them."),
     "scale": Key(UNSET, "mm per camera unit", "> 0", f"{_PLACEMENT}: its scale."),

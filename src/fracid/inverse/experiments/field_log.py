@@ -21,14 +21,10 @@ import numpy as np
 
 from fracid.data.errors import DataError
 from fracid.data.machine_log import FORCE_UNITS, LENGTH_UNITS, TIME_UNITS
-from fracid.inverse.experiments.vocabulary import file_format
+from fracid.inverse.experiments.vocabulary import choices_text, file_format
 from fracid.settings.keys import UNSET, Key, Said
 
 _WITH_LOG = Said("required with machine_log")
-
-
-def _words(values) -> str:
-    return " | ".join(f'"{value}"' for value in values)
 
 
 #: the keys of a field block's machine log, each described
@@ -36,17 +32,17 @@ LOG_KEY_DOCS = {
     "machine_log": Key(UNSET, "", "a CSV file path", "The testing machine's log (time, control, force): each frame's "
                        "control and force are read from it at the frame's time (control_column is then not given)."),
     "log_time_column": Key(_WITH_LOG, "", "a column name", "The log's column of the time."),
-    "log_time_unit": Key("s", "", _words(TIME_UNITS), "The unit of the log's time."),
+    "log_time_unit": Key("s", "", choices_text(TIME_UNITS), "The unit of the log's time."),
     "log_control_column": Key(_WITH_LOG, "", "a column name", "The log's column of the control quantity (the "
                               "specimen's, e.g. the CMOD; with synchronise = \"opening\" it must be the CMOD)."),
-    "log_control_unit": Key("mm", "", _words(LENGTH_UNITS), "The unit of the log's control column."),
+    "log_control_unit": Key("mm", "", choices_text(LENGTH_UNITS), "The unit of the log's control column."),
     "log_force_column": Key(UNSET, "", "a column name", "The log's column of the force (shown on the check figure)."),
-    "log_force_unit": Key("N", "", _words(FORCE_UNITS), "The unit of the log's force column."),
+    "log_force_unit": Key("N", "", choices_text(FORCE_UNITS), "The unit of the log's force column."),
     "log_delimiter": Key(Said("the block's delimiter"), "", "as delimiter", "The cell separator of the log."),
     "log_decimal": Key(Said("the block's decimal"), "", "as decimal", "The decimal mark of the log."),
     "frame_time_column": Key(UNSET, "", "a column name; this or frame_rate",
                              "The frame table's column of each frame's time stamp."),
-    "frame_time_unit": Key("s", "", _words(TIME_UNITS), "The unit of frame_time_column."),
+    "frame_time_unit": Key("s", "", choices_text(TIME_UNITS), "The unit of frame_time_column."),
     "frame_rate": Key(UNSET, "frames per s", "> 0; this or frame_time_column",
                       "Frame number i is taken at trigger_offset + i / frame_rate."),
     "trigger_offset": Key(Said("0 with frame_time_column; required with frame_rate"), "s", "a number",

@@ -9,6 +9,11 @@ from __future__ import annotations
 
 from fracid.settings.keys import Key
 
+
+def choices_text(values) -> str:
+    """The allowed values of a key as its description writes them: ``"a" | "b"``."""
+    return " | ".join(f'"{value}"' for value in values)
+
 #: ``control_unit`` -> multiplier to mm
 CONTROL_UNITS = {"mm": 1.0, "um": 1e-3, "m": 1e3}
 #: ``delimiter`` values -> the cell separator ("tab" spells a tab; " " is any run of whitespace)
@@ -56,5 +61,5 @@ def file_format(ck, prefix: str, raw: dict, stem: str = "", default: tuple = (",
     return delimiter, decimal
 
 
-__all__ = ["BLOCK_KEYS", "CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE_UNITS", "FORMAT_KEYS", "LOCAL_UNITS", "ROLES",
+__all__ = ["choices_text", "BLOCK_KEYS", "CONTROL_UNITS", "DECIMALS", "DELIMITERS", "FORCE_UNITS", "FORMAT_KEYS", "LOCAL_UNITS", "ROLES",
            "file_format"]
