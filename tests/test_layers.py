@@ -18,6 +18,7 @@ FLOORS = {
     "report": 4,
     "config": 5,
     "datasets": 5,  # datasets.load reads a data set through its configuration
+    "exchange": 5,  # export reads results and models, serve builds the configuration's operator
     "cli": 6, "__main__": 6, "__init__": 6,
 }
 
