@@ -23,6 +23,9 @@
     fracid check CONFIG       validate a configuration and print its plan and cost (:mod:`fracid.cli.check`)
     fracid datasets           the bundled data sets by name; fracid init --dataset NAME writes one's configuration
                               (:mod:`fracid.cli.datasets`)
+    fracid export RESULT --to FORMAT
+                              the identified parameters as material input for another code: Abaqus, DIANA, a CSV
+                              table of the traction-separation law (:mod:`fracid.cli.export`)
     fracid --version
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
@@ -48,7 +51,7 @@ __all__ = ["COMMANDS", "main", "version"]
 #: ``add_parser(sub, parents)`` (``parents.common``: the options of every command; ``parents.stored``: those
 #: and ``--store``), which sets the subparser's ``run`` (args -> exit status)
 COMMANDS = ("simulate", "identify", "posterior", "studies", "identify:add_demo_parser", "init", "check", "compare",
-            "datasets")
+            "datasets", "export")
 
 
 def _parents() -> SimpleNamespace:

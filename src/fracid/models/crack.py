@@ -12,6 +12,7 @@ from fracid.fem.formulations.cohesive_problem import CohesiveCrackProblem, crack
 from fracid.fem.formulations.crack_band_problem import CrackBandProblem, element_extent
 from fracid.fem.material.laws import TRACTION_SEPARATION_LAWS, HordijkLaw
 from fracid.fem.material.tsl import differentiable as gives_derivatives
+from fracid.models.cohesive_law import law_table
 from fracid.models.path_model import PathFollowingModel
 from fracid.models.protocol import SpecimenStart
 from fracid.specimens.description import at_points, conditions, described, discretize
@@ -50,6 +51,10 @@ class CrackModel(PathFollowingModel):
         """Why the specimen's crack path does not suit this model, or None."""
         return None
 
+    def cohesive_law(self, params):
+        """Its own law at ``params`` as a table (:func:`~fracid.models.cohesive_law.law_table`)."""
+        return law_table(self.law, params)
+
 
 @dataclass(frozen=True)
 class CohesiveCrackModel(CrackModel):
@@ -61,6 +66,9 @@ class CohesiveCrackModel(CrackModel):
 
     penalty_factor: float = 1000.0
     law: HordijkLaw = HordijkLaw()
+
+    #: another code represents it by interface elements
+    crack_representation: ClassVar[str] = "discrete"
 
     @property
     def key(self) -> str:

@@ -9,6 +9,7 @@ from typing import ClassVar
 from fracid.fem.formulations.fpz import zone_width_observer
 from fracid.fem.formulations.problem import FORMULATIONS
 from fracid.fem.material.laws import DAMAGE_LAWS, DamageLaw
+from fracid.models.cohesive_law import equivalent_law_on_bar
 from fracid.models.path_model import PathFollowingModel
 from fracid.models.protocol import BandWidth, MeshLength
 from fracid.specimens.description import at_points, conditions, described, discretize, uniform
@@ -108,3 +109,22 @@ class DamageModel(PathFollowingModel):
         return {zone.name: zone_width_observer(zone, law.softening.kappa_at_damage(damage_threshold, params),
                                                lambda names: law.kappa_at_damage_derivatives(damage_threshold, params,
                                                                                              names))}
+
+    def cohesive_law(self, params):
+        """The cohesive law it dissipates like, from a bar 4 band widths long (2 pi sqrt(c) each) with elements of
+        an eighth of the internal length l = sqrt(2 c) (its energy within 0.1 % of a mesh twice finer, measured at the
+        defaults: tests/test_export.py) (:func:`~fracid.models.cohesive_law.equivalent_law_on_bar`). Local damage
+        has none: the energy it dissipates depends on the element size.
+
+        Raises
+        ------
+        ValueError
+            For local damage.
+        """
+        if self.band_width is None:
+            raise ValueError("local damage has no cohesive law: the energy it dissipates depends on the element "
+                             "size (identify the crack band or a regularised damage model instead)")
+        c = params.c
+        width = self.band_width.factor * c ** self.band_width.exponent
+        return equivalent_law_on_bar(self, params, width, 0.125 * self.mesh_length.length(c),
+                                     f"{self.regularization} damage")

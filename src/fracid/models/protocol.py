@@ -119,8 +119,11 @@ class ForwardModel(Protocol):
     first_identified: tuple | None
     specimen_starts: Mapping
     needs_description: bool
+    crack_representation: str
 
     def simulate(self, specimen, params, **options): ...
+
+    def cohesive_law(self, params): ...
 
     def runs_on(self, specimen) -> bool: ...
 
@@ -159,7 +162,17 @@ class ModelDefaults:
     #: ``describe()`` or a :class:`~fracid.specimens.description.Description`; False: it checks its own specimens
     needs_description: ClassVar[bool] = False
 
+    #: how another code represents its crack: ``"discrete"`` (an interface with a traction-separation law) or
+    #: ``"smeared"`` (a continuum whose softening is scaled by a crack band width); ``fracid export`` writes that
+    crack_representation: ClassVar[str] = "smeared"
+
     def why_not(self, specimen) -> str | None:
+        return None
+
+    def cohesive_law(self, params):
+        """The traction-separation law it stands for at ``params``
+        (:class:`~fracid.models.cohesive_law.CohesiveLawTable`), None: it declares none (``fracid export`` then
+        refuses it); raises ValueError saying why when it has none at all."""
         return None
 
     def runs_on(self, specimen) -> bool:

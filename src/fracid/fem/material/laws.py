@@ -256,6 +256,10 @@ class BilinearSoftening(ShapeLaw):
     def steepest_shape_slope(self, params) -> float:
         return max((1.0 - params.psi) / params.chi, params.psi / (1.0 - params.chi))
 
+    def kinks(self, params) -> tuple:
+        """The opening of the kink, w1 = chi wc [mm] (a table of the law keeps it)."""
+        return (params.chi * self.critical_opening(params),)
+
 
 #: The traction-separation laws by name (a configuration's or a user's choice of law for the crack models)
 TRACTION_SEPARATION_LAWS = {law.name: law for law in (HordijkLaw, LinearSoftening, BilinearSoftening)}
