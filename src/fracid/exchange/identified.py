@@ -34,6 +34,8 @@ class Identified:
         The identification's status (``"converged"``, ...).
     source : str
         One line: the result file, the command, the date and the fracid version.
+    covariance : ndarray or None
+        The estimate's covariance, in the order of ``std``.
     """
 
     model: object
@@ -43,6 +45,7 @@ class Identified:
     units: dict
     status: str
     source: str
+    covariance: np.ndarray | None = None
 
     def value_text(self, name: str) -> str:
         """``name = value unit (identified, std s)`` or ``(fixed)``, for a comment line."""
@@ -96,9 +99,10 @@ def read_identified(path) -> Identified:
         params = model.parameters(**{k: v for k, v in values.items() if k in model.parameters.names()})
     except (TypeError, ValueError) as err:
         raise UsageError(f"{path}: the parameters do not make a {model_type} model: {err}") from None
-    std = dict(zip(names, np.sqrt(np.clip(np.diag(np.asarray(data.get("C"), float)), 0.0, None)).tolist())) \
-        if data.get("C") is not None else {}
+    C = None if data.get("C") is None else np.array([[np.nan if v is None else v for v in row] for row in data["C"]],
+                                                    float)
+    std = {} if C is None else dict(zip(names, np.sqrt(np.clip(np.diag(C), 0.0, None)).tolist()))
     prov = data.get("provenance") or {}
     source = (f"{path.resolve()} ({prov.get('command', 'fracid identify')}, {prov.get('date', 'date unknown')}, "
               f"fracid {prov.get('fracid', '?')})")
-    return Identified(model, model_type, params, std, parameter_units(model), str(data.get("status", "?")), source)
+    return Identified(model, model_type, params, std, parameter_units(model), str(data.get("status", "?")), source, C)
