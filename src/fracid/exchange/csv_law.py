@@ -16,9 +16,8 @@ def write_csv(identified, table, units) -> str:
     """The CSV text: ``#`` comment lines (:func:`~fracid.exchange.header.header_lines`), then
     ``opening_<length>,traction_<stress>`` and one row per point."""
     head = header_lines(identified, table, units, "traction-separation law (opening, traction) as a table")
-    w = units.converted(1.0, "mm")[0] * table.opening
-    sigma = units.converted(1.0, "MPa")[0] * table.traction
-    rows = [f"{a:.9g},{b:.9g}" for a, b in zip(w, sigma)]
+    converted = table.scaled(units.to_length, units.to_stress)
+    rows = [f"{a:.9g},{b:.9g}" for a, b in zip(converted.opening, converted.traction)]
     return "\n".join([*(f"# {line}" for line in head), f"opening_{units.length},traction_{units.stress}", *rows]) + "\n"
 
 

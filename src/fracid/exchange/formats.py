@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+from fracid.exchange.abaqus import write_abaqus
 from fracid.exchange.csv_law import write_csv
 
 #: ``--as``: the crack as an interface with a traction-separation law, or smeared over a band of elements
@@ -45,4 +46,7 @@ def _csv(identified, table, units, representation) -> str:
 EXPORT_FORMATS = {
     "csv": ExportFormat("a CSV table", ".csv", _csv, REPRESENTATIONS,
                         "the traction-separation law (opening, traction), whatever the representation"),
+    "abaqus": ExportFormat("Abaqus", ".inp", write_abaqus, REPRESENTATIONS,
+                           "discrete: a cohesive interface with tabular damage evolution; smeared: concrete damaged "
+                           "plasticity with tension stiffening by cracking displacement"),
 }

@@ -72,6 +72,10 @@ class CohesiveLawTable:
         """The last opening of the table [mm]."""
         return float(self.opening[-1])
 
+    def scaled(self, length: float, stress: float) -> "CohesiveLawTable":
+        """The table in other units: openings times ``length``, tractions times ``stress``."""
+        return CohesiveLawTable(length * self.opening, stress * self.traction, self.relation, self.law, self.how)
+
 
 def law_table(law, params, points: int = TABLE_POINTS) -> CohesiveLawTable:
     """The table of a traction-separation law at ``params``: ``points`` equally spaced openings from 0 to wc, and

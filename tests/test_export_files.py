@@ -1,0 +1,78 @@
+"""The Abaqus and DIANA files of ``fracid export`` parsed back by small readers: keywords, tables and units carry the
+values of result.json."""
+
+import numpy as np
+import pytest
+
+from fracid.exchange.export import export_text
+from fracid.models.registry import model_from_type
+from test_export import CRACK, DAMAGE, write_result
+
+SI = {"length": 1e-3, "stress": 1e6, "energy": 1e3}
+MM = {"length": 1.0, "stress": 1.0, "energy": 1.0}
+
+
+def abaqus_blocks(text):
+    """[(keyword, {parameter: value}, rows)] of an Abaqus input: ``**`` comments skipped, a row a list of floats."""
+    blocks = []
+    for line in text.splitlines():
+        if line.startswith("**") or not line.strip():
+            continue
+        if line.startswith("*"):
+            name, *options = [part.strip() for part in line[1:].split(",")]
+            blocks.append((name.upper(), dict(o.split("=", 1) if "=" in o else (o, "") for o in options), []))
+        else:
+            blocks[-1][2].append([float(v) for v in line.split(",") if v.strip()])
+    return blocks
+
+
+def block(blocks, name, **options):
+    found = [rows for n, opts, rows in blocks if n == name and all(opts.get(k) == v for k, v in options.items())]
+    assert len(found) == 1, (name, options, [b[:2] for b in blocks])
+    return np.array(found[0])
+
+
+CASES = [("cohesive-crack", CRACK, ("ft", "Gf")), ("crack-band", CRACK, ("ft", "Gf")),
+         ("gradient-damage", DAMAGE, ("kappa_i", "beta", "c"))]
+
+
+@pytest.mark.parametrize("units, scale", [("N-mm-MPa", MM), ("N-m-Pa", SI)], ids=["mm", "m"])
+@pytest.mark.parametrize("model_type, values, identified", CASES, ids=[c[0] for c in CASES])
+def test_the_abaqus_cohesive_interface_gives_back_the_law(tmp_path, model_type, values, identified, units, scale):
+    law = model_from_type(model_type).cohesive_law(model_from_type(model_type).parameters(**values))
+    blocks = abaqus_blocks(export_text(write_result(tmp_path, model_type, values, identified), "abaqus", units,
+                                       representation="discrete"))
+    K = block(blocks, "ELASTIC", TYPE="TRACTION")[0]
+    strengths = block(blocks, "DAMAGE INITIATION", CRITERION="MAXS")[0]
+    table = block(blocks, "DAMAGE EVOLUTION", TYPE="DISPLACEMENT", SOFTENING="TABULAR")
+    assert np.allclose(strengths, law.strength * scale["stress"], rtol=1e-10) and np.all(K == K[0])
+    damage, u = table[:, 0], table[:, 1]
+    assert damage[0] == 0.0 and damage[-1] == pytest.approx(1.0) and np.all(np.diff(damage) >= 0)
+    traction = (1.0 - damage) * K[0] * (strengths[0] / K[0] + u)  # t = (1 - D) K delta, delta = delta0 + u
+    assert np.allclose(traction, law.traction * scale["stress"], rtol=1e-8, atol=1e-9 * strengths[0])
+    assert np.trapezoid(traction, u) == pytest.approx(law.fracture_energy * scale["energy"], rel=1e-8)
+
+
+@pytest.mark.parametrize("units, scale", [("N-mm-MPa", MM), ("N-m-Pa", SI)], ids=["mm", "m"])
+@pytest.mark.parametrize("model_type, values, identified", CASES, ids=[c[0] for c in CASES])
+def test_the_abaqus_concrete_damaged_plasticity_keeps_the_law_and_its_energy(tmp_path, model_type, values, identified,
+                                                                              units, scale):
+    law = model_from_type(model_type).cohesive_law(model_from_type(model_type).parameters(**values))
+    blocks = abaqus_blocks(export_text(write_result(tmp_path, model_type, values, identified), "abaqus", units,
+                                       representation="smeared"))
+    assert [b[0] for b in blocks][:1] == ["MATERIAL"]
+    E, nu = block(blocks, "ELASTIC")[0]
+    assert E == pytest.approx(values["E"] * scale["stress"]) and nu == values["nu"]
+    assert block(blocks, "CONCRETE DAMAGED PLASTICITY").shape == (1, 5)
+    assert block(blocks, "CONCRETE COMPRESSION HARDENING").shape[1] == 2
+    stiffening = block(blocks, "CONCRETE TENSION STIFFENING", TYPE="DISPLACEMENT")
+    assert stiffening[0, 1] == 0.0 and stiffening[0, 0] == pytest.approx(law.strength * scale["stress"])
+    assert np.trapezoid(stiffening[:, 0], stiffening[:, 1]) == pytest.approx(law.fracture_energy * scale["energy"],
+                                                                             rel=1e-8)
+    damage = block(blocks, "CONCRETE TENSION DAMAGE", TYPE="DISPLACEMENT")
+    assert np.array_equal(damage[:, 1], stiffening[:, 1]) and damage[0, 0] == 0.0
+    assert np.all(np.diff(damage[:, 0]) >= 0) and damage[:, 0].max() <= 0.99
+    # below the cap the plastic displacement u_ck - d / (1 - d) sigma l0 / E0 (l0 = 1 length unit) is zero: secant
+    below = damage[:, 0] < 0.99
+    plastic = stiffening[:, 1] - damage[:, 0] / (1 - damage[:, 0]) * stiffening[:, 0] / E
+    assert np.allclose(plastic[below], 0.0, atol=1e-9 * stiffening[-1, 1])
