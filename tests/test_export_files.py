@@ -76,3 +76,64 @@ def test_the_abaqus_concrete_damaged_plasticity_keeps_the_law_and_its_energy(tmp
     below = damage[:, 0] < 0.99
     plastic = stiffening[:, 1] - damage[:, 0] / (1 - damage[:, 0]) * stiffening[:, 0] / E
     assert np.allclose(plastic[below], 0.0, atol=1e-9 * stiffening[-1, 1])
+
+
+def diana_parameters(text):
+    """{path: value} of the ``setParameter( MATERIAL, name, path, value )`` commands (comments skipped) and the
+    ``addMaterial`` arguments."""
+    import ast
+
+    values, material = {}, None
+    for line in text.splitlines():
+        line = line.strip()
+        if line.startswith("addMaterial("):
+            material = ast.literal_eval(line[len("addMaterial"):])
+        elif line.startswith("setParameter("):
+            _, name, path, value = (part.strip() for part in line[len("setParameter("):-1].split(","))
+            values[ast.literal_eval(path)] = ast.literal_eval(value)
+    return material, values
+
+
+@pytest.mark.parametrize("units, scale", [("N-mm-MPa", MM), ("N-m-Pa", SI)], ids=["mm", "m"])
+@pytest.mark.parametrize("model_type, law, values, curve, words", [
+    ("crack-band", None, CRACK, "HORDYK", "the same law"),
+    ("crack-band", "linear", {k: CRACK[k] for k in ("E", "nu", "ft", "Gf")}, "LINEAR", "the same law"),
+    ("cohesive-crack", None, {**CRACK, "c2": 5.0}, "HORDYK", "APPROXIMATION"),
+    ("gradient-damage", None, DAMAGE, "HORDYK", "APPROXIMATION"),
+], ids=["hordijk", "linear", "other-hordijk", "gradient-damage"])
+def test_the_diana_total_strain_crack_carries_strength_energy_and_curve(tmp_path, model_type, law, values, curve,
+                                                                        words, units, scale):
+    model = model_from_type(model_type, law)
+    table = model.cohesive_law(model.parameters(**values))
+    text = export_text(write_result(tmp_path, model_type, values, ("ft", "Gf") if "ft" in values else ("kappa_i",),
+                                    law=law), "diana", units)
+    material, parameters = diana_parameters(text)
+    assert material[1:3] == ("CONCR", "TSCR")
+    assert parameters["MODTYP/TOTCRK"] == "ROTATE" and parameters["TENSIL/TENCRV"] == curve
+    assert parameters["TENSIL/TENSTR"] == pytest.approx(table.strength * scale["stress"], rel=1e-10)
+    assert parameters["TENSIL/GF1"] == pytest.approx(table.fracture_energy * scale["energy"], rel=1e-10)
+    assert parameters["LINEAR/ELASTI/YOUNG"] == pytest.approx(values["E"] * scale["stress"])
+    assert parameters["LINEAR/ELASTI/POISON"] == values["nu"]
+    assert words in text and ("EQUIVALENCE" in text) == (model_type == "gradient-damage")
+    assert ("representation: smeared, while the cohesive-crack model's crack is discrete" in text) == \
+        (model_type == "cohesive-crack")
+
+
+def test_the_shape_difference_diana_reports_is_zero_for_its_own_curve_and_large_for_another():
+    from fracid.exchange.diana import shape_difference
+    from fracid.fem.material.laws import BilinearSoftening, HordijkLaw
+    from fracid.models.cohesive_law import law_table
+
+    hordijk = HordijkLaw()
+    assert shape_difference(law_table(hordijk, hordijk.parameters(**CRACK)), "HORDYK") < 1e-3
+    bilinear = BilinearSoftening()
+    table = law_table(bilinear, bilinear.parameters(E=3e4, nu=0.2, ft=3.0, Gf=0.1))
+    assert shape_difference(table, "HORDYK") > 0.05
+    assert shape_difference(table, "LINEAR") > shape_difference(table, "HORDYK")
+
+
+def test_diana_refuses_a_discrete_crack_asked_for_and_says_why(tmp_path):
+    from fracid.runtime.exits import UsageError
+
+    with pytest.raises(UsageError, match="smeared only"):
+        export_text(write_result(tmp_path, "cohesive-crack", CRACK, ("ft", "Gf")), "diana", representation="discrete")

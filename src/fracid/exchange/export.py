@@ -38,15 +38,22 @@ def export_text(result, to: str, units: str = "N-mm-MPa", representation: str | 
     fmt = _choice(to, EXPORT_FORMATS, "--to")
     system = _choice(units, UNIT_SYSTEMS, "--units")
     identified = read_identified(result)
-    kind = identified.model.crack_representation if representation is None else \
-        _choice(representation, REPRESENTATIONS, "--as")
+    own = identified.model.crack_representation
+    kind = own if representation is None else _choice(representation, REPRESENTATIONS, "--as")
     if kind not in fmt.representations:
-        raise UsageError(f"--to {to} --as {kind}: {fmt.name} writes {' or '.join(fmt.representations)} cracks only "
-                         f"({fmt.representations_note})")
+        if representation is not None:
+            raise UsageError(f"--to {to} --as {kind}: {fmt.name} writes {' or '.join(fmt.representations)} cracks "
+                             f"only ({fmt.representations_note})")
+        kind = fmt.representations[0]
     try:
         table = identified.model.cohesive_law(identified.params)
     except ValueError as err:
         raise UsageError(f"{result}: {err}") from None
     if table is None:
         raise UsageError(f"{result}: the {identified.model_type} model declares no cohesive law to export")
-    return fmt.write(identified, table, system, kind)
+    text = fmt.write(identified, table, system, kind)
+    if kind == own:
+        return text
+    first, rest = text.split("\n", 1)
+    return (f"{first}\n{fmt.comment} representation: {kind}, while the {identified.model_type} model's crack is {own}: "
+            f"the same law, spread over the code's crack band\n{rest}")

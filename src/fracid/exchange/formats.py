@@ -8,6 +8,7 @@ from typing import Callable
 
 from fracid.exchange.abaqus import write_abaqus
 from fracid.exchange.csv_law import write_csv
+from fracid.exchange.diana import write_diana
 
 #: ``--as``: the crack as an interface with a traction-separation law, or smeared over a band of elements
 REPRESENTATIONS = ("discrete", "smeared")
@@ -29,6 +30,8 @@ class ExportFormat:
         The representations of :data:`REPRESENTATIONS` it writes.
     representations_note : str
         What each representation becomes in the code (``fracid export --help``, the docs).
+    comment : str
+        What starts a comment line in the file.
     """
 
     name: str
@@ -36,6 +39,7 @@ class ExportFormat:
     write: Callable
     representations: tuple
     representations_note: str
+    comment: str
 
 
 def _csv(identified, table, units, representation) -> str:
@@ -45,8 +49,12 @@ def _csv(identified, table, units, representation) -> str:
 #: ``--to`` of ``fracid export``: format name -> :class:`ExportFormat`
 EXPORT_FORMATS = {
     "csv": ExportFormat("a CSV table", ".csv", _csv, REPRESENTATIONS,
-                        "the traction-separation law (opening, traction), whatever the representation"),
+                        "the traction-separation law (opening, traction), whatever the representation", "#"),
     "abaqus": ExportFormat("Abaqus", ".inp", write_abaqus, REPRESENTATIONS,
                            "discrete: a cohesive interface with tabular damage evolution; smeared: concrete damaged "
-                           "plasticity with tension stiffening by cracking displacement"),
+                           "plasticity with tension stiffening by cracking displacement", "**"),
+    "diana": ExportFormat("DIANA", ".py", write_diana, ("smeared",),
+                          "smeared only: the total strain crack model with its tension softening curve, as DIANA "
+                          "Python commands; DIANA's interface elements are not written (their keywords were not "
+                          "confirmed)", "#"),
 }
