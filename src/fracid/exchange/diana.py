@@ -3,9 +3,9 @@
 
 DIANA's tension softening curves are named, not tabulated here: Hordijk's (``HORDYK``, with Hordijk's constants c1 = 3,
 c2 = 6.93) and the linear one (``LINEAR``) take the strength ``TENSTR`` and the mode-I fracture energy ``GF1``, and
-DIANA scales them by its crack band width. A law of another shape (another c1, c2, a bilinear law, a continuum
-model's equivalent law) is written as DIANA's Hordijk curve with the same strength and energy, and the file says how
-far the shapes differ (:func:`shape_difference`). The multilinear curve of DIANA (a table in stress and crack
+DIANA scales them by its crack band width. The table is compared with both (:func:`shape_difference`): within
+0.2 % of ft it is that curve; a law of another shape (another c1, c2, a bilinear law, a continuum model's equivalent
+law) is written as the closest curve with the same strength and energy, and the file says how far the shapes differ. The multilinear curve of DIANA (a table in stress and crack
 strain) is not written: its keywords were not confirmed in a documented source.
 """
 
@@ -17,37 +17,38 @@ from fracid.exchange.header import header_lines
 from fracid.fem.material.laws import HordijkLaw, LinearSoftening
 from fracid.fem.material.tsl import ShapeLaw
 
-#: fracid's laws that DIANA has by name: the DIANA curve and the shape parameters its own curve fixes
-NATIVE = {"hordijk": ("HORDYK", {"c1": 3.0, "c2": 6.93}), "linear": ("LINEAR", {})}
-#: DIANA's curve for any other shape (same ft and Gf)
-FALLBACK = "HORDYK"
+#: DIANA's tension softening curves fracid writes, as fracid's laws of the same shape (DIANA's Hordijk curve has
+#: Hordijk's constants, fracid's law's defaults)
+DIANA_CURVES = {"HORDYK": HordijkLaw, "LINEAR": LinearSoftening}
+#: a table within this of a DIANA curve (in ft) is that curve: the table's own sampling error is 0.06 % of ft
+SAME_SHAPE = 2e-3
 MATERIAL = "FRACID_CONCRETE"
 
 
 def shape_difference(table, curve: str) -> float:
     """The largest difference between the table and DIANA's ``curve`` at the table's ft and Gf, in ft [-]."""
-    law: ShapeLaw = HordijkLaw() if curve == "HORDYK" else LinearSoftening()
+    law: ShapeLaw = DIANA_CURVES[curve]()
     params = law.parameters(E=1.0, nu=0.0, ft=table.strength, Gf=table.fracture_energy)
     w = np.linspace(0.0, max(table.critical_opening, law.critical_opening(params)), 2001)
     mine = np.interp(w, table.opening, table.traction, right=0.0)
     return float(np.max(np.abs(law.traction(w, params)[0] - mine)) / table.strength)
 
 
-def diana_curve(identified, table) -> tuple[str, str]:
-    """(DIANA's curve, a sentence on how it matches the table)."""
-    law = getattr(identified.model, "law", None)
-    native = NATIVE.get(getattr(law, "name", None)) if table.relation == "same" else None
-    if native is not None and all(np.isclose(getattr(identified.params, k), v) for k, v in native[1].items()):
-        return native[0], f"the same law: DIANA's {native[0]} curve is fracid's {law.name} law"
-    difference = shape_difference(table, FALLBACK)
-    return FALLBACK, (f"APPROXIMATION: DIANA's {FALLBACK} curve with the table's strength and fracture energy; its "
-                      f"shape differs from the table by {difference:.1%} of ft at most (the whole table: fracid export "
-                      "--to csv)")
+def diana_curve(table) -> tuple[str, str]:
+    """(DIANA's curve closest in shape to the table, a sentence on how it matches)."""
+    differences = {curve: shape_difference(table, curve) for curve in DIANA_CURVES}
+    curve = min(differences, key=differences.get)
+    if differences[curve] <= SAME_SHAPE:
+        return curve, (f"the same law: DIANA's {curve} curve at the table's strength and fracture energy is within "
+                       f"{differences[curve]:.2%} of ft of it")
+    return curve, (f"APPROXIMATION: DIANA's {curve} curve (the closest of {', '.join(DIANA_CURVES)}) with the table's "
+                   f"strength and fracture energy; its shape differs from the table by {differences[curve]:.1%} of ft "
+                   "at most (the whole table: fracid export --to csv)")
 
 
 def write_diana(identified, table, units, representation) -> str:
     """The DIANA Python command script (``#`` comments): elasticity, total strain rotating crack, tension softening."""
-    curve, how = diana_curve(identified, table)
+    curve, how = diana_curve(table)
     E, _ = units.converted(identified.params.E, "MPa")
     ft, _ = units.converted(table.strength, "MPa")
     gf, _ = units.converted(table.fracture_energy, "N/mm")
