@@ -49,7 +49,10 @@ def test_the_abaqus_cohesive_interface_gives_back_the_law(tmp_path, model_type, 
     damage, u = table[:, 0], table[:, 1]
     assert damage[0] == 0.0 and damage[-1] == pytest.approx(1.0) and np.all(np.diff(damage) >= 0)
     traction = (1.0 - damage) * K[0] * (strengths[0] / K[0] + u)  # t = (1 - D) K delta, delta = delta0 + u
-    assert np.allclose(traction, law.traction * scale["stress"], rtol=1e-8, atol=1e-9 * strengths[0])
+    expected = np.interp(u, law.opening * scale["length"], law.traction * scale["stress"])
+    assert np.allclose(traction, expected, rtol=1e-8, atol=1e-9 * strengths[0])
+    nearest = np.min(np.abs(law.opening[:, None] * scale["length"] - u[None, :]), axis=1)
+    assert np.all(nearest <= 1e-9 * u[-1])  # the law's own points are rows
     assert np.trapezoid(traction, u) == pytest.approx(law.fracture_energy * scale["energy"], rel=1e-8)
 
 
@@ -140,3 +143,24 @@ def test_diana_refuses_a_discrete_crack_asked_for_and_says_why(tmp_path):
 
     with pytest.raises(UsageError, match="smeared only"):
         export_text(write_result(tmp_path, "cohesive-crack", CRACK, ("ft", "Gf")), "diana", representation="discrete")
+
+
+@pytest.mark.parametrize("model_type, values", [("cohesive-crack", CRACK), ("gradient-damage", DAMAGE)])
+def test_abaqus_interpolating_the_damage_table_between_rows_keeps_the_traction(model_type, values):
+    """Abaqus interpolates D linearly between rows: at every quarter of every row interval the traction (1 - D) K
+    (delta0 + u) stays within 0.1 % of ft of the law; the law's own openings alone would be off by far more (1 - D
+    falls over a few delta0, which 101 equal rows do not resolve)."""
+    from fracid.exchange.abaqus import STIFFNESS_IN_LAW_SLOPES, damage_table
+
+    model = model_from_type(model_type)
+    table = model.cohesive_law(model.parameters(**values))
+    K = STIFFNESS_IN_LAW_SLOPES * table.strength / table.critical_opening
+
+    def worst(damage, u):
+        between = np.sort(np.concatenate([u, *(a * u[1:] + (1 - a) * u[:-1] for a in (0.25, 0.5, 0.75))]))
+        traction = (1 - np.interp(between, u, damage)) * K * (table.strength / K + between)
+        return np.max(np.abs(traction - np.interp(between, table.opening, table.traction))) / table.strength
+
+    assert worst(*damage_table(table, K)) < 1e-3
+    sparse = 1.0 - table.traction / (K * (table.strength / K + table.opening))
+    assert worst(sparse, table.opening) > 0.1

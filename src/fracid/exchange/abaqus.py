@@ -24,6 +24,8 @@ DILATION_ANGLE = 35.0
 COMPRESSION_IN_FT = 10.0
 #: the largest tension damage written (Abaqus's material guide advises against d_t above 0.99, secondary sources)
 MAX_TENSION_DAMAGE = 0.99
+#: the growth of the damage table's openings from delta0 / 50 on (rows enough for Abaqus's linear interpolation)
+ROW_GROWTH = 1.05
 #: which keywords the file's comments cite (docs/export/README.md lists the sources)
 SOURCES = "Abaqus Keywords Reference: *COHESIVE SECTION, *ELASTIC, *DAMAGE INITIATION, *DAMAGE EVOLUTION"
 
@@ -38,9 +40,16 @@ def _number(value: float) -> str:
 
 def damage_table(table, stiffness: float) -> tuple[np.ndarray, np.ndarray]:
     """(D, u) of the tabular damage evolution: u = the opening after initiation [length], D = 1 - sigma(u) /
-    (K (delta0 + u)), delta0 = ft / K; D = 0 at u = 0 and 1 where the law ends."""
-    u, sigma = table.opening, table.traction
+    (K (delta0 + u)), delta0 = ft / K; D = 0 at u = 0 and 1 where the law ends.
+
+    Abaqus interpolates D linearly between rows, and 1 - D falls like delta0 / (delta0 + u) over a few delta0: the rows
+    are the law's openings and openings growing geometrically from delta0 / 50 by :data:`ROW_GROWTH` (the
+    traction between two rows is then within 0.1 % of ft of the law's, measured 0.06 %: tests/test_export_files.py)."""
     delta0 = table.strength / stiffness
+    steps = np.ceil(np.log(50.0 * table.critical_opening / delta0) / np.log(ROW_GROWTH))
+    geometric = 0.02 * delta0 * ROW_GROWTH ** np.arange(steps)
+    u = np.union1d(table.opening, geometric[geometric < table.critical_opening])
+    sigma = np.interp(u, table.opening, table.traction)
     damage = np.clip(1.0 - sigma / (stiffness * (delta0 + u)), 0.0, 1.0)
     damage[0] = 0.0  # 1 - ft / (K delta0), zero but for rounding
     return damage, u
