@@ -26,6 +26,8 @@
     fracid export RESULT --to FORMAT
                               the identified parameters as material input for another code: Abaqus, DIANA, a CSV
                               table of the traction-separation law (:mod:`fracid.cli.export`)
+    fracid serve CONFIG       the configuration's forward model as an UM-Bridge model (evaluate, gradient and
+                              Jacobian from the exact sensitivities) for UQ tools (:mod:`fracid.cli.serve`)
     fracid --version
 
 Options common to all: --out DIR, --workers N, --scheduler ADDRESS, --quiet, --retry-failed, --debug.
@@ -51,7 +53,7 @@ __all__ = ["COMMANDS", "main", "version"]
 #: ``add_parser(sub, parents)`` (``parents.common``: the options of every command; ``parents.stored``: those
 #: and ``--store``), which sets the subparser's ``run`` (args -> exit status)
 COMMANDS = ("simulate", "identify", "posterior", "studies", "identify:add_demo_parser", "init", "check", "compare",
-            "datasets", "export")
+            "datasets", "export", "serve")
 
 
 def _parents() -> SimpleNamespace:
