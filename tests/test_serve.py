@@ -167,3 +167,27 @@ def test_serve_without_a_free_port_or_with_a_bad_one_is_exit_2(served, tmp_path)
     assert proc.returncode == 2 and f"--port {port}" in proc.stderr and "Traceback" not in proc.stderr
     proc = run_fracid(["serve", "bar.toml", "--port", "70000", "--out", str(tmp_path / "p")], folder)
     assert proc.returncode == 2 and "1 to 65535" in proc.stderr
+
+
+def test_the_examples_emcee_sampler_runs_through_the_server(served, tmp_path, monkeypatch):
+    """examples/umbridge/sampler.py, a few steps: its likelihood is the served model's, its draws are written."""
+    import importlib.util
+    import sys
+
+    pytest.importorskip("emcee")
+    url, folder, _ = served
+    path = Path(__file__).parents[1] / "examples" / "umbridge" / "sampler.py"
+    spec = importlib.util.spec_from_file_location("umbridge_sampler", path)
+    sampler = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sampler)
+    log_probability, info, counts = sampler.served_target(url)
+    direct = operator_of(folder)(X).y
+    data, std = np.array(info["data"]), np.array(info["std"])
+    assert log_probability(X) == pytest.approx(-0.5 * np.sum(((direct - data) / std) ** 2), rel=1e-12)
+    assert log_probability(np.array([0.1, 250.0])) == -np.inf and counts["calls"] == 1  # outside the bounds: no run
+    out = tmp_path / "draws.csv"
+    monkeypatch.setattr(sys, "argv", ["sampler.py", "--url", url, "--walkers", "4", "--steps", "3", "--burn", "1",
+                                      "--out", str(out)])
+    sampler.main()
+    draws = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert draws.shape == (8, 2) and np.all((draws[:, 0] > 0.5) & (draws[:, 0] < 4.0))
