@@ -191,3 +191,66 @@ def test_the_examples_emcee_sampler_runs_through_the_server(served, tmp_path, mo
     sampler.main()
     draws = np.loadtxt(out, delimiter=",", skiprows=1)
     assert draws.shape == (8, 2) and np.all((draws[:, 0] > 0.5) & (draws[:, 0] < 4.0))
+
+
+class _Unsupported:
+    """A served model without derivatives whose evaluate fails or succeeds by its input."""
+
+    name = "plain"
+    info = {}
+
+    def supports_evaluate(self):
+        return True
+
+    def supports_gradient(self):
+        return False
+
+    def supports_apply_jacobian(self):
+        return False
+
+    def get_input_sizes(self, config=None):
+        return [1]
+
+    def get_output_sizes(self, config=None):
+        return [1]
+
+    def __call__(self, parameters, config=None):
+        from fracid.exchange.umbridge_model import ServedRunError
+
+        if parameters[0][0] < 0:
+            raise ServedRunError("the forward run at {'x': -1.0} failed: no convergence")
+        return [[2.0 * parameters[0][0]]]
+
+
+def test_the_protocols_routes_in_process_unsupported_features_and_malformed_requests():
+    """The server's answers without a subprocess: Info, a gradient of a model without derivatives
+    (UnsupportedFeature), a body that is not JSON (InvalidInput), a failed run (InvalidOutput), an evaluation."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    pytest.importorskip("aiohttp")
+    from aiohttp.test_utils import TestClient, TestServer
+
+    from fracid.exchange.umbridge_server import application
+
+    async def exchange():
+        with ThreadPoolExecutor(1) as executor:
+            async with TestClient(TestServer(application([_Unsupported()], executor))) as client:
+                answers = [await (await client.get("/Info")).json()]
+                for route, body in (("/Gradient", {"name": "plain", "input": [[1.0]], "sens": [1.0], "outWrt": 0,
+                                                   "inWrt": 0}),
+                                    ("/Evaluate", "not json"),
+                                    ("/Evaluate", {"name": "plain", "input": [[-1.0]]}),
+                                    ("/Evaluate", {"name": "plain", "input": [[1.5]]})):
+                    response = await (client.post(route, json=body) if isinstance(body, dict)
+                                      else client.post(route, data=body))
+                    answers.append((response.status, await response.json()))
+                return answers
+
+    info, gradient, malformed, failed, evaluated = asyncio.run(exchange())
+    assert info == {"protocolVersion": 1.0, "models": ["plain"]}
+    assert gradient[0] == 400 and gradient[1]["error"]["type"] == "UnsupportedFeature"
+    assert malformed[0] == 400 and malformed[1]["error"]["type"] == "InvalidInput"
+    assert failed[0] == 500 and failed[1]["error"] == {"type": "InvalidOutput",
+                                                       "message": "the forward run at {'x': -1.0} failed: no convergence"}
+    assert evaluated == (200, {"output": [[3.0]]})
