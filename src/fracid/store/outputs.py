@@ -35,8 +35,8 @@ OUTPUTS = {
     "sensitivity": ("runs.sqlite", "sensitivity.csv", "sensitivity.png"),
     "size-effect": ("size_effect.csv", "size_effect.json", "size_effect.png"),
     "compare": ("runs.sqlite", "compare.json", "compare.html", "figures"),  # not report.html: identify's in a shared --out
-    "check": ("check",),
-    "serve": ("runs.sqlite", "serve.json"),  # the check figures (fracid.cli.check_figures), written only for a block with a machine log
+    "check": ("check",),  # the check figures (fracid.cli.check_figures), written only for a block with a machine log
+    "serve": ("runs.sqlite", "serve.json"),
 }
 
 
